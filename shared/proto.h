@@ -1,0 +1,208 @@
+/* argil wire protocol v1: the frames that cross between board and host (USB bulk or UDP).
+ * A frame is header + payload + CRC-32C, little-endian, encoded field by field.
+ * Byte-level layout and golden vectors: docs/protocol.md. */
+#ifndef ARGIL_PROTO_H
+#define ARGIL_PROTO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "argil_limits.h"
+
+#define PROTO_MAGIC 0x4C475241u        /* bytes 'A' 'R' 'G' 'L' on the wire */
+#define PROTO_VERSION 1u
+#define PROTO_HEADER_SIZE 12u          /* magic u32, version u8, type u8, length u16, seq u32 */
+#define PROTO_CRC_SIZE 4u              /* CRC-32C of header + payload */
+#define PROTO_FRAME_MAX 1024u          /* no frame is larger: a WINDOW chunk fits in 1 KiB */
+#define PROTO_PAYLOAD_MAX (PROTO_FRAME_MAX - PROTO_HEADER_SIZE - PROTO_CRC_SIZE)
+#define PROTO_IMPULSE_MAX 124u         /* impulse entries in one IMPULSE frame */
+#define PROTO_WINDOW_CHUNK_SAMPLES 224u /* samples per WINDOW chunk (the last may hold fewer) */
+#define PROTO_WINDOW_CHUNKS_MAX \
+    ((ARGIL_WINDOW_SAMPLES_MAX + PROTO_WINDOW_CHUNK_SAMPLES - 1u) / PROTO_WINDOW_CHUNK_SAMPLES)
+#define PROTO_NAME_LEN 16u
+
+/* Which rule a frame broke. Every decoder error is distinct so tests and logs can say why. */
+typedef enum {
+    PROTO_OK = 0,
+    PROTO_ERR_TRUNCATED = -1,  /* fewer bytes than the header or its declared length needs */
+    PROTO_ERR_OVERSIZE = -2,   /* declared payload length above PROTO_PAYLOAD_MAX */
+    PROTO_ERR_MAGIC = -3,      /* the first four bytes are not 'ARGL' */
+    PROTO_ERR_CRC = -4,        /* CRC-32C does not match */
+    PROTO_ERR_VERSION = -5,    /* protocol version not 1 */
+    PROTO_ERR_TYPE = -6,       /* unknown message type */
+    PROTO_ERR_PAYLOAD = -7,    /* payload length does not match its type's layout */
+    PROTO_ERR_VALUE = -8,      /* a field out of range: NaN/Inf, zero spacing, count too high */
+    PROTO_ERR_CHUNK = -9,      /* WINDOW chunk inconsistent with itself or with its siblings */
+    PROTO_ERR_NOSPACE = -10    /* encode: the output buffer is too small */
+} proto_err_t;
+
+typedef enum {
+    MSG_HELLO = 1,
+    MSG_HEARTBEAT = 2,
+    MSG_TELEMETRY = 3,
+    MSG_IMPULSE = 4,
+    MSG_WINDOW = 5,
+    MSG_TOOL = 6,
+    MSG_FAULT = 7
+} msg_type_t;
+
+typedef enum { PROTO_ROLE_BOARD = 1, PROTO_ROLE_HOST = 2 } proto_role_t;
+
+/* HELLO: sent by each side when a link (re)starts; the host answers with the window and tool. */
+typedef struct {
+    uint8_t role;            /* proto_role_t */
+    uint8_t drives;          /* joints the board drives (ARGIL_DRIVES) */
+    uint16_t window_max;     /* largest window edge the sender accepts, samples */
+    uint16_t tick_hz;        /* board loop rate; 0 from the host */
+    char name[PROTO_NAME_LEN]; /* sender's name and build, NUL-padded, not necessarily terminated */
+} msg_hello_t;
+
+/* Commands the host may carry in a HEARTBEAT. */
+typedef enum {
+    PROTO_CMD_NONE = 0,
+    PROTO_CMD_ARM = 1,       /* IDLE → ARMED → ACTIVE, or re-arm after ESTOP / FAULT */
+    PROTO_CMD_DISARM = 2     /* back to IDLE, drives off */
+} proto_cmd_t;
+
+/* HEARTBEAT: both ways, at least every 10 ms; its absence for the timeout is a fault. */
+typedef struct {
+    uint64_t time_us;        /* sender's clock */
+    uint32_t window_version; /* host: newest window sent; board: window in use */
+    uint32_t impulse_seq;    /* host: newest impulse batch applied; board: newest sent */
+    uint8_t command;         /* proto_cmd_t, host → board only */
+} msg_heartbeat_t;
+
+/* TELEMETRY: board → host every tick. Positions and forces are in model space. */
+typedef struct {
+    uint64_t time_us;
+    uint32_t tick;
+    uint8_t state;           /* board safety state (firmware/core/safety.h) */
+    uint8_t tool_kind;       /* tool_kind_t in use */
+    uint8_t buttons;         /* bit 0: stylus button 1, bit 1: button 2 */
+    uint8_t flags;           /* bit 0: in contact, bit 1: sculpting */
+    float pos_m[3];
+    float vel_m_s[3];
+    float force_n[3];        /* force rendered to the hand */
+    uint32_t window_version;
+    uint32_t compute_ns;     /* this tick's compute time */
+    uint32_t deadline_misses;/* since boot */
+} msg_telemetry_t;
+
+typedef struct {
+    uint32_t node;           /* linear index x + nx*(y + ny*z) in the window of window_version */
+    float impulse_ns;        /* ∫ f dt on that node's density axis, N·s */
+} proto_impulse_t;
+
+/* IMPULSE: board → host a few hundred times a second: accumulated node impulses. */
+typedef struct {
+    uint32_t window_version;
+    uint32_t impulse_seq;    /* increases by one per IMPULSE frame */
+    uint16_t count;          /* ≤ PROTO_IMPULSE_MAX */
+    proto_impulse_t entries[PROTO_IMPULSE_MAX];
+} msg_impulse_t;
+
+/* WINDOW: host → board, one chunk of a versioned local density window.
+ * Chunk i holds samples [i*PROTO_WINDOW_CHUNK_SAMPLES, …) of the x-fastest sample array. */
+typedef struct {
+    uint32_t version;
+    uint16_t chunk_index;
+    uint16_t chunk_count;
+    uint8_t dims[3];         /* samples per axis, 2 … ARGIL_WINDOW_MAX */
+    float origin_m[3];       /* model-space position of sample (0,0,0) */
+    float spacing_m;         /* > 0 */
+    float iso;               /* iso-value of the surface */
+    float node_mass;         /* density-spring material, uniform over the window */
+    float stiffness;
+    float damping;
+    float plastic_rate_hz;   /* how fast rest densities follow the current ones (0 = elastic) */
+    uint32_t impulse_seq;    /* newest IMPULSE batch the host had applied when it extracted this */
+    uint32_t first_sample;
+    uint16_t sample_count;
+    float samples[PROTO_WINDOW_CHUNK_SAMPLES];
+} msg_window_t;
+
+typedef enum {
+    TOOL_TOUCH = 0,          /* feel only */
+    TOOL_PUSH = 1,           /* lower density where the tool moves (dent) */
+    TOOL_PULL = 2,           /* raise density where the tool moves (bulge) */
+    TOOL_CARVE = 3           /* host-side geometric removal; the board renders contact */
+} tool_kind_t;
+#define TOOL_KIND_COUNT 4
+
+/* TOOL: host → board, the active tool, its gains and the device-to-model transform. */
+typedef struct {
+    uint8_t kind;            /* tool_kind_t */
+    float radius_m;          /* > 0 */
+    float alpha;             /* sculpting gain of Hua & Qin eq. 7 */
+    float contact_stiffness_n_per_m;
+    float max_force_n;       /* > 0 */
+    float model_scale;       /* model = scale * device + offset; > 0 */
+    float model_offset_m[3];
+} msg_tool_t;
+
+/* FAULT: board → host when the board enters FAULT or ESTOP. */
+typedef struct {
+    uint64_t time_us;
+    uint16_t code;           /* fault_code_t of firmware/core/safety.h */
+    uint8_t state;
+    uint32_t detail;
+} msg_fault_t;
+
+typedef struct {
+    uint8_t type;            /* msg_type_t */
+    uint32_t seq;            /* from the frame header */
+    union {
+        msg_hello_t hello;
+        msg_heartbeat_t heartbeat;
+        msg_telemetry_t telemetry;
+        msg_impulse_t impulse;
+        msg_window_t window;
+        msg_tool_t tool;
+        msg_fault_t fault;
+    } u;
+} proto_msg_t;
+
+/* Encodes msg as one frame with sequence seq into buf; *len gets the frame size.
+ * Returns PROTO_ERR_NOSPACE when cap is too small, PROTO_ERR_VALUE / PROTO_ERR_TYPE for
+ * a message that would not decode (so nothing invalid is ever sent). */
+proto_err_t proto_encode(const proto_msg_t *msg, uint32_t seq, uint8_t *buf, size_t cap,
+                         size_t *len);
+
+/* Decodes the frame at the start of buf[0..len). On PROTO_OK *frame_len is its size.
+ * Never reads outside buf[0..len). */
+proto_err_t proto_decode(const uint8_t *buf, size_t len, proto_msg_t *msg, size_t *frame_len);
+
+/* A short English name of err, for logs. */
+const char *proto_strerror(proto_err_t err);
+
+/* Reassembles the chunks of one window version into caller-given storage. */
+typedef struct {
+    float *samples;          /* caller's storage */
+    uint32_t capacity;       /* samples it holds */
+    bool started;
+    uint32_t version;
+    uint16_t chunk_count;
+    uint16_t received;       /* distinct chunks of this version seen */
+    uint32_t got[(PROTO_WINDOW_CHUNKS_MAX + 31u) / 32u]; /* bitmap of chunks seen */
+    msg_window_t head;       /* fields of the first chunk (samples unused) */
+} window_asm_t;
+
+void window_asm_init(window_asm_t *a, float *storage, uint32_t capacity);
+
+/* Adds one decoded chunk. A newer version restarts assembly; an older one is refused.
+ * Returns PROTO_ERR_CHUNK when the chunk disagrees with its siblings or does not fit. */
+proto_err_t window_asm_feed(window_asm_t *a, const msg_window_t *chunk);
+
+/* True once every chunk of the current version has arrived. */
+bool window_asm_complete(const window_asm_t *a);
+
+/* Fills chunk number index of a window (header fields from head, samples from samples[])
+ * the way window_asm_feed expects; returns PROTO_ERR_VALUE if index is out of range. */
+proto_err_t window_chunk_fill(const msg_window_t *head, const float *samples, uint16_t index,
+                              msg_window_t *chunk);
+
+/* Number of chunks a window of dims[0]*dims[1]*dims[2] samples takes. */
+uint16_t window_chunk_count(const uint8_t dims[3]);
+
+#endif
