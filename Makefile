@@ -14,7 +14,7 @@ OUT ?= out
 SCRIPT ?= scripts/default.scn
 
 WARN := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes \
-        -Wpointer-arith -Wformat=2
+        -Wpointer-arith -Wformat=2 -Wno-format-truncation
 # firmware/core and shared/: no variable-length arrays, nothing from the hosted libc.
 RT_FLAGS := -Wvla -fno-common
 CSTD := -std=c11 -D_DEFAULT_SOURCE

@@ -1,0 +1,406 @@
+/* The board tick pipeline. */
+#include "board.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "shared/gpio_lines.h"
+
+void board_cfg_default(board_cfg_t *cfg)
+{
+    memset(cfg, 0, sizeof(*cfg));
+    cfg->tick_us = 1000u;
+    cfg->max_force_n = 3.3f;
+    cfg->impulse_period_us = 5000u;
+    cfg->heartbeat_period_us = 10000u;
+    cfg->crossfade_ticks = 8u;
+    cfg->velocity_filter = 0.2f;
+    safety_cfg_default(&cfg->safety);
+    drives_cfg_default(&cfg->drives);
+    arm_desc_default(&cfg->arm);
+    memcpy(cfg->name, "argil-board v1", 14);
+}
+
+argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
+{
+    if (cfg->tick_us < 100u || cfg->tick_us > 10000u || !(cfg->max_force_n > 0.0f) ||
+        !isfinite(cfg->max_force_n) || cfg->impulse_period_us == 0 ||
+        cfg->heartbeat_period_us == 0 || !(cfg->velocity_filter > 0.0f) ||
+        cfg->velocity_filter > 1.0f)
+        return ARGIL_ERR_ARG;
+    b->cfg = *cfg;
+    safety_init(&b->safety);
+    drives_init(&b->drives);
+    window_init(&b->window);
+    haptics_init(&b->haptics);
+    memset(&b->tool, 0, sizeof(b->tool));
+    b->tool_valid = false;
+    memset(b->impulse_ns, 0, sizeof(b->impulse_ns));
+    b->impulse_pending = false;
+    b->impulse_seq = 0;
+    b->tx_seq = 0;
+    b->time_us = 0;
+    b->since_impulse_us = 0;
+    b->since_heartbeat_us = 0;
+    b->hello_due = true;
+    b->fault_reported = false;
+    b->wdog_level = false;
+    b->host_window_version = 0;
+    b->have_tip = false;
+    b->tip_device_m = vec3(0, 0, 0);
+    b->pos_m = vec3(0, 0, 0);
+    b->vel_m_s = vec3(0, 0, 0);
+    b->force_n = vec3(0, 0, 0);
+    b->fade_from_n = vec3(0, 0, 0);
+    b->fade_left = 0;
+    b->contact = false;
+    b->sculpting = false;
+    memset(&b->stats, 0, sizeof(b->stats));
+    return ARGIL_OK;
+}
+
+vec3_t board_device_to_model(const board_t *b, vec3_t device_m)
+{
+    return vec3(b->tool.model_scale * device_m.x + b->tool.model_offset_m[0],
+                b->tool.model_scale * device_m.y + b->tool.model_offset_m[1],
+                b->tool.model_scale * device_m.z + b->tool.model_offset_m[2]);
+}
+
+/* Encodes msg into the tick's output; counts a drop when it does not fit. */
+static void send(board_t *b, board_out_t *out, const proto_msg_t *msg)
+{
+    size_t len = 0;
+    const proto_err_t e = proto_encode(msg, b->tx_seq, out->link_tx + out->link_tx_len,
+                                       BOARD_LINK_TX_MAX - out->link_tx_len, &len);
+    if (e != PROTO_OK) {
+        b->stats.link_tx_dropped++;
+        return;
+    }
+    b->tx_seq++;
+    out->link_tx_len += len;
+}
+
+typedef struct {
+    bool heartbeat;
+    bool arm;
+    bool disarm;
+    bool nonfinite;
+} host_events_t;
+
+/* Decodes every frame the host sent; a refused frame is skipped byte by byte until the next
+ * frame boundary is found, so one bad frame costs only itself. */
+static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
+{
+    proto_msg_t *const m = &b->scratch;
+    size_t at = 0;
+    const size_t len = in->link_rx ? in->link_rx_len : 0;
+    while (at < len) {
+        size_t flen = 0;
+        const proto_err_t e = proto_decode(in->link_rx + at, len - at, m, &flen);
+        if (e != PROTO_OK) {
+            b->stats.link_errors++;
+            b->stats.last_link_error = e;
+            if (e == PROTO_ERR_TRUNCATED)
+                break; /* frames arrive whole; the rest of this buffer is a torn frame */
+            at++;
+            continue;
+        }
+        at += flen;
+        b->stats.link_frames_rx++;
+        switch (m->type) {
+        case MSG_HELLO:
+            if (m->u.hello.role == PROTO_ROLE_HOST)
+                b->hello_due = true;
+            break;
+        case MSG_HEARTBEAT:
+            ev->heartbeat = true;
+            b->host_window_version = m->u.heartbeat.window_version;
+            if (m->u.heartbeat.command == PROTO_CMD_ARM)
+                ev->arm = true;
+            else if (m->u.heartbeat.command == PROTO_CMD_DISARM)
+                ev->disarm = true;
+            break;
+        case MSG_WINDOW: {
+            const proto_err_t we = window_feed(&b->window, &m->u.window);
+            if (we == PROTO_ERR_VALUE)
+                ev->nonfinite = true;
+            if (we != PROTO_OK) {
+                b->stats.link_errors++;
+                b->stats.last_link_error = we;
+            }
+            break;
+        }
+        case MSG_TOOL:
+            b->tool = m->u.tool; /* the decoder has checked every field */
+            b->tool_valid = true;
+            break;
+        default:
+            break; /* TELEMETRY, IMPULSE, FAULT are board → host only */
+        }
+    }
+}
+
+/* Kinematics: joint angles from the encoders, tip in device and model space, velocity. */
+static bool sense_tool(board_t *b)
+{
+    if (!drives_positions_valid(&b->drives))
+        return true;
+    float q[ARGIL_DRIVES];
+    for (int j = 0; j < ARGIL_DRIVES; j++)
+        q[j] = arm_counts_to_rad(&b->cfg.arm, j, b->drives.d[j].position_counts);
+    const vec3_t tip = arm_fk(&b->cfg.arm, q);
+    if (!vec3_isfinite(tip))
+        return false;
+    const float dt_s = (float)b->cfg.tick_us * 1e-6f;
+    if (b->have_tip) {
+        const vec3_t v = vec3_scale(vec3_sub(tip, b->tip_device_m), 1.0f / dt_s);
+        const float a = b->cfg.velocity_filter;
+        b->vel_m_s = vec3_add(vec3_scale(b->vel_m_s, 1.0f - a), vec3_scale(v, a));
+    }
+    b->tip_device_m = tip;
+    b->have_tip = true;
+    if (b->tool_valid) {
+        b->pos_m = board_device_to_model(b, tip);
+    }
+    return vec3_isfinite(b->pos_m) && vec3_isfinite(b->vel_m_s);
+}
+
+/* Sends the accumulated impulses of the active window, at most BOARD_IMPULSE_FRAMES_MAX frames. */
+static void flush_impulses(board_t *b, board_out_t *out)
+{
+    const window_buf_t *w = window_active(&b->window);
+    if (!w || !b->impulse_pending)
+        return;
+    proto_msg_t *const m = &b->scratch;
+    const int32_t n = w->dims[0] * w->dims[1] * w->dims[2];
+    int32_t i = 0;
+    bool left = false;
+    for (uint32_t frame = 0; frame < BOARD_IMPULSE_FRAMES_MAX && i < n; frame++) {
+        m->type = MSG_IMPULSE;
+        m->u.impulse.window_version = w->version;
+        m->u.impulse.impulse_seq = b->impulse_seq + 1u;
+        m->u.impulse.count = 0;
+        for (; i < n && m->u.impulse.count < PROTO_IMPULSE_MAX; i++) {
+            if (b->impulse_ns[i] != 0.0f) {
+                proto_impulse_t *e = &m->u.impulse.entries[m->u.impulse.count++];
+                e->node = (uint32_t)i;
+                e->impulse_ns = b->impulse_ns[i];
+            }
+        }
+        if (m->u.impulse.count == 0)
+            break;
+        const size_t before = out->link_tx_len;
+        send(b, out, m);
+        if (out->link_tx_len == before) {
+            /* No room this tick: keep these impulses for the next flush. */
+            left = true;
+            break;
+        }
+        b->impulse_seq++;
+        for (uint16_t k = 0; k < m->u.impulse.count; k++)
+            b->impulse_ns[m->u.impulse.entries[k].node] = 0.0f;
+    }
+    for (; i < n && !left; i++)
+        if (b->impulse_ns[i] != 0.0f)
+            left = true;
+    b->impulse_pending = left;
+}
+
+/* LED pattern per state: off idle, slow blink armed, on active, fast blink fault/e-stop. */
+static bool status_led(const board_t *b)
+{
+    const uint32_t ms = (uint32_t)(b->time_us / 1000u);
+    switch (b->safety.state) {
+    case SAFETY_ARMED: return (ms / 500u) % 2u == 0;
+    case SAFETY_ACTIVE: return true;
+    case SAFETY_FAULT:
+    case SAFETY_ESTOP: return (ms / 100u) % 2u == 0;
+    default: return false;
+    }
+}
+
+void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
+{
+    const uint32_t dt_us = b->cfg.tick_us;
+    const float dt_s = (float)dt_us * 1e-6f;
+    out->can_tx.n = 0;
+    out->link_tx_len = 0;
+    b->stats.ticks++;
+    b->time_us += dt_us;
+
+    /* Deadline accounting for the previous tick. */
+    const bool overrun = in->prev_compute_ns > dt_us * 1000u;
+    if (overrun)
+        b->stats.deadline_misses++;
+    if (in->prev_compute_ns > b->stats.worst_compute_ns)
+        b->stats.worst_compute_ns = in->prev_compute_ns;
+
+    /* 1. Sense. */
+    host_events_t ev = {false, false, false, false};
+    if (in->can_rx)
+        drives_receive(&b->drives, in->can_rx);
+    receive_link(b, in, &ev);
+    if (ev.arm)
+        drives_clear_emcy(&b->drives);
+
+    /* Swap a complete window in at this tick boundary, once its predecessor's impulses are out. */
+    if (window_pending(&b->window) && !b->impulse_pending) {
+        window_swap(&b->window);
+        memset(b->impulse_ns, 0, sizeof(b->impulse_ns));
+        haptics_reset_path(&b->haptics);
+        b->fade_from_n = b->force_n;
+        b->fade_left = b->cfg.crossfade_ticks;
+        b->stats.windows_swapped++;
+    }
+
+    /* 2. Kinematics. */
+    bool nonfinite = ev.nonfinite || !sense_tool(b);
+
+    /* 3-4. Force mapping and the local window step. */
+    window_buf_t *w = window_active_mut(&b->window);
+    const bool btn1 = (in->gpio_in & GPIO_IN_STYLUS_BTN1) != 0;
+    haptics_out_t h = {vec3(0, 0, 0), false, false};
+    if (w && b->tool_valid && b->have_tip && !nonfinite) {
+        haptics_process(&b->haptics, &b->tool, w, b->pos_m, b->vel_m_s, btn1,
+                        safety_may_sculpt(&b->safety), dt_s, b->impulse_ns, &h);
+        if (h.sculpting)
+            b->impulse_pending = true;
+        /* Step the springs in a box around the tool: the nodes the tool can reach and a margin. */
+        const float reach = b->tool.radius_m + 3.0f * w->spacing_m;
+        int32_t lo[3], hi[3];
+        const float p[3] = {b->pos_m.x - w->origin_m.x, b->pos_m.y - w->origin_m.y,
+                            b->pos_m.z - w->origin_m.z};
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (int32_t)floorf((p[a] - reach) / w->spacing_m);
+            hi[a] = (int32_t)ceilf((p[a] + reach) / w->spacing_m) + 1;
+        }
+        spring_field_t f = {{w->dims[0], w->dims[1], w->dims[2]},
+                            w->density, w->rest, w->velocity, w->force};
+        (void)springs_step(&f, &w->material, lo, hi, dt_s);
+    } else {
+        haptics_reset_path(&b->haptics);
+    }
+    if (!vec3_isfinite(h.force_n))
+        nonfinite = true;
+
+    /* 5. Safety. */
+    safety_inputs_t si;
+    si.estop_pressed = (in->gpio_in & GPIO_IN_ESTOP_N) == 0;
+    si.drive_fault_line = (in->gpio_in & GPIO_IN_DRIVE_FAULT_N) == 0;
+    si.drives_enabled = drives_all_enabled(&b->drives);
+    si.drive_heartbeat_lost = drives_heartbeat_lost(&b->drives, &b->cfg.drives);
+    si.drive_emcy = drives_any_emcy(&b->drives);
+    si.window_ready = w != 0 && b->tool_valid && b->have_tip;
+    si.host_heartbeat = ev.heartbeat;
+    si.arm_request = ev.arm;
+    si.disarm_request = ev.disarm;
+    si.nonfinite = nonfinite;
+    si.force_limit_exceeded = false;
+    si.deadline_overrun = overrun;
+    si.bus_error = false;
+    const float scale = safety_process(&b->safety, &b->cfg.safety, &si, dt_us);
+
+    vec3_t f = nonfinite ? vec3(0, 0, 0) : vec3_clamp_len(h.force_n, b->cfg.max_force_n);
+    if (b->fade_left > 0) {
+        /* Cross-fade from the force felt before the swap. */
+        const float t = (float)(b->cfg.crossfade_ticks - b->fade_left + 1u) /
+                        (float)(b->cfg.crossfade_ticks + 1u);
+        f = vec3_add(vec3_scale(b->fade_from_n, 1.0f - t), vec3_scale(f, t));
+        b->fade_left--;
+    }
+    f = vec3_scale(f, scale);
+    if (!vec3_isfinite(f))
+        f = vec3(0, 0, 0);
+    b->force_n = f;
+    b->contact = h.contact;
+    b->sculpting = h.sculpting && scale > 0.0f;
+    const float fn = vec3_norm(f);
+    if (fn > b->stats.peak_force_n)
+        b->stats.peak_force_n = fn;
+
+    /* 6. Actuate: tau = Jᵀ F, motor torque in per-mille of rated. */
+    int16_t permille[ARGIL_DRIVES] = {0};
+    if (b->have_tip && fn > 0.0f) {
+        float q[ARGIL_DRIVES], jac[3][ARGIL_DRIVES], tau[ARGIL_DRIVES];
+        for (int j = 0; j < ARGIL_DRIVES; j++)
+            q[j] = arm_counts_to_rad(&b->cfg.arm, j, b->drives.d[j].position_counts);
+        arm_jacobian(&b->cfg.arm, q, jac);
+        arm_jt_force(jac, f, tau);
+        for (int j = 0; j < ARGIL_DRIVES; j++) {
+            float pm = tau[j] / b->cfg.arm.gear_ratio[j] / b->cfg.arm.rated_torque_nm[j] * 1000.0f;
+            if (!isfinite(pm))
+                pm = 0.0f;
+            if (pm > 32767.0f) pm = 32767.0f;
+            if (pm < -32767.0f) pm = -32767.0f;
+            permille[j] = (int16_t)lrintf(pm);
+        }
+    }
+    const bool drives_on = safety_drives_on(&b->safety);
+    drives_process(&b->drives, &b->cfg.drives, drives_on, permille, dt_us, &out->can_tx);
+    const bool healthy = b->safety.state != SAFETY_FAULT && b->safety.state != SAFETY_ESTOP;
+    if (healthy)
+        b->wdog_level = !b->wdog_level;
+    out->gpio_out = (drives_on ? GPIO_OUT_DRIVE_ENABLE : 0u) |
+                    (status_led(b) ? GPIO_OUT_STATUS_LED : 0u) |
+                    (b->wdog_level ? GPIO_OUT_WDOG_KICK : 0u);
+
+    /* 7. Telemetry, heartbeats, impulses, faults. */
+    proto_msg_t *const m = &b->scratch;
+    if (b->hello_due) {
+        memset(m, 0, sizeof(*m));
+        m->type = MSG_HELLO;
+        m->u.hello.role = PROTO_ROLE_BOARD;
+        m->u.hello.drives = ARGIL_DRIVES;
+        m->u.hello.window_max = ARGIL_WINDOW_MAX;
+        m->u.hello.tick_hz = (uint16_t)(1000000u / dt_us);
+        memcpy(m->u.hello.name, b->cfg.name, PROTO_NAME_LEN);
+        send(b, out, m);
+        b->hello_due = false;
+    }
+    const bool bad = b->safety.state == SAFETY_FAULT || b->safety.state == SAFETY_ESTOP;
+    if (bad && !b->fault_reported) {
+        m->type = MSG_FAULT;
+        m->u.fault.time_us = b->time_us;
+        m->u.fault.code = (uint16_t)b->safety.fault;
+        m->u.fault.state = (uint8_t)b->safety.state;
+        m->u.fault.detail = b->stats.last_link_error < 0 ? (uint32_t)(-b->stats.last_link_error) : 0u;
+        send(b, out, m);
+        b->fault_reported = true;
+    } else if (!bad) {
+        b->fault_reported = false;
+    }
+    b->since_impulse_us += dt_us;
+    if (b->since_impulse_us >= b->cfg.impulse_period_us || window_pending(&b->window)) {
+        flush_impulses(b, out);
+        b->since_impulse_us = 0;
+    }
+    b->since_heartbeat_us += dt_us;
+    if (b->since_heartbeat_us >= b->cfg.heartbeat_period_us) {
+        const window_buf_t *aw = window_active(&b->window);
+        m->type = MSG_HEARTBEAT;
+        m->u.heartbeat.time_us = b->time_us;
+        m->u.heartbeat.window_version = aw ? aw->version : 0u;
+        m->u.heartbeat.impulse_seq = b->impulse_seq;
+        m->u.heartbeat.command = PROTO_CMD_NONE;
+        send(b, out, m);
+        b->since_heartbeat_us = 0;
+    }
+    const window_buf_t *aw = window_active(&b->window);
+    m->type = MSG_TELEMETRY;
+    msg_telemetry_t *t = &m->u.telemetry;
+    t->time_us = b->time_us;
+    t->tick = b->stats.ticks;
+    t->state = (uint8_t)b->safety.state;
+    t->tool_kind = b->tool_valid ? b->tool.kind : (uint8_t)TOOL_TOUCH;
+    t->buttons = (uint8_t)((btn1 ? 1u : 0u) | ((in->gpio_in & GPIO_IN_STYLUS_BTN2) ? 2u : 0u));
+    t->flags = (uint8_t)((b->contact ? 1u : 0u) | (b->sculpting ? 2u : 0u));
+    const vec3_t pos = vec3_isfinite(b->pos_m) ? b->pos_m : vec3(0, 0, 0);
+    const vec3_t vel = vec3_isfinite(b->vel_m_s) ? b->vel_m_s : vec3(0, 0, 0);
+    t->pos_m[0] = pos.x; t->pos_m[1] = pos.y; t->pos_m[2] = pos.z;
+    t->vel_m_s[0] = vel.x; t->vel_m_s[1] = vel.y; t->vel_m_s[2] = vel.z;
+    t->force_n[0] = f.x; t->force_n[1] = f.y; t->force_n[2] = f.z;
+    t->window_version = aw ? aw->version : 0u;
+    t->compute_ns = in->prev_compute_ns;
+    t->deadline_misses = b->stats.deadline_misses;
+    send(b, out, m);
+}

@@ -1,0 +1,30 @@
+/* The board's one window on the world: CAN, GPIO, the host link and a clock. Each backend is
+ * its own .c file chosen at link time (hal_sim.c today; hal_linux.c and hal_cortexm.c come with
+ * the board issue). Every call returns at once: nothing here may block the 1 kHz tick. */
+#ifndef ARGIL_HAL_H
+#define ARGIL_HAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/canopen.h"
+
+typedef struct hal hal_t;  /* defined by the backend */
+
+/* Moves the frames the drives sent since the last call into rx (at most CAN_BATCH_MAX). */
+argil_err_t hal_can_receive(hal_t *h, can_batch_t *rx);
+/* Queues the tick's frames for the bus; ARGIL_ERR_FULL when the bus cannot take them. */
+argil_err_t hal_can_send(hal_t *h, const can_batch_t *tx);
+/* Input line levels as GPIO_IN_* bits (shared/gpio_lines.h). */
+uint32_t hal_gpio_read(hal_t *h);
+/* Drives the output lines to GPIO_OUT_* levels. */
+void hal_gpio_write(hal_t *h, uint32_t levels);
+/* Copies whole frames from the host into buf, back to back; returns the bytes copied. */
+size_t hal_link_receive(hal_t *h, uint8_t *buf, size_t cap);
+/* Queues bytes of whole frames for the host; ARGIL_ERR_FULL when the link cannot take them. */
+argil_err_t hal_link_send(hal_t *h, const uint8_t *buf, size_t len);
+/* A monotonic nanosecond clock for measuring the tick's compute time. */
+uint64_t hal_compute_clock_ns(hal_t *h);
+
+#endif

@@ -1,0 +1,143 @@
+/* argil: the desktop program. Today: `argil sculpt` runs a scripted session on the simulated
+ * arm and writes the result. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "firmware/core/safety.h"
+#include "host/app/session.h"
+
+static void usage_main(FILE *f)
+{
+    fprintf(f,
+            "usage: argil COMMAND [OPTIONS]\n"
+            "\n"
+            "argil is a haptic virtual-clay sculpting system.\n"
+            "\n"
+            "commands:\n"
+            "  sculpt    run a sculpting session (see 'argil sculpt --help')\n"
+            "  help      show this text\n");
+}
+
+static void usage_sculpt(FILE *f)
+{
+    fprintf(f,
+            "usage: argil sculpt [--device sim] [--script FILE] [--out DIR] [--window N]\n"
+            "                    [--quiet]\n"
+            "\n"
+            "Runs a sculpting session. With --device sim (the default) the arm, its drives and\n"
+            "the hand holding the stylus are simulated in lockstep on a virtual clock, so the\n"
+            "same script always gives the same files.\n"
+            "\n"
+            "options:\n"
+            "  --device sim    the device to sculpt with (sim: the simulated arm; USB and UDP\n"
+            "                  boards come with the host-application work)\n"
+            "  --script FILE   the session script (default scripts/default.scn; format in\n"
+            "                  docs/script.md)\n"
+            "  --out DIR       where to write final.ply, telemetry.csv and session.scn\n"
+            "                  (default out; created if missing)\n"
+            "  --window N      edge of the board's local density window in samples, 4..32\n"
+            "                  (default 16)\n"
+            "  --quiet         no progress line and no summary\n"
+            "  -h, --help      this text\n");
+}
+
+static int cmd_sculpt(int argc, char **argv)
+{
+    session_opts_t o;
+    session_opts_default(&o);
+    int quiet = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage_sculpt(stdout);
+            return 0;
+        } else if (strcmp(a, "--quiet") == 0) {
+            quiet = 1;
+        } else if (strcmp(a, "--device") == 0 || strcmp(a, "--script") == 0 ||
+                   strcmp(a, "--out") == 0 || strcmp(a, "--window") == 0) {
+            if (!v) {
+                fprintf(stderr, "argil sculpt: %s needs a value (see --help)\n", a);
+                return 2;
+            }
+            i++;
+            if (strcmp(a, "--device") == 0) {
+                if (strcmp(v, "sim") != 0) {
+                    fprintf(stderr,
+                            "argil sculpt: device '%s' is not available in this build; only "
+                            "'sim' (the simulated arm) is\n",
+                            v);
+                    return 2;
+                }
+            } else if (strcmp(a, "--script") == 0) {
+                o.script_path = v;
+            } else if (strcmp(a, "--out") == 0) {
+                o.out_dir = v;
+            } else {
+                char *end;
+                const long n = strtol(v, &end, 10);
+                if (*end != '\0' || n < 4 || n > 32) {
+                    fprintf(stderr, "argil sculpt: --window must be a whole number 4..32, got '%s'\n",
+                            v);
+                    return 2;
+                }
+                o.window_edge = (int)n;
+            }
+        } else {
+            fprintf(stderr, "argil sculpt: unknown option '%s' (see --help)\n", a);
+            return 2;
+        }
+    }
+    o.progress = !quiet && isatty(STDERR_FILENO);
+    session_summary_t s;
+    char err[1024] = "";
+    const argil_err_t rc = session_run(&o, &s, err, sizeof(err));
+    if (!quiet && s.board_ticks > 0) {
+        const double vb = s.volume_before_m3 * 1e6, va = s.volume_after_m3 * 1e6;
+        printf("argil: session %s on the simulated arm\n", o.script_path);
+        printf("  simulated time      %.3f s (%u board ticks at %u Hz)\n", s.sim_seconds,
+               s.board_ticks, s.tick_hz);
+        printf("  worst tick compute  %.1f us of a %u us period, deadline misses %u\n",
+               s.worst_compute_ns / 1000.0, 1000000u / s.tick_hz, s.deadline_misses);
+        printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
+               (double)s.force_limit_n);
+        printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,
+               vb > 0 ? (va - vb) / vb * 100.0 : 0.0);
+        printf("  mesh                %zu triangles, %zu vertices, %s\n", s.triangles, s.vertices,
+               s.watertight ? "watertight" : "NOT watertight");
+        printf("  link                %u windows sent, %u impulse frames, %u refused frames\n",
+               s.windows_sent, s.impulse_frames, s.link_errors);
+        printf("  board state         %s%s%s\n", safety_state_name((safety_state_t)s.final_state),
+               s.fault_code ? ", last fault: " : "",
+               s.fault_code ? safety_fault_name((fault_code_t)s.fault_code) : "");
+        if (o.out_dir)
+            printf("  files               %s/final.ply, %s/telemetry.csv (%u rows), "
+                   "%s/session.scn\n",
+                   o.out_dir, o.out_dir, s.telemetry_rows, o.out_dir);
+    }
+    if (rc != ARGIL_OK) {
+        fprintf(stderr, "argil sculpt: %s\n", err);
+        return 1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage_main(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "sculpt") == 0)
+        return cmd_sculpt(argc - 2, argv + 2);
+    if (strcmp(argv[1], "help") == 0 || strcmp(argv[1], "-h") == 0 ||
+        strcmp(argv[1], "--help") == 0) {
+        usage_main(stdout);
+        return 0;
+    }
+    fprintf(stderr, "argil: unknown command '%s'\n", argv[1]);
+    usage_main(stderr);
+    return 2;
+}

@@ -1,0 +1,102 @@
+/* The host's half of the board protocol: keeps the global field in step with the board —
+ * applies the board's impulses, sends versioned windows around the tool, the tool settings
+ * and heartbeats — and hands telemetry to whoever records it. Transport-neutral: bytes in,
+ * frames out through a callback. */
+#ifndef ARGIL_PEER_H
+#define ARGIL_PEER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "host/model/grid.h"
+#include "shared/proto.h"
+
+#define PEER_VERSIONS_KEPT 32u        /* window versions whose layout is remembered */
+#define PEER_CHUNKS_PER_TICK 4u       /* WINDOW chunks sent per millisecond at most */
+
+typedef struct {
+    uint32_t version;
+    int32_t corner[3];
+    int32_t dims[3];
+} peer_window_ref_t;
+
+/* Sends one encoded frame; returns false when the link cannot take it now. */
+typedef bool (*peer_send_fn)(void *ctx, const uint8_t *frame, size_t len);
+/* Receives each telemetry message in arrival order. */
+typedef void (*peer_telemetry_fn)(void *ctx, const msg_telemetry_t *t);
+
+typedef struct {
+    int32_t window_edge;              /* samples per axis of the board's window */
+    uint32_t heartbeat_period_us;     /* 5 ms */
+    uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
+    uint32_t window_min_period_us;    /* refresh an edited window at most this often */
+} peer_cfg_t;
+
+typedef struct {
+    uint32_t frames_rx;
+    uint32_t decode_errors;
+    uint32_t impulse_frames;
+    uint32_t impulses_unmapped;       /* for a window version no longer remembered */
+    uint32_t windows_sent;
+    uint32_t chunks_sent;
+    uint32_t solves;
+    uint32_t faults;
+    uint16_t last_fault_code;
+    double impulse_total_ns;          /* Σ|J| applied */
+} peer_stats_t;
+
+typedef struct {
+    peer_cfg_t cfg;
+    grid_t *grid;
+    peer_send_fn send;
+    peer_telemetry_fn on_telemetry;
+    void *ctx;
+    uint32_t tx_seq;
+    uint64_t time_us;
+    bool board_seen;
+    msg_telemetry_t last_tm;
+    bool have_tm;
+    msg_tool_t tool;
+    bool tool_dirty;
+    bool want_armed;
+    bool arm_sent;
+    peer_window_ref_t refs[PEER_VERSIONS_KEPT];
+    uint32_t next_version;
+    peer_window_ref_t sending;        /* window whose chunks are going out */
+    bool sending_active;
+    uint16_t next_chunk;
+    msg_window_t head;                /* header fields of the window being sent */
+    float *win_samples;               /* window_edge³ */
+    peer_window_ref_t current;        /* newest window fully sent */
+    bool have_current;
+    bool field_dirty;
+    uint32_t since_window_us;
+    uint32_t since_heartbeat_us;
+    uint32_t since_solve_us;
+    uint32_t impulse_seq_applied;
+    int32_t dirty_lo[3], dirty_hi[3]; /* samples changed since the last mesh (lo > hi: none) */
+    peer_stats_t stats;
+    proto_msg_t scratch;
+} peer_t;
+
+void peer_cfg_default(peer_cfg_t *cfg);
+
+/* Sets up the peer over a grid; the grid stays the caller's. */
+argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
+                      peer_telemetry_fn on_telemetry, void *ctx);
+void peer_free(peer_t *p);
+
+/* Takes in bytes of whole frames from the board. */
+void peer_receive(peer_t *p, const uint8_t *bytes, size_t len);
+
+/* Changes the tool (sent to the board on the next tick). */
+void peer_set_tool(peer_t *p, const msg_tool_t *tool);
+
+/* Asks the board to arm (once it reports IDLE) — the session's start. */
+void peer_request_arm(peer_t *p);
+
+/* Advances the host by dt_us: heartbeats, tool, global solve and carving, windows. */
+void peer_tick(peer_t *p, uint32_t dt_us);
+
+#endif

@@ -1,0 +1,318 @@
+/* Session script parser and player. */
+#include "script.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "shared/proto.h"
+
+static const char *const PARAM_NAMES[PARAM_COUNT] = {"radius_mm", "alpha", "stiffness_n_per_mm",
+                                                     "max_force_n"};
+static const float PARAM_MIN[PARAM_COUNT] = {0.5f, 0.0f, 0.01f, 0.1f};
+static const float PARAM_MAX[PARAM_COUNT] = {50.0f, 1e7f, 10.0f, 10.0f};
+static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull", "carve"};
+
+const char *script_param_name(script_param_t p)
+{
+    return (p >= 0 && p < PARAM_COUNT) ? PARAM_NAMES[p] : "?";
+}
+
+void script_init(script_t *s)
+{
+    s->cmds = NULL;
+    s->count = 0;
+    s->cap = 0;
+}
+
+void script_free(script_t *s)
+{
+    free(s->cmds);
+    script_init(s);
+}
+
+/* Splits a line into at most max words; returns the count, or max+1 if there are more. */
+static int split_words(char *line, char **words, int max)
+{
+    int n = 0;
+    char *p = line;
+    for (;;) {
+        while (*p && isspace((unsigned char)*p))
+            p++;
+        if (!*p || *p == '#')
+            break;
+        if (n == max)
+            return max + 1;
+        words[n++] = p;
+        while (*p && !isspace((unsigned char)*p))
+            p++;
+        if (*p)
+            *p++ = '\0';
+    }
+    return n;
+}
+
+static int parse_float(const char *w, float *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(w, &end);
+    if (end == w || *end != '\0' || errno == ERANGE || !isfinite(v) || fabs(v) > 1e9)
+        return 0;
+    *out = (float)v;
+    return 1;
+}
+
+static argil_err_t push_cmd(script_t *s, const script_cmd_t *c)
+{
+    if (s->count == s->cap) {
+        const size_t cap = s->cap ? s->cap * 2 : 64;
+        script_cmd_t *n = realloc(s->cmds, cap * sizeof(*n));
+        if (!n)
+            return ARGIL_ERR_NOMEM;
+        s->cmds = n;
+        s->cap = cap;
+    }
+    s->cmds[s->count++] = *c;
+    return ARGIL_OK;
+}
+
+#define FAIL(...)                                                                              \
+    do {                                                                                       \
+        snprintf(err, err_len, __VA_ARGS__);                                                   \
+        return ARGIL_ERR_PARSE;                                                                \
+    } while (0)
+
+/* Parses one line's words into a command; returns 0 for a blank line, 1 for a command. */
+static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char *err,
+                              size_t err_len)
+{
+    c->line = lineno;
+    c->arg_int = 0;
+    c->value = 0.0f;
+    c->target_m = vec3(0, 0, 0);
+    const char *op = w[0];
+    if (strcmp(op, "tool") == 0) {
+        if (n != 2)
+            FAIL("line %d: 'tool' takes one name (touch, push, pull, carve)", lineno);
+        for (int k = 0; k < TOOL_KIND_COUNT; k++) {
+            if (strcmp(w[1], TOOL_NAMES[k]) == 0) {
+                c->op = SCRIPT_TOOL;
+                c->arg_int = k;
+                return ARGIL_OK;
+            }
+        }
+        FAIL("line %d: unknown tool '%s' (touch, push, pull, carve)", lineno, w[1]);
+    }
+    if (strcmp(op, "set") == 0) {
+        if (n != 3)
+            FAIL("line %d: 'set' takes a name and a value", lineno);
+        for (int k = 0; k < PARAM_COUNT; k++) {
+            if (strcmp(w[1], PARAM_NAMES[k]) == 0) {
+                if (!parse_float(w[2], &c->value))
+                    FAIL("line %d: '%s' is not a number", lineno, w[2]);
+                if (c->value < PARAM_MIN[k] || c->value > PARAM_MAX[k])
+                    FAIL("line %d: %s must be within %g … %g, got %s", lineno, PARAM_NAMES[k],
+                         (double)PARAM_MIN[k], (double)PARAM_MAX[k], w[2]);
+                c->op = SCRIPT_SET;
+                c->arg_int = k;
+                return ARGIL_OK;
+            }
+        }
+        FAIL("line %d: unknown parameter '%s' (radius_mm, alpha, stiffness_n_per_mm, "
+             "max_force_n)",
+             lineno, w[1]);
+    }
+    if (strcmp(op, "move") == 0) {
+        float x, y, z, t;
+        if (n != 5)
+            FAIL("line %d: 'move' takes X Y Z (mm, model space) and SECONDS", lineno);
+        if (!parse_float(w[1], &x) || !parse_float(w[2], &y) || !parse_float(w[3], &z) ||
+            !parse_float(w[4], &t))
+            FAIL("line %d: 'move' arguments must be numbers", lineno);
+        if (fabsf(x) > 500.0f || fabsf(y) > 500.0f || fabsf(z) > 500.0f)
+            FAIL("line %d: move target beyond ±500 mm", lineno);
+        if (t <= 0.0f || t > SCRIPT_MAX_SECONDS)
+            FAIL("line %d: move duration must be within 0 … %g s", lineno,
+                 (double)SCRIPT_MAX_SECONDS);
+        c->op = SCRIPT_MOVE;
+        c->target_m = vec3(x * 1e-3f, y * 1e-3f, z * 1e-3f);
+        c->value = t;
+        return ARGIL_OK;
+    }
+    if (strcmp(op, "press") == 0 || strcmp(op, "release") == 0) {
+        if (n != 2 || (strcmp(w[1], "1") != 0 && strcmp(w[1], "2") != 0))
+            FAIL("line %d: '%s' takes a button number, 1 or 2", lineno, op);
+        c->op = op[0] == 'p' ? SCRIPT_PRESS : SCRIPT_RELEASE;
+        c->arg_int = w[1][0] - '0';
+        return ARGIL_OK;
+    }
+    if (strcmp(op, "wait") == 0) {
+        if (n != 2 || !parse_float(w[1], &c->value))
+            FAIL("line %d: 'wait' takes SECONDS", lineno);
+        if (c->value < 0.0f || c->value > SCRIPT_MAX_SECONDS)
+            FAIL("line %d: wait must be within 0 … %g s", lineno, (double)SCRIPT_MAX_SECONDS);
+        c->op = SCRIPT_WAIT;
+        return ARGIL_OK;
+    }
+    FAIL("line %d: unknown command '%s' (tool, set, move, press, release, wait)", lineno, op);
+}
+
+argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len)
+{
+    char line[512];
+    int lineno = 0;
+    size_t at = 0;
+    float total_s = 0.0f;
+    script_free(s);
+    while (at < len) {
+        size_t end = at;
+        while (end < len && text[end] != '\n')
+            end++;
+        lineno++;
+        size_t l = end - at;
+        if (l > 0 && text[at + l - 1] == '\r')
+            l--;
+        if (l >= sizeof(line))
+            FAIL("line %d: longer than %zu characters", lineno, sizeof(line) - 1);
+        memcpy(line, text + at, l);
+        line[l] = '\0';
+        if (memchr(line, '\0', l) != NULL)
+            FAIL("line %d: contains a NUL byte", lineno);
+        at = end + 1;
+        char *w[6];
+        const int n = split_words(line, w, 5);
+        if (n == 0)
+            continue;
+        if (n > 5)
+            FAIL("line %d: too many words", lineno);
+        script_cmd_t c;
+        const argil_err_t e = parse_line(w, n, lineno, &c, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+        if (c.op == SCRIPT_MOVE || c.op == SCRIPT_WAIT) {
+            total_s += c.value;
+            if (total_s > SCRIPT_MAX_SECONDS)
+                FAIL("line %d: the script runs longer than %g s", lineno,
+                     (double)SCRIPT_MAX_SECONDS);
+        }
+        if (s->count >= SCRIPT_MAX_COMMANDS)
+            FAIL("line %d: more than %u commands", lineno, SCRIPT_MAX_COMMANDS);
+        if (push_cmd(s, &c) != ARGIL_OK) {
+            snprintf(err, err_len, "line %d: out of memory", lineno);
+            return ARGIL_ERR_NOMEM;
+        }
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
+        return ARGIL_ERR_IO;
+    }
+    const size_t max = 16u << 20;
+    char *buf = malloc(max);
+    if (!buf) {
+        fclose(f);
+        snprintf(err, err_len, "%s: out of memory", path);
+        return ARGIL_ERR_NOMEM;
+    }
+    const size_t n = fread(buf, 1, max, f);
+    const int too_big = n == max && fgetc(f) != EOF;
+    const int rd_err = ferror(f);
+    fclose(f);
+    if (rd_err || too_big) {
+        free(buf);
+        snprintf(err, err_len, "%s: %s", path, rd_err ? "read error" : "larger than 16 MiB");
+        return rd_err ? ARGIL_ERR_IO : ARGIL_ERR_PARSE;
+    }
+    char msg[256];
+    const argil_err_t e = script_parse(s, buf, n, msg, sizeof(msg));
+    free(buf);
+    if (e != ARGIL_OK)
+        snprintf(err, err_len, "%s: %s", path, msg);
+    return e;
+}
+
+float script_duration_s(const script_t *s)
+{
+    float t = 0.0f;
+    for (size_t i = 0; i < s->count; i++)
+        if (s->cmds[i].op == SCRIPT_MOVE || s->cmds[i].op == SCRIPT_WAIT)
+            t += s->cmds[i].value;
+    return t;
+}
+
+void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
+{
+    memset(p, 0, sizeof(*p));
+    p->script = s;
+    p->pos_m = start_m;
+    p->from_m = start_m;
+    p->to_m = start_m;
+    p->tool = TOOL_TOUCH;
+    p->params[PARAM_RADIUS_MM] = 4.0f;
+    p->params[PARAM_ALPHA] = 12000.0f;
+    p->params[PARAM_STIFFNESS_N_PER_MM] = 0.8f;
+    p->params[PARAM_MAX_FORCE_N] = 3.3f;
+    p->params_changed = 1;
+}
+
+int script_player_step(script_player_t *p, float dt_s)
+{
+    /* Start commands until one takes time (bounded by the script's length). */
+    while (!p->active && p->next < p->script->count) {
+        const script_cmd_t *c = &p->script->cmds[p->next++];
+        switch (c->op) {
+        case SCRIPT_TOOL:
+            p->tool = c->arg_int;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_SET:
+            p->params[c->arg_int] = c->value;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_PRESS:
+            p->buttons |= 1 << (c->arg_int - 1);
+            break;
+        case SCRIPT_RELEASE:
+            p->buttons &= ~(1 << (c->arg_int - 1));
+            break;
+        case SCRIPT_MOVE:
+            p->active = 1;
+            p->elapsed_s = 0.0f;
+            p->duration_s = c->value;
+            p->from_m = p->pos_m;
+            p->to_m = c->target_m;
+            break;
+        case SCRIPT_WAIT:
+            p->active = 1;
+            p->elapsed_s = 0.0f;
+            p->duration_s = c->value;
+            p->from_m = p->pos_m;
+            p->to_m = p->pos_m;
+            break;
+        }
+    }
+    if (!p->active) {
+        p->vel_m_s = vec3(0, 0, 0);
+        return 1;
+    }
+    p->elapsed_s += dt_s;
+    /* Half a step of slack so float rounding never adds a tick to a move. */
+    float t = p->elapsed_s / p->duration_s;
+    if (t >= 1.0f || p->elapsed_s >= p->duration_s - 0.5f * dt_s)
+        t = 1.0f;
+    const vec3_t prev = p->pos_m;
+    p->pos_m = vec3_add(p->from_m, vec3_scale(vec3_sub(p->to_m, p->from_m), t));
+    p->vel_m_s = vec3_scale(vec3_sub(p->pos_m, prev), 1.0f / dt_s);
+    if (t >= 1.0f)
+        p->active = 0;
+    return 0;
+}

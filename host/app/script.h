@@ -1,0 +1,81 @@
+/* Session scripts: a line-based description of what the virtual hand does (docs/script.md). */
+#ifndef ARGIL_SCRIPT_H
+#define ARGIL_SCRIPT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/vec3.h"
+
+typedef enum {
+    SCRIPT_TOOL,      /* tool touch|push|pull|carve */
+    SCRIPT_SET,       /* set NAME VALUE */
+    SCRIPT_MOVE,      /* move X_MM Y_MM Z_MM SECONDS */
+    SCRIPT_PRESS,     /* press 1|2 */
+    SCRIPT_RELEASE,   /* release 1|2 */
+    SCRIPT_WAIT       /* wait SECONDS */
+} script_op_t;
+
+typedef enum {
+    PARAM_RADIUS_MM,
+    PARAM_ALPHA,
+    PARAM_STIFFNESS_N_PER_MM,
+    PARAM_MAX_FORCE_N,
+    PARAM_COUNT
+} script_param_t;
+
+typedef struct {
+    script_op_t op;
+    int line;                 /* 1-based line in the file */
+    int arg_int;              /* tool kind, button number, or param id */
+    vec3_t target_m;          /* move: model space */
+    float value;              /* set: value; move/wait: seconds */
+} script_cmd_t;
+
+typedef struct {
+    script_cmd_t *cmds;
+    size_t count;
+    size_t cap;
+} script_t;
+
+#define SCRIPT_MAX_COMMANDS 100000u
+#define SCRIPT_MAX_SECONDS 3600.0f
+
+void script_init(script_t *s);
+void script_free(script_t *s);
+
+/* Parses script text. On error returns ARGIL_ERR_PARSE (or ARGIL_ERR_NOMEM) and writes
+ * "LINE: what is wrong" into err. Text need not be NUL-terminated. */
+argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len);
+
+/* Reads and parses a file; err names the file and line. */
+argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len);
+
+/* The name a param is written with in scripts. */
+const char *script_param_name(script_param_t p);
+
+/* Total duration (s) of the moves and waits. */
+float script_duration_s(const script_t *s);
+
+/* Plays a script tick by tick: where the hand is and which buttons it holds. */
+typedef struct {
+    const script_t *script;
+    size_t next;              /* next command to start */
+    int active;               /* 1 while a move or wait runs */
+    float elapsed_s;          /* in the running move/wait */
+    float duration_s;
+    vec3_t from_m, to_m;
+    vec3_t pos_m;             /* hand target, model space */
+    vec3_t vel_m_s;
+    int buttons;              /* bit 0: button 1, bit 1: button 2 */
+    int tool;                 /* tool_kind_t */
+    float params[PARAM_COUNT];
+    int params_changed;       /* set when tool or a param changed since the last call */
+} script_player_t;
+
+void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m);
+/* Advances by dt_s; returns 0 while running, 1 once every command has finished. */
+int script_player_step(script_player_t *p, float dt_s);
+
+#endif

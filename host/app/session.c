@@ -1,0 +1,372 @@
+/* Lockstep session: script → virtual hand → simulated arm ⇄ board core ⇄ host field. */
+#define _POSIX_C_SOURCE 200809L
+#include "session.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "firmware/core/board_hal.h"
+#include "firmware/hal/hal_sim.h"
+#include "host/app/peer.h"
+#include "host/app/script.h"
+#include "host/io/ply.h"
+#include "host/mesh/mc.h"
+#include "host/mesh/mesh_check.h"
+#include "host/model/grid.h"
+#include "sim/sim_device.h"
+
+#define SESSION_CLAY_RADIUS_M 0.030f
+#define SESSION_GRID_EDGE 88
+#define SESSION_SPACING_M 0.00125f
+#define SESSION_TAIL_S 0.3f            /* simulated time after the script, to let the clay settle */
+#define SESSION_START_Z_M 0.060f       /* the workspace centre sits 60 mm in front of the clay */
+
+void session_opts_default(session_opts_t *o)
+{
+    o->script_path = "scripts/default.scn";
+    o->out_dir = "out";
+    o->window_edge = 16;
+    o->progress = false;
+    o->settle_s = 2.0f;
+}
+
+/* Everything a session owns; large, so it lives on the heap. */
+typedef struct {
+    hal_t hal;
+    board_t board;
+    board_io_t io;
+    sim_device_t dev;
+    sim_params_t sim_params;
+    grid_t grid;
+    peer_t peer;
+    script_t script;
+    script_player_t player;
+    FILE *csv;
+    uint32_t csv_rows;
+    uint8_t rx[HAL_SIM_LINK_BYTES];
+    vec3_t model_offset_m;             /* model = device + offset (scale 1) */
+} session_t;
+
+static bool link_send(void *ctx, const uint8_t *frame, size_t len)
+{
+    session_t *s = ctx;
+    return hal_sim_host_send(&s->hal, frame, len) == ARGIL_OK;
+}
+
+static void on_telemetry(void *ctx, const msg_telemetry_t *t)
+{
+    session_t *s = ctx;
+    if (!s->csv)
+        return;
+    const double fn = sqrt((double)t->force_n[0] * t->force_n[0] +
+                           (double)t->force_n[1] * t->force_n[1] +
+                           (double)t->force_n[2] * t->force_n[2]);
+    fprintf(s->csv, "%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%s,%u,%u,%u,%u\n",
+            (double)t->time_us * 1e-6, (double)t->pos_m[0] * 1e3, (double)t->pos_m[1] * 1e3,
+            (double)t->pos_m[2] * 1e3, (double)t->force_n[0], (double)t->force_n[1],
+            (double)t->force_n[2], fn, safety_state_name((safety_state_t)t->state),
+            t->tool_kind, t->buttons, t->flags & 1u, (t->flags >> 1) & 1u);
+    s->csv_rows++;
+}
+
+static void tool_from_player(const session_t *s, msg_tool_t *tool)
+{
+    const script_player_t *p = &s->player;
+    memset(tool, 0, sizeof(*tool));
+    tool->kind = (uint8_t)p->tool;
+    tool->radius_m = p->params[PARAM_RADIUS_MM] * 1e-3f;
+    tool->alpha = p->params[PARAM_ALPHA];
+    tool->contact_stiffness_n_per_m = p->params[PARAM_STIFFNESS_N_PER_MM] * 1e3f;
+    tool->max_force_n = p->params[PARAM_MAX_FORCE_N];
+    tool->model_scale = 1.0f;
+    tool->model_offset_m[0] = s->model_offset_m.x;
+    tool->model_offset_m[1] = s->model_offset_m.y;
+    tool->model_offset_m[2] = s->model_offset_m.z;
+}
+
+/* Meshes the whole field and returns its volume; fills the mesh for the caller. */
+static argil_err_t mesh_field(const grid_t *g, mesh_t *m, double *volume_m3)
+{
+    mesh_free(m);
+    mesh_init(m);
+    const argil_err_t e = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, m);
+    if (e == ARGIL_OK)
+        *volume_m3 = mesh_volume_m3(m);
+    return e;
+}
+
+static int make_dir(const char *path)
+{
+    if (mkdir(path, 0777) == 0 || errno == EEXIST)
+        return 0;
+    return -1;
+}
+
+/* Copies a file atomically (temp file + rename). */
+static argil_err_t copy_file(const char *from, const char *to, char *err, size_t err_len)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof(tmp), "%s.tmp", to);
+    FILE *in = fopen(from, "rb");
+    if (!in) {
+        snprintf(err, err_len, "%s: cannot open: %s", from, strerror(errno));
+        return ARGIL_ERR_IO;
+    }
+    FILE *out = fopen(tmp, "wb");
+    if (!out) {
+        snprintf(err, err_len, "%s: cannot create: %s", tmp, strerror(errno));
+        fclose(in);
+        return ARGIL_ERR_IO;
+    }
+    char buf[65536];
+    size_t n;
+    int bad = 0;
+    while ((n = fread(buf, 1, sizeof(buf), in)) > 0)
+        if (fwrite(buf, 1, n, out) != n)
+            bad = 1;
+    bad |= ferror(in);
+    fclose(in);
+    if (fflush(out) != 0 || fsync(fileno(out)) != 0)
+        bad = 1;
+    if (fclose(out) != 0)
+        bad = 1;
+    if (bad || rename(tmp, to) != 0) {
+        snprintf(err, err_len, "%s: cannot write: %s", to, strerror(errno));
+        unlink(tmp);
+        return ARGIL_ERR_IO;
+    }
+    return ARGIL_OK;
+}
+
+static void progress(const session_opts_t *o, double t_s, double total_s)
+{
+    if (!o->progress)
+        return;
+    const double frac = total_s > 0 ? t_s / total_s : 1.0;
+    const int bar = (int)(frac * 30.0);
+    fprintf(stderr, "\r  [%-30.*s] %5.1f %%  %.1f / %.1f s simulated", bar,
+            "##############################", frac * 100.0, t_s, total_s);
+    fflush(stderr);
+}
+
+argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char *err,
+                        size_t err_len)
+{
+    memset(sum, 0, sizeof(*sum));
+    session_t *s = calloc(1, sizeof(*s));
+    if (!s) {
+        snprintf(err, err_len, "out of memory for the session");
+        return ARGIL_ERR_NOMEM;
+    }
+    argil_err_t rc = ARGIL_OK;
+    mesh_t mesh;
+    mesh_init(&mesh);
+    char csv_tmp[4096] = "", csv_path[4096] = "", path[4096];
+    script_init(&s->script);
+
+    rc = script_load(&s->script, opts->script_path, err, err_len);
+    if (rc != ARGIL_OK)
+        goto done;
+
+    /* The device and the board. */
+    sim_params_default(&s->sim_params);
+    sim_device_init(&s->dev, &s->sim_params);
+    hal_sim_init(&s->hal);
+    board_cfg_t bcfg;
+    board_cfg_default(&bcfg);
+    bcfg.arm = s->sim_params.arm.desc;
+    if (board_init(&s->board, &bcfg) != ARGIL_OK) {
+        snprintf(err, err_len, "board configuration refused");
+        rc = ARGIL_ERR_ARG;
+        goto done;
+    }
+    board_io_init(&s->io);
+
+    /* The host's clay: a sphere at the model origin. */
+    const int32_t dims[3] = {SESSION_GRID_EDGE, SESSION_GRID_EDGE, SESSION_GRID_EDGE};
+    const float half = 0.5f * (float)(SESSION_GRID_EDGE - 1) * SESSION_SPACING_M;
+    rc = grid_init(&s->grid, dims, SESSION_SPACING_M, vec3(-half, -half, -half));
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "cannot allocate the density grid");
+        goto done;
+    }
+    grid_fill_sphere(&s->grid, vec3(0, 0, 0), SESSION_CLAY_RADIUS_M);
+    rc = mesh_field(&s->grid, &mesh, &sum->volume_before_m3);
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "meshing the initial clay failed");
+        goto done;
+    }
+
+    peer_cfg_t pcfg;
+    peer_cfg_default(&pcfg);
+    pcfg.window_edge = opts->window_edge;
+    rc = peer_init(&s->peer, &pcfg, &s->grid, link_send, on_telemetry, s);
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "window edge %d refused (4 … %d)", opts->window_edge,
+                 ARGIL_WINDOW_MAX);
+        goto done;
+    }
+
+    const vec3_t centre = sim_device_tip_m(&s->dev);
+    s->model_offset_m = vec3_sub(vec3(0, 0, SESSION_START_Z_M), centre);
+    script_player_init(&s->player, &s->script, vec3(0, 0, SESSION_START_Z_M));
+
+    if (opts->out_dir) {
+        if (make_dir(opts->out_dir) != 0) {
+            snprintf(err, err_len, "%s: cannot create directory: %s", opts->out_dir,
+                     strerror(errno));
+            rc = ARGIL_ERR_IO;
+            goto done;
+        }
+        snprintf(csv_path, sizeof(csv_path), "%s/telemetry.csv", opts->out_dir);
+        snprintf(csv_tmp, sizeof(csv_tmp), "%s/telemetry.csv.tmp", opts->out_dir);
+        s->csv = fopen(csv_tmp, "wb");
+        if (!s->csv) {
+            snprintf(err, err_len, "%s: cannot create: %s", csv_tmp, strerror(errno));
+            rc = ARGIL_ERR_IO;
+            goto done;
+        }
+        fprintf(s->csv, "time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state,tool,buttons,"
+                        "contact,sculpting\n");
+    }
+
+    /* The lockstep loop. */
+    const uint32_t dt_us = bcfg.tick_us;
+    const float dt_s = (float)dt_us * 1e-6f;
+    const double script_s = script_duration_s(&s->script);
+    const double total_s = opts->settle_s + script_s + SESSION_TAIL_S;
+    const uint64_t max_ticks = (uint64_t)(total_s / dt_s) + 1u;
+    bool started = false, finished = false;
+    double started_at_s = 0.0, finished_at_s = 0.0;
+    peer_request_arm(&s->peer);
+    uint64_t tick;
+    for (tick = 0; tick < max_ticks; tick++) {
+        const double t_s = (double)tick * dt_s;
+        if (!started && s->peer.have_tm && s->peer.last_tm.state == SAFETY_ACTIVE) {
+            started = true;
+            started_at_s = t_s;
+        }
+        if (!started && t_s > opts->settle_s) {
+            snprintf(err, err_len, "the board did not become ACTIVE within %.1f s (state %s)",
+                     (double)opts->settle_s,
+                     s->peer.have_tm ? safety_state_name((safety_state_t)s->peer.last_tm.state)
+                                     : "no telemetry");
+            rc = ARGIL_ERR_STATE;
+            break;
+        }
+        if (started && !finished && script_player_step(&s->player, dt_s)) {
+            finished = true;
+            finished_at_s = t_s;
+        }
+        if (finished && t_s - finished_at_s >= SESSION_TAIL_S)
+            break;
+        if (started && s->peer.have_tm &&
+            (s->peer.last_tm.state == SAFETY_FAULT || s->peer.last_tm.state == SAFETY_ESTOP)) {
+            snprintf(err, err_len, "the board stopped in %s at %.3f s: %s",
+                     safety_state_name((safety_state_t)s->peer.last_tm.state), t_s,
+                     safety_fault_name((fault_code_t)s->peer.stats.last_fault_code));
+            rc = ARGIL_ERR_STATE;
+            break;
+        }
+        if (s->player.params_changed) {
+            msg_tool_t tool;
+            tool_from_player(s, &tool);
+            peer_set_tool(&s->peer, &tool);
+            s->player.params_changed = 0;
+        }
+
+        /* The hand, the arm and its drives. */
+        const vec3_t target_dev = vec3_sub(s->player.pos_m, s->model_offset_m);
+        sim_device_set_hand(&s->dev, target_dev, s->player.vel_m_s, (s->player.buttons & 1) != 0,
+                            (s->player.buttons & 2) != 0);
+        can_batch_t from_board, to_board;
+        to_board.n = 0;
+        hal_sim_take_from_board(&s->hal, &from_board);
+        sim_device_step(&s->dev, &from_board, hal_sim_gpio_out(&s->hal), &to_board, dt_us);
+        hal_sim_put_to_board(&s->hal, &to_board);
+        hal_sim_set_gpio_in(&s->hal, sim_device_gpio_in(&s->dev));
+
+        /* The board's tick, then the host's. */
+        (void)board_run_tick(&s->board, &s->io, &s->hal);
+        const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
+        peer_receive(&s->peer, s->rx, n);
+        peer_tick(&s->peer, dt_us);
+        if (tick % 1000u == 0)
+            progress(opts, t_s, total_s);
+    }
+    progress(opts, (double)tick * dt_s, (double)tick * dt_s);
+    if (opts->progress)
+        fputc('\n', stderr);
+    (void)started_at_s;
+
+    sum->sim_seconds = (double)tick * dt_s;
+    sum->board_ticks = s->board.stats.ticks;
+    sum->tick_hz = 1000000u / dt_us;
+    sum->worst_compute_ns = s->board.stats.worst_compute_ns;
+    sum->deadline_misses = s->board.stats.deadline_misses;
+    sum->peak_force_n = s->board.stats.peak_force_n;
+    sum->force_limit_n = s->board.cfg.max_force_n;
+    sum->final_state = s->board.safety.state;
+    sum->fault_code = s->board.safety.fault;
+    sum->windows_sent = s->peer.stats.windows_sent;
+    sum->impulse_frames = s->peer.stats.impulse_frames;
+    sum->link_errors = s->peer.stats.decode_errors + s->board.stats.link_errors;
+    sum->telemetry_rows = s->csv_rows;
+
+    {
+        const argil_err_t me = mesh_field(&s->grid, &mesh, &sum->volume_after_m3);
+        if (me != ARGIL_OK && rc == ARGIL_OK) {
+            snprintf(err, err_len, "meshing the final clay failed");
+            rc = me;
+        }
+        size_t boundary = 0, nonmanifold = 0;
+        sum->watertight = me == ARGIL_OK && mesh_watertight(&mesh, &boundary, &nonmanifold);
+        sum->triangles = mesh.n_tri;
+        sum->vertices = mesh.n_vert;
+    }
+
+    /* Files: whatever happened, keep what was sculpted (each file appears whole, by rename). */
+    if (opts->out_dir) {
+        char ferr[512];
+        int bad = 0;
+        if (s->csv) {
+            bad |= fflush(s->csv) != 0 || fsync(fileno(s->csv)) != 0;
+            bad |= fclose(s->csv) != 0;
+            s->csv = NULL;
+            if (bad || rename(csv_tmp, csv_path) != 0) {
+                if (rc == ARGIL_OK)
+                    snprintf(err, err_len, "%s: cannot write: %s", csv_path, strerror(errno));
+                rc = rc == ARGIL_OK ? ARGIL_ERR_IO : rc;
+            }
+        }
+        snprintf(path, sizeof(path), "%s/final.ply", opts->out_dir);
+        if (mesh.n_tri > 0 && ply_write(path, &mesh, ferr, sizeof(ferr)) != ARGIL_OK &&
+            rc == ARGIL_OK) {
+            snprintf(err, err_len, "%s", ferr);
+            rc = ARGIL_ERR_IO;
+        }
+        snprintf(path, sizeof(path), "%s/session.scn", opts->out_dir);
+        if (copy_file(opts->script_path, path, ferr, sizeof(ferr)) != ARGIL_OK &&
+            rc == ARGIL_OK) {
+            snprintf(err, err_len, "%s", ferr);
+            rc = ARGIL_ERR_IO;
+        }
+    }
+
+done:
+    if (s->csv) {
+        fclose(s->csv);
+        unlink(csv_tmp);
+    }
+    mesh_free(&mesh);
+    peer_free(&s->peer);
+    grid_free(&s->grid);
+    script_free(&s->script);
+    free(s);
+    return rc;
+}
