@@ -1,0 +1,36 @@
+#!/bin/sh
+# The argil command line as a new user meets it: help, bad options and bad scripts give one
+# clear line and a non-zero exit, never a crash.
+set -eu
+bin="$SAN/argil"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$bin" --help >"$tmp/h" || fail "--help exited non-zero"
+grep -q sculpt "$tmp/h" || fail "--help does not list 'sculpt'"
+"$bin" sculpt --help >"$tmp/h" || fail "sculpt --help exited non-zero"
+for opt in --device --script --out --window --quiet; do
+    grep -q -- "$opt" "$tmp/h" || fail "sculpt --help does not explain $opt"
+done
+
+expect_error() { # expected-status expected-text args...
+    want=$1; text=$2; shift 2
+    set +e
+    "$bin" "$@" >"$tmp/o" 2>"$tmp/e"
+    st=$?
+    set -e
+    [ "$st" = "$want" ] || fail "'$*' exited $st, want $want"
+    grep -q -- "$text" "$tmp/e" || { cat "$tmp/e"; fail "'$*' did not say '$text'"; }
+    [ "$(wc -l <"$tmp/e")" -le 2 ] || { cat "$tmp/e"; fail "'$*' printed more than a line or two of error"; }
+}
+expect_error 2 "unknown command 'frobnicate'" frobnicate
+expect_error 2 "unknown option '--bogus'" sculpt --bogus
+expect_error 2 "needs a value" sculpt --script
+expect_error 2 "device 'usb' is not available" sculpt --device usb
+expect_error 2 "--window must be" sculpt --window 99
+expect_error 1 "$tmp/none.scn: cannot open" sculpt --script "$tmp/none.scn" --out "$tmp/o1"
+printf 'tool push\nmove 0 0 abc 1\n' >"$tmp/bad.scn"
+expect_error 1 "bad.scn: line 2: 'move' arguments must be numbers" sculpt --script "$tmp/bad.scn" --out "$tmp/o2"
+[ ! -e "$tmp/o2/final.ply" ] || fail "a refused script still wrote files"
+echo "cli: all checks passed"

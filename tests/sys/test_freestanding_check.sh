@@ -1,0 +1,19 @@
+#!/bin/sh
+# The freestanding check must catch what it is there for: an object of the real-time code
+# that reaches malloc, printf or a blocking call fails the build.
+set -eu
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+for call in 'void *p = malloc(4); free(p);' 'printf("x");' 'usleep(10);' 'fopen("x", "r");'; do
+    printf '#define _DEFAULT_SOURCE\n#include <stdlib.h>\n#include <stdio.h>\n#include <unistd.h>\nvoid bad(void);\nvoid bad(void) { %s }\n' "$call" >"$tmp/bad.c"
+    cc -c -O2 "$tmp/bad.c" -o "$tmp/bad.o"
+    if sh toolchain/check-freestanding.sh "$tmp/bad.o" >"$tmp/out" 2>&1; then
+        fail "check-freestanding accepted: $call"
+    fi
+    grep -q 'must not call' "$tmp/out" || fail "no clear message for: $call"
+done
+# And it accepts the real core + shared objects.
+objs=$(ls "$REL"/shared/*.o "$REL"/firmware/core/*.o)
+sh toolchain/check-freestanding.sh $objs || fail "the real-time objects are not freestanding"
+echo "freestanding check: catches heap, stdio and blocking calls; core + shared pass"
