@@ -108,7 +108,9 @@ fuzz: deps
 	  seeds=tests/fuzz/corpus/$$t; [ -d $$seeds ] || seeds=; \
 	  echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
 	  $(FZ)/$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
-	     $(FZ)/corpus/$$t $$seeds 2>&1 | tail -n 12 || exit 1; \
+	     $(FZ)/corpus/$$t $$seeds >$(FZ)/$$t.log 2>&1; st=$$?; \
+	  grep -E '^(Done|stat::(number_of_executed_units|new_units_added|peak_rss_mb))' $(FZ)/$$t.log; \
+	  if [ $$st != 0 ]; then tail -n 40 $(FZ)/$$t.log; echo "fuzz: $$t FAILED (log: $(FZ)/$$t.log)"; exit 1; fi; \
 	done
 
 bench: all

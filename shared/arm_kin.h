@@ -40,6 +40,13 @@ void arm_jt_force(const float j[3][ARGIL_DRIVES], vec3_t force_n,
 /* Elbow-down inverse kinematics; false when tip is out of reach or outside the joint limits. */
 bool arm_ik(const arm_desc_t *d, vec3_t tip_m, float q_rad[ARGIL_DRIVES]);
 
+/* The device-frame workspace centre: the stylus tip at q_home_rad (fk(q_home)). */
+vec3_t arm_workspace_centre(const arm_desc_t *d);
+
+/* The default drives' peak torque (current limit) in per-mille of the rated torque: 4x rated.
+ * Target torques beyond it are clipped by the drive (docs/arm.md). */
+#define ARM_PEAK_TORQUE_PERMILLE 4000
+
 /* Joint angle from a motor encoder reading (counts since power-up at q_home_rad). */
 float arm_counts_to_rad(const arm_desc_t *d, int joint, int32_t counts);
 /* The encoder reading for a joint angle (rounded toward zero count quantisation). */

@@ -50,6 +50,12 @@ typedef enum {
     NMT_STATE_PREOP = 0x7F
 } nmt_state_t;
 
+/* EMCY error codes (CiA 301 / CiA 402) and error-register bits the drives use. */
+#define CANOPEN_EMCY_NO_ERROR 0x0000u        /* sent when a fault is reset */
+#define CANOPEN_EMCY_OVERCURRENT 0x2310u     /* continuous over-current (CiA 402) */
+#define CANOPEN_ERRREG_GENERIC 0x01u
+#define CANOPEN_ERRREG_CURRENT 0x02u
+
 /* CiA 402 controlword commands (bits 0-3 and 7). */
 #define CIA402_CW_SHUTDOWN 0x0006u
 #define CIA402_CW_SWITCH_ON 0x0007u

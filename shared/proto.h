@@ -164,8 +164,9 @@ typedef struct {
 } proto_msg_t;
 
 /* Encodes msg as one frame with sequence seq into buf; *len gets the frame size.
- * Returns PROTO_ERR_NOSPACE when cap is too small, PROTO_ERR_VALUE / PROTO_ERR_TYPE for
- * a message that would not decode (so nothing invalid is ever sent). */
+ * Returns PROTO_ERR_NOSPACE when cap is too small, and for a message that would not decode
+ * the error its decoding would give: PROTO_ERR_TYPE, PROTO_ERR_VALUE, or PROTO_ERR_CHUNK for
+ * WINDOW chunk numbering (so nothing invalid is ever sent). */
 proto_err_t proto_encode(const proto_msg_t *msg, uint32_t seq, uint8_t *buf, size_t cap,
                          size_t *len);
 
@@ -191,7 +192,8 @@ typedef struct {
 void window_asm_init(window_asm_t *a, float *storage, uint32_t capacity);
 
 /* Adds one decoded chunk. A newer version restarts assembly; an older one is refused.
- * Returns PROTO_ERR_CHUNK when the chunk disagrees with its siblings or does not fit. */
+ * Returns PROTO_ERR_CHUNK when the chunk disagrees with its siblings or does not fit; a
+ * disagreeing sibling abandons that version (it never completes; the next version restarts). */
 proto_err_t window_asm_feed(window_asm_t *a, const msg_window_t *chunk);
 
 /* True once every chunk of the current version has arrived. */
@@ -202,7 +204,8 @@ bool window_asm_complete(const window_asm_t *a);
 proto_err_t window_chunk_fill(const msg_window_t *head, const float *samples, uint16_t index,
                               msg_window_t *chunk);
 
-/* Number of chunks a window of dims[0]*dims[1]*dims[2] samples takes. */
+/* Number of chunks a window of dims[0]*dims[1]*dims[2] samples takes; 0 when a dim is
+ * outside 2 … ARGIL_WINDOW_MAX. */
 uint16_t window_chunk_count(const uint8_t dims[3]);
 
 #endif

@@ -137,7 +137,6 @@ int main(int argc, char **argv)
         usage_main(stdout);
         return 0;
     }
-    fprintf(stderr, "argil: unknown command '%s'\n", argv[1]);
-    usage_main(stderr);
+    fprintf(stderr, "argil: unknown command '%s' (see 'argil --help')\n", argv[1]);
     return 2;
 }

@@ -5,8 +5,8 @@ set -eu
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
-for call in 'void *p = malloc(4); free(p);' 'printf("x");' 'usleep(10);' 'fopen("x", "r");'; do
-    printf '#define _DEFAULT_SOURCE\n#include <stdlib.h>\n#include <stdio.h>\n#include <unistd.h>\nvoid bad(void);\nvoid bad(void) { %s }\n' "$call" >"$tmp/bad.c"
+for call in 'return malloc(4);' 'free(q); return 0;' 'printf("x"); return 0;' 'usleep(10); return 0;' 'return fopen("x", "r");'; do
+    printf '#define _DEFAULT_SOURCE\n#include <stdlib.h>\n#include <stdio.h>\n#include <unistd.h>\nvoid *bad(void *q);\nvoid *bad(void *q) { (void)q; %s }\n' "$call" >"$tmp/bad.c"
     cc -c -O2 "$tmp/bad.c" -o "$tmp/bad.o"
     if sh toolchain/check-freestanding.sh "$tmp/bad.o" >"$tmp/out" 2>&1; then
         fail "check-freestanding accepted: $call"

@@ -1,0 +1,385 @@
+/* Marching cubes with a case table derived at run time from the cube's faces: on each face the
+ * crossed edges are joined by segments (a saddle face always separates its inside corners), the
+ * segments chain into closed loops around the cube, and each loop becomes a triangle fan. Since a
+ * face's segments depend only on its four corners, neighbouring cells agree and the surface is
+ * closed and edge-manifold. Samples beyond the block read 0, so the surface always closes. */
+#include "host/mesh/mc.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+
+/* Cube corner c sits at offset (c & 1, (c >> 1) & 1, (c >> 2) & 1). Edge e runs along axis
+ * a = e / 4; with u = (a+1)%3 and v = (a+2)%3 its lower corner has bit u = e & 1 and bit
+ * v = (e >> 1) & 1. Face f lies on axis f / 2 at side f & 1. */
+#define MC_EDGES 12
+#define MC_TRI_MAX 10 /* 12 crossed edges in a single loop give 10 triangles; more loops fewer */
+#define MC_NONE UINT32_MAX
+
+typedef struct {
+    uint8_t n_tri;
+    uint8_t edge[3 * MC_TRI_MAX]; /* cube edges, 3 per triangle, CCW seen from outside */
+} mc_case_t;
+
+typedef struct {
+    mc_case_t cases[256]; /* by corner mask, bit c set = corner c inside (density > iso) */
+} mc_table_t;
+
+static int mc_edge_id(int axis, int bit_u, int bit_v)
+{
+    return axis * 4 + bit_u + 2 * bit_v;
+}
+
+/* The edge joining two corners that differ in one bit. */
+static int mc_edge_between(int c0, int c1)
+{
+    const int d = c0 ^ c1;
+    const int a = d == 1 ? 0 : (d == 2 ? 1 : 2);
+    const int base = c0 & c1;
+    return mc_edge_id(a, (base >> ((a + 1) % 3)) & 1, (base >> ((a + 2) % 3)) & 1);
+}
+
+/* True when two distinct cube edges lie on a common face. */
+static bool mc_edges_share_face(int e0, int e1)
+{
+    int f[2][2];
+    const int e[2] = {e0, e1};
+    for (int k = 0; k < 2; k++) {
+        const int a = e[k] / 4;
+        f[k][0] = ((a + 1) % 3) * 2 + (e[k] & 1);
+        f[k][1] = ((a + 2) % 3) * 2 + ((e[k] >> 1) & 1);
+    }
+    return f[0][0] == f[1][0] || f[0][0] == f[1][1] || f[0][1] == f[1][0] || f[0][1] == f[1][1];
+}
+
+/* Links every crossed edge to the next one around its loop. On each face, walked CCW as seen
+ * from outside the cube, an "entry" edge (outside corner → inside corner) is joined to the next
+ * "exit" edge (inside → outside): each run of inside corners is cut off on its own, which splits
+ * a saddle face between its inside corners. The link entry → exit keeps the outside corners on
+ * the left, so every crossed edge gets exactly one successor (it is an entry on one of its two
+ * faces and an exit on the other). */
+static void mc_link_face_segments(unsigned mask, int next[MC_EDGES])
+{
+    static const int cu_ccw[4] = {0, 1, 1, 0}, cv_ccw[4] = {0, 0, 1, 1};
+    for (int f = 0; f < 6; f++) {
+        const int a = f / 2, side = f & 1, u = (a + 1) % 3, v = (a + 2) % 3;
+        int q[4];
+        bool in[4];
+        for (int k = 0; k < 4; k++) {
+            /* (u, v) is right-handed about +axis: that order is CCW seen from +axis; reversed
+             * for the face at side 0, whose outside is -axis. */
+            const int cu = side ? cu_ccw[k] : cv_ccw[k];
+            const int cv = side ? cv_ccw[k] : cu_ccw[k];
+            q[k] = (side << a) | (cu << u) | (cv << v);
+            in[k] = ((mask >> q[k]) & 1u) != 0;
+        }
+        for (int k = 0; k < 4; k++) {
+            if (in[k] || !in[(k + 1) & 3])
+                continue; /* not an entry edge */
+            for (int j = 1; j < 4; j++) {
+                const int b = (k + j) & 3;
+                if (in[b] && !in[(b + 1) & 3]) {
+                    next[mc_edge_between(q[k], q[(k + 1) & 3])] =
+                        mc_edge_between(q[b], q[(b + 1) & 3]);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/* Fans one loop from the first vertex whose diagonals all cross the cube's interior (exhaustive
+ * enumeration shows every loop of every case has one), so no triangle lies in a face and no
+ * diagonal can be shared with a neighbouring cell. */
+static void mc_fan_loop(const int *loop, int n, mc_case_t *c)
+{
+    int apex = 0;
+    for (int k = 0; k < n; k++) {
+        bool ok = true;
+        for (int j = 0; j < n && ok; j++) {
+            if (j == k || j == (k + 1) % n || j == (k + n - 1) % n)
+                continue;
+            if (mc_edges_share_face(loop[k], loop[j]))
+                ok = false;
+        }
+        if (ok) {
+            apex = k;
+            break;
+        }
+    }
+    for (int i = 1; i + 1 < n; i++) {
+        uint8_t *t = c->edge + 3 * c->n_tri;
+        t[0] = (uint8_t)loop[apex];
+        t[1] = (uint8_t)loop[(apex + i) % n];
+        t[2] = (uint8_t)loop[(apex + i + 1) % n];
+        c->n_tri++;
+    }
+}
+
+/* Derives all 256 cases from the face rule above. */
+static void mc_build_table(mc_table_t *tab)
+{
+    for (unsigned mask = 0; mask < 256; mask++) {
+        mc_case_t *c = &tab->cases[mask];
+        int next[MC_EDGES];
+        bool seen[MC_EDGES] = {false};
+        c->n_tri = 0;
+        for (int e = 0; e < MC_EDGES; e++)
+            next[e] = -1;
+        mc_link_face_segments(mask, next);
+        for (int e = 0; e < MC_EDGES; e++) {
+            if (next[e] < 0 || seen[e])
+                continue;
+            int loop[MC_EDGES], n = 0, cur = e;
+            while (cur >= 0 && !seen[cur] && n < MC_EDGES) {
+                seen[cur] = true;
+                loop[n++] = cur;
+                cur = next[cur];
+            }
+            mc_fan_loop(loop, n, c);
+        }
+    }
+}
+
+/* Working state for one extraction over the padded lattice (sample index + 1 per axis). */
+typedef struct {
+    const float *density;
+    int32_t dims[3];
+    int32_t pad[3];        /* dims + 2 */
+    size_t layer;          /* pad[0] * pad[1] */
+    float spacing_m;
+    vec3_t origin_m;
+    float iso;
+    float *val[2];         /* padded densities of the cell slab's lower and upper layers */
+    uint8_t *ins[2];       /* 1 where that density > iso */
+    uint32_t *xe[2], *ye[2]; /* vertex of the x / y edge starting at each sample of a layer */
+    uint32_t *ze;          /* vertex of the z edge between the two layers */
+    mesh_t *out;
+} mc_work_t;
+
+/* Density of original sample (x,y,z), 0 beyond the block. */
+static float mc_sample(const mc_work_t *w, int64_t x, int64_t y, int64_t z)
+{
+    if (x < 0 || y < 0 || z < 0 || x >= w->dims[0] || y >= w->dims[1] || z >= w->dims[2])
+        return 0.0f;
+    return w->density[(size_t)x + (size_t)w->dims[0] * ((size_t)y + (size_t)w->dims[1] * (size_t)z)];
+}
+
+/* Central-difference gradient (unscaled) at original sample s. */
+static vec3_t mc_gradient(const mc_work_t *w, const int64_t s[3])
+{
+    return vec3(mc_sample(w, s[0] + 1, s[1], s[2]) - mc_sample(w, s[0] - 1, s[1], s[2]),
+                mc_sample(w, s[0], s[1] + 1, s[2]) - mc_sample(w, s[0], s[1] - 1, s[2]),
+                mc_sample(w, s[0], s[1], s[2] + 1) - mc_sample(w, s[0], s[1], s[2] - 1));
+}
+
+/* Fills padded layer Z (0 .. pad[2]-1) into slot k; false when a density is not finite. */
+static bool mc_load_layer(mc_work_t *w, int32_t pz, int k)
+{
+    float *val = w->val[k];
+    uint8_t *ins = w->ins[k];
+    const int32_t z = pz - 1;
+    for (size_t i = 0; i < w->layer; i++) {
+        val[i] = 0.0f;
+        ins[i] = 0;
+    }
+    if (z < 0 || z >= w->dims[2])
+        return true;
+    for (int32_t y = 0; y < w->dims[1]; y++) {
+        const float *src = w->density + (size_t)w->dims[0] * ((size_t)y + (size_t)w->dims[1] * (size_t)z);
+        const size_t row = (size_t)w->pad[0] * (size_t)(y + 1) + 1;
+        for (int32_t x = 0; x < w->dims[0]; x++) {
+            const float d = src[x];
+            if (!isfinite(d))
+                return false;
+            val[row + (size_t)x] = d;
+            ins[row + (size_t)x] = d > w->iso;
+        }
+    }
+    return true;
+}
+
+/* Creates the vertex on the edge from padded sample p along axis a (densities d0 at p, d1 at
+ * the other end, exactly one of them inside). */
+static argil_err_t mc_make_vertex(mc_work_t *w, const int32_t p[3], int a, float d0, float d1,
+                                  uint32_t *id)
+{
+    float t = (w->iso - d0) / (d1 - d0);
+    if (!(t >= MC_T_MIN))
+        t = MC_T_MIN; /* also NaN */
+    if (t > 1.0f - MC_T_MIN)
+        t = 1.0f - MC_T_MIN;
+    int64_t s0[3] = {p[0] - 1, p[1] - 1, p[2] - 1};
+    int64_t s1[3] = {s0[0], s0[1], s0[2]};
+    s1[a] += 1;
+    float idx[3] = {(float)s0[0], (float)s0[1], (float)s0[2]};
+    idx[a] += t;
+    const vec3_t pos = vec3(w->origin_m.x + w->spacing_m * idx[0],
+                            w->origin_m.y + w->spacing_m * idx[1],
+                            w->origin_m.z + w->spacing_m * idx[2]);
+    const vec3_t g0 = mc_gradient(w, s0), g1 = mc_gradient(w, s1);
+    const vec3_t g = vec3_add(g0, vec3_scale(vec3_sub(g1, g0), t));
+    const float len = vec3_norm(g);
+    vec3_t n;
+    if (len > 1e-12f && isfinite(len)) {
+        n = vec3_scale(g, -1.0f / len);
+    } else {
+        /* Flat field: fall back to the edge direction from the inside end to the outside end. */
+        const float sgn = d0 > w->iso ? 1.0f : -1.0f;
+        n = vec3(a == 0 ? sgn : 0.0f, a == 1 ? sgn : 0.0f, a == 2 ? sgn : 0.0f);
+    }
+    return mesh_add_vertex(w->out, pos, n, id);
+}
+
+/* The vertex on cube edge e of the cell whose lower padded corner is (px, py) in the current
+ * slab, created on first use and shared through the layer caches afterwards. */
+static argil_err_t mc_edge_vertex(mc_work_t *w, int32_t px, int32_t py, int32_t pz, int e,
+                                  uint32_t *id)
+{
+    const int a = e / 4, bu = e & 1, bv = (e >> 1) & 1;
+    int32_t p[3] = {px, py, pz};
+    p[(a + 1) % 3] += bu;
+    p[(a + 2) % 3] += bv;
+    const int lz = p[2] - pz; /* layer slot of the lower end */
+    const size_t i = (size_t)p[0] + (size_t)w->pad[0] * (size_t)p[1];
+    const size_t step = a == 0 ? 1 : (a == 1 ? (size_t)w->pad[0] : 0);
+    uint32_t *slot = a == 0 ? &w->xe[lz][i] : (a == 1 ? &w->ye[lz][i] : &w->ze[i]);
+    if (*slot != MC_NONE) {
+        *id = *slot;
+        return ARGIL_OK;
+    }
+    const float d0 = w->val[lz][i];
+    const float d1 = a == 2 ? w->val[1][i] : w->val[lz][i + step];
+    argil_err_t err = mc_make_vertex(w, p, a, d0, d1, slot);
+    *id = *slot;
+    return err;
+}
+
+static void mc_fill_none(uint32_t *a, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        a[i] = MC_NONE;
+}
+
+/* Triangulates every cell of the slab between padded layers pz and pz + 1. */
+static argil_err_t mc_slab(mc_work_t *w, const mc_table_t *tab, int32_t pz)
+{
+    const size_t px_n = (size_t)w->pad[0];
+    const uint8_t *i0 = w->ins[0], *i1 = w->ins[1];
+    for (int32_t py = 0; py + 1 < w->pad[1]; py++) {
+        for (int32_t px = 0; px + 1 < w->pad[0]; px++) {
+            const size_t i = (size_t)px + px_n * (size_t)py;
+            const unsigned mask = (unsigned)i0[i] | (unsigned)i0[i + 1] << 1 |
+                                  (unsigned)i0[i + px_n] << 2 | (unsigned)i0[i + px_n + 1] << 3 |
+                                  (unsigned)i1[i] << 4 | (unsigned)i1[i + 1] << 5 |
+                                  (unsigned)i1[i + px_n] << 6 | (unsigned)i1[i + px_n + 1] << 7;
+            if (mask == 0 || mask == 255)
+                continue;
+            const mc_case_t *c = &tab->cases[mask];
+            for (int k = 0; k < 3 * (int)c->n_tri; k += 3) {
+                uint32_t v[3];
+                for (int j = 0; j < 3; j++) {
+                    argil_err_t err = mc_edge_vertex(w, px, py, pz, c->edge[k + j], &v[j]);
+                    if (err != ARGIL_OK)
+                        return err;
+                }
+                argil_err_t err = mesh_add_triangle(w->out, v[0], v[1], v[2]);
+                if (err != ARGIL_OK)
+                    return err;
+            }
+        }
+    }
+    return ARGIL_OK;
+}
+
+/* Runs the slabs bottom to top, rolling the layer buffers and edge caches. */
+static argil_err_t mc_run(mc_work_t *w, const mc_table_t *tab)
+{
+    if (!mc_load_layer(w, 0, 0))
+        return ARGIL_ERR_NONFINITE;
+    mc_fill_none(w->xe[0], w->layer);
+    mc_fill_none(w->ye[0], w->layer);
+    for (int32_t pz = 0; pz + 1 < w->pad[2]; pz++) {
+        if (!mc_load_layer(w, pz + 1, 1))
+            return ARGIL_ERR_NONFINITE;
+        mc_fill_none(w->xe[1], w->layer);
+        mc_fill_none(w->ye[1], w->layer);
+        mc_fill_none(w->ze, w->layer);
+        argil_err_t err = mc_slab(w, tab, pz);
+        if (err != ARGIL_OK)
+            return err;
+        /* The upper layer becomes the next slab's lower layer. */
+        float *fv = w->val[0];
+        w->val[0] = w->val[1];
+        w->val[1] = fv;
+        uint8_t *fi = w->ins[0];
+        w->ins[0] = w->ins[1];
+        w->ins[1] = fi;
+        uint32_t *fx = w->xe[0];
+        w->xe[0] = w->xe[1];
+        w->xe[1] = fx;
+        uint32_t *fy = w->ye[0];
+        w->ye[0] = w->ye[1];
+        w->ye[1] = fy;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t mc_extract(const float *density, const int32_t dims[3], float spacing_m,
+                       vec3_t origin_m, float iso, mesh_t *out)
+{
+    if (out == NULL)
+        return ARGIL_ERR_ARG;
+    mesh_clear(out);
+    if (density == NULL || dims == NULL)
+        return ARGIL_ERR_ARG;
+    int64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1 || dims[a] > INT32_MAX - 2)
+            return ARGIL_ERR_ARG;
+        n *= dims[a];
+        if (n > ((int64_t)1 << 31))
+            return ARGIL_ERR_ARG;
+    }
+    if (!isfinite(spacing_m) || !(spacing_m > 0.0f) || !isfinite(iso) || !vec3_isfinite(origin_m))
+        return ARGIL_ERR_ARG;
+
+    mc_table_t *tab = malloc(sizeof(*tab));
+    mc_work_t w = {0};
+    w.density = density;
+    for (int a = 0; a < 3; a++) {
+        w.dims[a] = dims[a];
+        w.pad[a] = dims[a] + 2;
+    }
+    w.layer = (size_t)w.pad[0] * (size_t)w.pad[1];
+    w.spacing_m = spacing_m;
+    w.origin_m = origin_m;
+    w.iso = iso;
+    w.out = out;
+    for (int k = 0; k < 2; k++) {
+        w.val[k] = malloc(w.layer * sizeof(float));
+        w.ins[k] = malloc(w.layer);
+        w.xe[k] = malloc(w.layer * sizeof(uint32_t));
+        w.ye[k] = malloc(w.layer * sizeof(uint32_t));
+    }
+    w.ze = malloc(w.layer * sizeof(uint32_t));
+
+    argil_err_t err = ARGIL_ERR_NOMEM;
+    if (tab != NULL && w.val[0] != NULL && w.val[1] != NULL && w.ins[0] != NULL &&
+        w.ins[1] != NULL && w.xe[0] != NULL && w.xe[1] != NULL && w.ye[0] != NULL &&
+        w.ye[1] != NULL && w.ze != NULL) {
+        mc_build_table(tab);
+        err = mc_run(&w, tab);
+    }
+    for (int k = 0; k < 2; k++) {
+        free(w.val[k]);
+        free(w.ins[k]);
+        free(w.xe[k]);
+        free(w.ye[k]);
+    }
+    free(w.ze);
+    free(tab);
+    if (err != ARGIL_OK)
+        mesh_clear(out);
+    return err;
+}

@@ -1,0 +1,26 @@
+/* Marching cubes over a dense density block: the closed triangle surface the renderer draws and
+ * the exporters write. */
+#ifndef ARGIL_MC_H
+#define ARGIL_MC_H
+
+#include <stdint.h>
+
+#include "host/mesh/mesh.h"
+#include "shared/argil_err.h"
+#include "shared/vec3.h"
+
+/* Smallest fraction of a cell edge between a vertex and a sample, so no triangle collapses when
+ * a sample sits exactly on the iso-value. */
+#define MC_T_MIN 0.01f
+
+/* Replaces out with the iso-surface of density (x fastest, dims samples, sample (0,0,0) at
+ * origin_m): closed, edge-manifold, one vertex per crossed grid edge, triangles CCW seen from
+ * outside (density <= iso, which includes every sample beyond the grid), unit outward normals
+ * from the central-difference gradient. Deterministic. ARGIL_ERR_ARG for dims < 1 or more than
+ * 2^31 samples, a spacing that is not finite and > 0, a non-finite iso or origin;
+ * ARGIL_ERR_NONFINITE when a density is NaN or Inf; ARGIL_ERR_NOMEM / ARGIL_ERR_FULL (more than
+ * 2^32 vertices). On error out is left empty. */
+argil_err_t mc_extract(const float *density, const int32_t dims[3], float spacing_m,
+                       vec3_t origin_m, float iso, mesh_t *out);
+
+#endif

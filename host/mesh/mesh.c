@@ -1,0 +1,111 @@
+/* Growable indexed triangle mesh (host heap). */
+#include "host/mesh/mesh.h"
+
+#include <stdlib.h>
+
+#define MESH_MAX_VERTS ((size_t)UINT32_MAX)
+
+void mesh_init(mesh_t *m)
+{
+    m->pos = NULL;
+    m->normal = NULL;
+    m->tri = NULL;
+    m->n_vert = 0;
+    m->n_tri = 0;
+    m->cap_vert = 0;
+    m->cap_tri = 0;
+}
+
+void mesh_free(mesh_t *m)
+{
+    free(m->pos);
+    free(m->normal);
+    free(m->tri);
+    mesh_init(m);
+}
+
+void mesh_clear(mesh_t *m)
+{
+    m->n_vert = 0;
+    m->n_tri = 0;
+}
+
+/* Next capacity: doubling from 256, at least need, at most limit. */
+static size_t next_cap(size_t cap, size_t need, size_t limit)
+{
+    size_t c = cap < 256 ? 256 : cap;
+    while (c < need && c <= limit / 2)
+        c *= 2;
+    if (c < need)
+        c = need;
+    return c > limit ? limit : c;
+}
+
+argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri)
+{
+    if (n_vert > MESH_MAX_VERTS || n_tri > SIZE_MAX / (3 * sizeof(uint32_t)))
+        return ARGIL_ERR_ARG;
+    if (n_vert > m->cap_vert) {
+        size_t cap = next_cap(m->cap_vert, n_vert, MESH_MAX_VERTS);
+        if (cap > SIZE_MAX / (3 * sizeof(float)))
+            return ARGIL_ERR_NOMEM;
+        float *p = realloc(m->pos, cap * 3 * sizeof(float));
+        if (p == NULL)
+            return ARGIL_ERR_NOMEM;
+        m->pos = p;
+        float *n = realloc(m->normal, cap * 3 * sizeof(float));
+        if (n == NULL)
+            return ARGIL_ERR_NOMEM; /* pos grew already; cap_vert stays, which is safe */
+        m->normal = n;
+        m->cap_vert = cap;
+    }
+    if (n_tri > m->cap_tri) {
+        size_t cap = next_cap(m->cap_tri, n_tri, SIZE_MAX / (3 * sizeof(uint32_t)));
+        uint32_t *t = realloc(m->tri, cap * 3 * sizeof(uint32_t));
+        if (t == NULL)
+            return ARGIL_ERR_NOMEM;
+        m->tri = t;
+        m->cap_tri = cap;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *index_out)
+{
+    if (m->n_vert >= m->cap_vert) {
+        if (m->n_vert >= MESH_MAX_VERTS)
+            return ARGIL_ERR_FULL;
+        argil_err_t e = mesh_reserve(m, m->n_vert + 1, m->n_tri);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    float *p = m->pos + 3 * m->n_vert;
+    float *n = m->normal + 3 * m->n_vert;
+    p[0] = pos_m.x;
+    p[1] = pos_m.y;
+    p[2] = pos_m.z;
+    n[0] = normal.x;
+    n[1] = normal.y;
+    n[2] = normal.z;
+    if (index_out != NULL)
+        *index_out = (uint32_t)m->n_vert;
+    m->n_vert++;
+    return ARGIL_OK;
+}
+
+argil_err_t mesh_add_triangle(mesh_t *m, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (a >= m->n_vert || b >= m->n_vert || c >= m->n_vert)
+        return ARGIL_ERR_ARG;
+    if (m->n_tri >= m->cap_tri) {
+        argil_err_t e = mesh_reserve(m, m->n_vert, m->n_tri + 1);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    uint32_t *t = m->tri + 3 * m->n_tri;
+    t[0] = a;
+    t[1] = b;
+    t[2] = c;
+    m->n_tri++;
+    return ARGIL_OK;
+}

@@ -1,0 +1,37 @@
+/* Indexed triangle mesh in model space: the mesher fills it, the renderer and exporters read it. */
+#ifndef ARGIL_MESH_H
+#define ARGIL_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/vec3.h"
+
+typedef struct {
+    float *pos;      /* xyz per vertex, model-space m */
+    float *normal;   /* xyz per vertex, unit, outward */
+    uint32_t *tri;   /* 3 vertex indices per triangle, CCW seen from outside */
+    size_t n_vert, n_tri, cap_vert, cap_tri;
+} mesh_t;
+
+/* Makes m an empty mesh that owns no memory. */
+void mesh_init(mesh_t *m);
+
+/* Releases m's arrays and leaves it empty (as after mesh_init). */
+void mesh_free(mesh_t *m);
+
+/* Empties m but keeps its capacity for reuse. */
+void mesh_clear(mesh_t *m);
+
+/* Ensures room for at least n_vert vertices and n_tri triangles in total (ARGIL_ERR_NOMEM or
+ * ARGIL_ERR_ARG beyond 2^32 vertices); the contents are kept. */
+argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri);
+
+/* Appends a vertex and stores its index in *index_out (may be NULL). */
+argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *index_out);
+
+/* Appends triangle (a, b, c); ARGIL_ERR_ARG when an index names no vertex. */
+argil_err_t mesh_add_triangle(mesh_t *m, uint32_t a, uint32_t b, uint32_t c);
+
+#endif

@@ -1,0 +1,68 @@
+/* The host's dense density grid: the sampled field the tools edit, the springs move, the
+ * mesher reads and the board's local window is cut from (sparse blocks come later). */
+#ifndef ARGIL_GRID_H
+#define ARGIL_GRID_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/density_springs.h"
+#include "shared/vec3.h"
+
+/* Largest number of samples a grid may hold (indices stay within int32). */
+#define GRID_SAMPLES_MAX ((int64_t)1 << 30)
+
+typedef struct {
+    int32_t dims[3];            /* samples per axis; index = x + dims0*(y + dims1*z) */
+    float spacing_m;            /* distance between neighbouring samples */
+    vec3_t origin_m;            /* model-space position of sample (0,0,0) */
+    float iso;                  /* surface level, 0.5 */
+    float band_m;               /* half-width of the density ramp across the surface */
+    spring_material_t material;
+    float *density, *rest, *velocity, *force;
+} grid_t;
+
+/* Allocates a grid with all densities 0, iso 0.5, band 4 spacings, the default material.
+ * ARGIL_ERR_ARG for dims < 1, more than GRID_SAMPLES_MAX samples, or a spacing that is not
+ * finite and > 0; ARGIL_ERR_NONFINITE for a non-finite origin; ARGIL_ERR_NOMEM. */
+argil_err_t grid_init(grid_t *g, const int32_t dims[3], float spacing_m, vec3_t origin_m);
+
+/* Releases the arrays; g may then be initialised again. */
+void grid_free(grid_t *g);
+
+/* A spring_field_t view onto the grid's own arrays (no copy). */
+spring_field_t grid_springs(grid_t *g);
+
+/* The density profile used everywhere: clamp(0.5 + 0.5*sd/band, 0, 1), sd positive inside. */
+float grid_profile(float signed_dist_m, float band_m);
+
+/* Sets density and rest to a solid sphere's profile, zeroes velocity and force; no effect for
+ * a non-finite centre or a radius that is not finite and >= 0. */
+void grid_fill_sphere(grid_t *g, vec3_t centre_m, float radius_m);
+
+/* Trilinear density at p; samples beyond the grid count as 0 (0 for a non-finite p). */
+float grid_density_at(const grid_t *g, vec3_t p_m);
+
+/* Exact gradient (1/m) of the trilinear interpolant in the cell holding p (zero far outside). */
+vec3_t grid_gradient_at(const grid_t *g, vec3_t p_m);
+
+/* Removes material inside a sphere (Ferley's hard eraser): density and rest become
+ * min(d, profile of the sphere's outside); changed samples lose their velocity. Writes the
+ * index box [lo, hi) of changed samples (lo = hi = 0 when none changed). */
+void grid_carve_sphere(grid_t *g, vec3_t centre_m, float radius_m, int32_t lo[3], int32_t hi[3]);
+
+/* The corner sample index (may be negative or beyond the grid) of a win_dims window whose
+ * centre is nearest p (corner 0 on any axis where p is not finite). */
+void grid_window_corner(const grid_t *g, vec3_t p_m, const int32_t win_dims[3],
+                        int32_t corner[3]);
+
+/* Copies the win_dims window of densities starting at corner into out (x fastest); samples
+ * outside the grid read 0. */
+void grid_extract(const grid_t *g, const int32_t corner[3], const int32_t win_dims[3],
+                  float *out);
+
+/* Adds force to sample (x,y,z); false (no effect) outside the grid or for a non-finite force. */
+bool grid_add_force(grid_t *g, int32_t x, int32_t y, int32_t z, float force);
+
+#endif

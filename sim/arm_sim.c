@@ -1,0 +1,225 @@
+/* Arm dynamics for the simulated device. The arm is counterbalanced (no gravity); its moving
+ * mass is lumped at the stylus tip, so with tip acceleration a = J q̈ + J̇ q̇ Lagrange gives
+ *   (Jᵀ m J + R) q̈ = τ_motor·gear + Jᵀ F_ext − τ_friction − Jᵀ m J̇ q̇,   R = diag(I_rotor gear²).
+ * Double precision inside: this is the "physics", the board sees it only through encoders. */
+#include "arm_sim.h"
+
+#include <math.h>
+#include <stddef.h>
+
+void arm_params_default(arm_params_t *p)
+{
+    arm_desc_default(&p->desc);
+    p->tip_mass_kg = 0.075f;
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        p->rotor_inertia_kg_m2[j] = 1.1e-6f;
+        p->viscous_nm_s_per_rad[j] = 0.002f;
+        p->coulomb_nm[j] = 0.005f;
+        p->peak_torque_nm[j] = p->desc.rated_torque_nm[j] * (float)ARM_PEAK_TORQUE_PERMILLE / 1000.0f;
+    }
+    p->coulomb_smooth_rad_s = 0.01f;
+}
+
+/* Kinematic terms at (q, q̇): Jacobian, tip position, tip velocity and the velocity-product
+ * acceleration J̇ q̇ (the tip acceleration when q̈ = 0). Any output may be NULL. */
+static void kin_terms(const arm_params_t *p, const double q[ARGIL_DRIVES],
+                      const double qd[ARGIL_DRIVES], double jac[3][ARGIL_DRIVES],
+                      double tip[3], double tip_vel[3], double acc_bias[3])
+{
+    const double l1 = p->desc.link1_m, l2 = p->desc.link2_m;
+    const double s0 = sin(q[0]), c0 = cos(q[0]);
+    const double a = q[1], b = q[1] + q[2];
+    const double l1s = l1 * sin(a), l1c = l1 * cos(a);
+    const double l2s = l2 * sin(b), l2c = l2 * cos(b);
+    const double r = l1c + l2c, h = l1s + l2s;
+    double j[3][ARGIL_DRIVES] = {
+        {r * c0, -h * s0, -l2s * s0},
+        {0.0, r, l2c},
+        {-r * s0, -h * c0, -l2s * c0},
+    };
+    if (jac != NULL)
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < ARGIL_DRIVES; k++)
+                jac[i][k] = j[i][k];
+    if (tip != NULL) {
+        tip[0] = r * s0;
+        tip[1] = h;
+        tip[2] = r * c0;
+    }
+    if (qd == NULL)
+        return;
+    if (tip_vel != NULL)
+        for (int i = 0; i < 3; i++)
+            tip_vel[i] = j[i][0] * qd[0] + j[i][1] * qd[1] + j[i][2] * qd[2];
+    if (acc_bias != NULL) {
+        const double ad = qd[1], bd = qd[1] + qd[2], q0d = qd[0];
+        const double rd = -(l1s * ad + l2s * bd);
+        const double rdd = -(l1c * ad * ad + l2c * bd * bd); /* with q̈ = 0 */
+        const double hdd = -(l1s * ad * ad + l2s * bd * bd);
+        acc_bias[0] = rdd * s0 + 2.0 * rd * c0 * q0d - r * s0 * q0d * q0d;
+        acc_bias[1] = hdd;
+        acc_bias[2] = rdd * c0 - 2.0 * rd * s0 * q0d - r * c0 * q0d * q0d;
+    }
+}
+
+/* M = Jᵀ m J + R from a Jacobian. */
+static void mass_from_jacobian(const arm_params_t *p, const double j[3][ARGIL_DRIVES],
+                               double m[ARGIL_DRIVES][ARGIL_DRIVES])
+{
+    for (int r = 0; r < ARGIL_DRIVES; r++) {
+        for (int c = 0; c < ARGIL_DRIVES; c++) {
+            double s = 0.0;
+            for (int i = 0; i < 3; i++)
+                s += j[i][r] * j[i][c];
+            m[r][c] = (double)p->tip_mass_kg * s;
+        }
+        const double g = p->desc.gear_ratio[r];
+        m[r][r] += (double)p->rotor_inertia_kg_m2[r] * g * g;
+    }
+}
+
+void arm_sim_mass_matrix(const arm_params_t *p, const double q_rad[ARGIL_DRIVES],
+                         double m[ARGIL_DRIVES][ARGIL_DRIVES])
+{
+    double j[3][ARGIL_DRIVES];
+    kin_terms(p, q_rad, NULL, j, NULL, NULL, NULL);
+    mass_from_jacobian(p, j, m);
+}
+
+bool arm_sim_solve3(const double a[3][3], const double b[3], double x[3])
+{
+    double m[3][4];
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            m[r][c] = a[r][c];
+        m[r][3] = b[r];
+    }
+    for (int c = 0; c < 3; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 3; r++)
+            if (fabs(m[r][c]) > fabs(m[piv][c]))
+                piv = r;
+        if (!(fabs(m[piv][c]) > 1e-300))
+            return false;
+        if (piv != c)
+            for (int k = 0; k < 4; k++) {
+                const double t = m[c][k];
+                m[c][k] = m[piv][k];
+                m[piv][k] = t;
+            }
+        for (int r = c + 1; r < 3; r++) {
+            const double f = m[r][c] / m[c][c];
+            for (int k = c; k < 4; k++)
+                m[r][k] -= f * m[c][k];
+        }
+    }
+    for (int r = 2; r >= 0; r--) {
+        double s = m[r][3];
+        for (int k = r + 1; k < 3; k++)
+            s -= m[r][k] * x[k];
+        x[r] = s / m[r][r];
+    }
+    return true;
+}
+
+void arm_sim_init(arm_sim_t *sim, const arm_params_t *p, const float q0_rad[ARGIL_DRIVES])
+{
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        double q = isfinite(q0_rad[j]) ? (double)q0_rad[j] : (double)p->desc.q_home_rad[j];
+        q = fmin(fmax(q, (double)p->desc.q_min_rad[j]), (double)p->desc.q_max_rad[j]);
+        sim->q_rad[j] = q;
+        sim->qd_rad_s[j] = 0.0;
+        sim->qdd_rad_s2[j] = 0.0;
+    }
+}
+
+/* One semi-implicit Euler sub-step of h seconds; tau_in_nm is the joint torque from the motors
+ * and the external force, before friction and velocity-product terms. */
+static void substep(arm_sim_t *sim, const arm_params_t *p, const double tau_in_nm[ARGIL_DRIVES],
+                    const double force_n[3], double h)
+{
+    double j[3][ARGIL_DRIVES], bias[3], m[ARGIL_DRIVES][ARGIL_DRIVES];
+    double tau[ARGIL_DRIVES], qdd[ARGIL_DRIVES];
+    kin_terms(p, sim->q_rad, sim->qd_rad_s, j, NULL, NULL, bias);
+    mass_from_jacobian(p, j, m);
+    const double eps = p->coulomb_smooth_rad_s > 0.0f ? (double)p->coulomb_smooth_rad_s : 1e-3;
+    for (int k = 0; k < ARGIL_DRIVES; k++) {
+        const double v = sim->qd_rad_s[k];
+        double t = tau_in_nm[k];
+        for (int i = 0; i < 3; i++)
+            t += j[i][k] * (force_n[i] - (double)p->tip_mass_kg * bias[i]);
+        t -= (double)p->viscous_nm_s_per_rad[k] * v;
+        t -= (double)p->coulomb_nm[k] * tanh(v / eps);
+        tau[k] = t;
+    }
+    if (!arm_sim_solve3((const double(*)[3])m, tau, qdd))
+        qdd[0] = qdd[1] = qdd[2] = 0.0; /* cannot happen while the rotor inertia is positive */
+    for (int k = 0; k < ARGIL_DRIVES; k++) {
+        sim->qdd_rad_s2[k] = qdd[k];
+        sim->qd_rad_s[k] += h * qdd[k];
+        sim->q_rad[k] += h * sim->qd_rad_s[k];
+        /* hard stops, restitution 0 */
+        const double lo = p->desc.q_min_rad[k], hi = p->desc.q_max_rad[k];
+        if (sim->q_rad[k] < lo) {
+            sim->q_rad[k] = lo;
+            if (sim->qd_rad_s[k] < 0.0)
+                sim->qd_rad_s[k] = 0.0;
+        } else if (sim->q_rad[k] > hi) {
+            sim->q_rad[k] = hi;
+            if (sim->qd_rad_s[k] > 0.0)
+                sim->qd_rad_s[k] = 0.0;
+        }
+    }
+}
+
+void arm_sim_step(arm_sim_t *sim, const arm_params_t *p,
+                  const float motor_torque_nm[ARGIL_DRIVES], vec3_t tip_force_n,
+                  uint32_t dt_us)
+{
+    double tau_in[ARGIL_DRIVES], f[3];
+    for (int k = 0; k < ARGIL_DRIVES; k++) {
+        const double peak = p->peak_torque_nm[k];
+        double t = isfinite(motor_torque_nm[k]) ? (double)motor_torque_nm[k] : 0.0;
+        t = fmin(fmax(t, -peak), peak);
+        tau_in[k] = t * (double)p->desc.gear_ratio[k];
+    }
+    const bool ok = vec3_isfinite(tip_force_n);
+    f[0] = ok ? tip_force_n.x : 0.0;
+    f[1] = ok ? tip_force_n.y : 0.0;
+    f[2] = ok ? tip_force_n.z : 0.0;
+    while (dt_us > 0) {
+        const uint32_t h_us = dt_us < ARM_SIM_SUBSTEP_US ? dt_us : ARM_SIM_SUBSTEP_US;
+        substep(sim, p, tau_in, f, (double)h_us * 1e-6);
+        dt_us -= h_us;
+    }
+}
+
+double arm_sim_kinetic_energy_j(const arm_sim_t *sim, const arm_params_t *p)
+{
+    double m[ARGIL_DRIVES][ARGIL_DRIVES], e = 0.0;
+    arm_sim_mass_matrix(p, sim->q_rad, m);
+    for (int r = 0; r < ARGIL_DRIVES; r++)
+        for (int c = 0; c < ARGIL_DRIVES; c++)
+            e += sim->qd_rad_s[r] * m[r][c] * sim->qd_rad_s[c];
+    return 0.5 * e;
+}
+
+vec3_t arm_sim_tip_m(const arm_sim_t *sim, const arm_params_t *p)
+{
+    double t[3];
+    kin_terms(p, sim->q_rad, NULL, NULL, t, NULL, NULL);
+    return vec3((float)t[0], (float)t[1], (float)t[2]);
+}
+
+vec3_t arm_sim_tip_vel_m_s(const arm_sim_t *sim, const arm_params_t *p)
+{
+    double v[3];
+    kin_terms(p, sim->q_rad, sim->qd_rad_s, NULL, NULL, v, NULL);
+    return vec3((float)v[0], (float)v[1], (float)v[2]);
+}
+
+void arm_sim_q_rad(const arm_sim_t *sim, float q_rad[ARGIL_DRIVES])
+{
+    for (int k = 0; k < ARGIL_DRIVES; k++)
+        q_rad[k] = (float)sim->q_rad[k];
+}

@@ -1,0 +1,300 @@
+/* The host density grid: sphere profile, trilinear sampling and gradient, hard carving, board
+ * windows, external forces and the density-spring view. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/model/grid.h"
+
+#define N 64
+#define H 1.25e-3f
+#define R 0.030f
+
+/* A 64³ grid at 1.25 mm, centred on the origin, holding a 30 mm sphere. */
+static grid_t *sphere_grid(void)
+{
+    grid_t *g = malloc(sizeof(*g));
+    assert_non_null(g);
+    const int32_t dims[3] = {N, N, N};
+    const float o = -0.5f * (float)(N - 1) * H;
+    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(g, vec3(0.0f, 0.0f, 0.0f), R);
+    return g;
+}
+
+static void drop_grid(grid_t *g)
+{
+    grid_free(g);
+    free(g);
+}
+
+static size_t idx(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+}
+
+static vec3_t sample_pos(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return vec3(g->origin_m.x + H * (float)x, g->origin_m.y + H * (float)y,
+                g->origin_m.z + H * (float)z);
+}
+
+/* Some directions that avoid the grid axes. */
+static vec3_t direction(int k)
+{
+    const float a = 0.37f + 0.91f * (float)k, b = 0.23f + 0.53f * (float)k;
+    return vec3(cosf(a) * sinf(b + 0.4f), sinf(a) * sinf(b + 0.4f), cosf(b + 0.4f));
+}
+
+static void test_init_defaults_and_errors(void **state)
+{
+    (void)state;
+    grid_t g;
+    const int32_t dims[3] = {4, 5, 6};
+    assert_int_equal(grid_init(&g, dims, 0.002f, vec3(1, 2, 3)), ARGIL_OK);
+    assert_float_equal(g.iso, 0.5f, 0.0f);
+    assert_float_equal(g.band_m, 0.008f, 1e-9f);
+    assert_true(spring_material_valid(&g.material));
+    for (size_t i = 0; i < 120; i++)
+        assert_true(g.density[i] == 0.0f && g.rest[i] == 0.0f && g.velocity[i] == 0.0f &&
+                    g.force[i] == 0.0f);
+    spring_field_t f = grid_springs(&g);
+    assert_int_equal(f.dims[0], 4);
+    assert_int_equal(f.dims[2], 6);
+    assert_ptr_equal(f.density, g.density);
+    assert_ptr_equal(f.force, g.force);
+    grid_free(&g);
+    grid_free(&g); /* twice is harmless */
+
+    const int32_t zero[3] = {4, 0, 6};
+    const int32_t huge[3] = {2048, 2048, 2048};
+    assert_int_equal(grid_init(&g, zero, 0.002f, vec3(0, 0, 0)), ARGIL_ERR_ARG);
+    assert_int_equal(grid_init(&g, huge, 0.002f, vec3(0, 0, 0)), ARGIL_ERR_ARG);
+    assert_int_equal(grid_init(&g, dims, 0.0f, vec3(0, 0, 0)), ARGIL_ERR_ARG);
+    assert_int_equal(grid_init(&g, dims, NAN, vec3(0, 0, 0)), ARGIL_ERR_ARG);
+    assert_int_equal(grid_init(&g, dims, 0.002f, vec3(NAN, 0, 0)), ARGIL_ERR_NONFINITE);
+    grid_free(&g);
+}
+
+static void test_sphere_profile(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    assert_float_equal(grid_density_at(g, vec3(0, 0, 0)), 1.0f, 1e-6f);
+    assert_float_equal(grid_profile(0.0f, 1.0f), 0.5f, 0.0f);
+    for (int k = 0; k < 20; k++) {
+        const vec3_t dir = direction(k);
+        const vec3_t p = vec3_scale(dir, R);
+        assert_float_equal(grid_density_at(g, p), 0.5f, 0.01f);
+        /* Deep inside and well outside the band. */
+        assert_float_equal(grid_density_at(g, vec3_scale(dir, R - 2.0f * g->band_m)), 1.0f, 1e-6f);
+        assert_float_equal(grid_density_at(g, vec3_scale(dir, R + 2.0f * g->band_m)), 0.0f, 1e-6f);
+
+        const vec3_t grad = grid_gradient_at(g, p);
+        const float mag = vec3_norm(grad);
+        assert_float_equal(mag, 0.5f / g->band_m, 0.05f * 0.5f / g->band_m);
+        assert_true(vec3_dot(grad, dir) / mag < -0.99f); /* points inward */
+    }
+    /* Outside the grid the field is 0 and flat. */
+    assert_float_equal(grid_density_at(g, vec3(1.0f, 0, 0)), 0.0f, 0.0f);
+    assert_float_equal(grid_density_at(g, vec3(NAN, 0, 0)), 0.0f, 0.0f);
+    assert_float_equal(vec3_norm(grid_gradient_at(g, vec3(0, -1.0f, 0))), 0.0f, 0.0f);
+    drop_grid(g);
+}
+
+static void test_gradient_matches_finite_differences(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    const float step = 1e-3f * H;
+    for (int k = 0; k < 200; k++) {
+        /* Points in the band, kept away from cell faces so the difference stays in one cell. */
+        const vec3_t dir = direction(k);
+        vec3_t p = vec3_scale(dir, R + (float)(k % 7 - 3) * 1.0e-3f);
+        float c[3] = {p.x, p.y, p.z};
+        const float o[3] = {g->origin_m.x, g->origin_m.y, g->origin_m.z};
+        for (int a = 0; a < 3; a++) {
+            const float u = (c[a] - o[a]) / H;
+            const float fr = u - floorf(u);
+            if (fr < 0.05f || fr > 0.95f)
+                c[a] = o[a] + (floorf(u) + 0.5f) * H;
+        }
+        p = vec3(c[0], c[1], c[2]);
+        const vec3_t grad = grid_gradient_at(g, p);
+        const vec3_t ex = vec3(step, 0, 0), ey = vec3(0, step, 0), ez = vec3(0, 0, step);
+        const vec3_t fd = vec3(
+            (grid_density_at(g, vec3_add(p, ex)) - grid_density_at(g, vec3_sub(p, ex))) / (2 * step),
+            (grid_density_at(g, vec3_add(p, ey)) - grid_density_at(g, vec3_sub(p, ey))) / (2 * step),
+            (grid_density_at(g, vec3_add(p, ez)) - grid_density_at(g, vec3_sub(p, ez))) / (2 * step));
+        /* |grad| is 100 /m; float differences over 1.25 µm carry ~1 /m of rounding. */
+        assert_true(vec3_norm(vec3_sub(grad, fd)) < 2.0f);
+    }
+    drop_grid(g);
+}
+
+static void test_carve_sphere(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    const size_t n = (size_t)N * N * N;
+    float *before = malloc(n * sizeof(float));
+    float *rest_before = malloc(n * sizeof(float));
+    assert_non_null(before);
+    assert_non_null(rest_before);
+    memcpy(before, g->density, n * sizeof(float));
+    memcpy(rest_before, g->rest, n * sizeof(float));
+
+    const vec3_t c = vec3(R, 0.0f, 0.0f);
+    const float rc = 0.008f;
+    int32_t lo[3], hi[3];
+    grid_carve_sphere(g, c, rc, lo, hi);
+
+    int32_t want_lo[3] = {N, N, N}, want_hi[3] = {0, 0, 0};
+    size_t changed = 0;
+    for (int32_t z = 0; z < N; z++)
+        for (int32_t y = 0; y < N; y++)
+            for (int32_t x = 0; x < N; x++) {
+                const size_t i = idx(g, x, y, z);
+                const float dist = vec3_norm(vec3_sub(sample_pos(g, x, y, z), c));
+                if (dist < rc - g->band_m)
+                    assert_true(g->density[i] == 0.0f && g->rest[i] == 0.0f);
+                if (dist < rc)
+                    assert_true(g->density[i] < 0.5f);
+                if (dist > rc + g->band_m + H) {
+                    assert_memory_equal(&g->density[i], &before[i], sizeof(float));
+                    assert_memory_equal(&g->rest[i], &rest_before[i], sizeof(float));
+                }
+                assert_true(g->density[i] <= before[i]);
+                if (g->density[i] != before[i] || g->rest[i] != rest_before[i]) {
+                    changed++;
+                    const int32_t s[3] = {x, y, z};
+                    for (int a = 0; a < 3; a++) {
+                        want_lo[a] = s[a] < want_lo[a] ? s[a] : want_lo[a];
+                        want_hi[a] = s[a] + 1 > want_hi[a] ? s[a] + 1 : want_hi[a];
+                    }
+                }
+            }
+    assert_true(changed > 1000);
+    for (int a = 0; a < 3; a++) {
+        assert_int_equal(lo[a], want_lo[a]);
+        assert_int_equal(hi[a], want_hi[a]);
+    }
+    /* The carve centre sits on the old surface; the box reaches about rc + band around it. */
+    assert_true(hi[0] - lo[0] <= (int32_t)(2.0f * (rc + g->band_m) / H) + 2);
+    assert_float_equal(grid_density_at(g, c), 0.0f, 0.0f);
+
+    /* The same carve again changes nothing; one far outside the solid neither. */
+    grid_carve_sphere(g, c, rc, lo, hi);
+    for (int a = 0; a < 3; a++)
+        assert_true(lo[a] == 0 && hi[a] == 0);
+    grid_carve_sphere(g, vec3(0.035f, 0.035f, 0.035f), 0.002f, lo, hi);
+    for (int a = 0; a < 3; a++)
+        assert_true(lo[a] == 0 && hi[a] == 0);
+    grid_carve_sphere(g, vec3(NAN, 0, 0), 0.01f, lo, hi);
+    for (int a = 0; a < 3; a++)
+        assert_true(lo[a] == 0 && hi[a] == 0);
+    free(before);
+    free(rest_before);
+    drop_grid(g);
+}
+
+static void test_window_corner_and_extract(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    const int32_t win[3] = {32, 5, 8};
+    /* p at sample index (10.2, 20.0, 60.7). */
+    const vec3_t p = vec3(g->origin_m.x + 10.2f * H, g->origin_m.y + 20.0f * H,
+                          g->origin_m.z + 60.7f * H);
+    int32_t corner[3];
+    grid_window_corner(g, p, win, corner);
+    assert_int_equal(corner[0], -5); /* centre at 10.5 */
+    assert_int_equal(corner[1], 18); /* centre at 20 */
+    assert_int_equal(corner[2], 57); /* centre at 60.5 */
+
+    float *out = malloc(32 * 5 * 8 * sizeof(float));
+    assert_non_null(out);
+    grid_extract(g, corner, win, out);
+    size_t o = 0, zeros_outside = 0;
+    for (int32_t z = 0; z < 8; z++)
+        for (int32_t y = 0; y < 5; y++)
+            for (int32_t x = 0; x < 32; x++, o++) {
+                const int32_t gx = corner[0] + x, gy = corner[1] + y, gz = corner[2] + z;
+                if (gx < 0 || gz >= N) {
+                    assert_true(out[o] == 0.0f);
+                    zeros_outside++;
+                } else {
+                    assert_memory_equal(&out[o], &g->density[idx(g, gx, gy, gz)], sizeof(float));
+                }
+            }
+    assert_int_equal(zeros_outside, 32 * 5 * 8 - 27 * 5 * 7);
+
+    /* A window entirely beyond the grid reads zeros. */
+    const int32_t far[3] = {1000, -1000, 5};
+    grid_extract(g, far, win, out);
+    for (size_t i = 0; i < 32 * 5 * 8; i++)
+        assert_true(out[i] == 0.0f);
+    free(out);
+
+    grid_window_corner(g, vec3(INFINITY, 0, 0), win, corner);
+    assert_int_equal(corner[0], 0);
+    drop_grid(g);
+}
+
+static void test_add_force(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    assert_false(grid_add_force(g, -1, 0, 0, 1.0f));
+    assert_false(grid_add_force(g, 0, N, 0, 1.0f));
+    assert_false(grid_add_force(g, 0, 0, N + 5, 1.0f));
+    assert_false(grid_add_force(g, 1, 1, 1, NAN));
+    assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
+    assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
+    assert_true(grid_add_force(g, 1, 2, 3, 1.0f));
+    assert_float_equal(g->force[idx(g, 1, 2, 3)], 2.5f, 0.0f);
+    drop_grid(g);
+}
+
+static void test_springs_push_lowers_density(void **state)
+{
+    (void)state;
+    grid_t *g = sphere_grid();
+    /* The sample on the +x surface of the sphere: 30 mm = 24 spacings from the centre. */
+    const int32_t x = 31 + 24, y = 31, z = 31;
+    const size_t i = idx(g, x, y, z);
+    const float d0 = g->density[i];
+    assert_true(d0 > 0.2f && d0 < 0.8f);
+    const float far0 = g->density[idx(g, 5, 5, 5)];
+    assert_true(grid_add_force(g, x, y, z, -50.0f));
+
+    spring_field_t f = grid_springs(g);
+    const int32_t lo[3] = {0, 0, 0}, hi[3] = {N, N, N};
+    const float dt = springs_stable_dt_s(&g->material);
+    springs_step(&f, &g->material, lo, hi, dt);
+    /* a = F/m = -50 /s²; after one step of ~21 ms the density falls by a*dt² ≈ 0.02. */
+    assert_true(g->density[i] < d0 - 0.01f);
+    assert_float_equal(g->force[i], 0.0f, 0.0f); /* consumed */
+    assert_float_equal(g->density[idx(g, 5, 5, 5)], far0, 0.0f);
+    drop_grid(g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_defaults_and_errors),
+        cmocka_unit_test(test_sphere_profile),
+        cmocka_unit_test(test_gradient_matches_finite_differences),
+        cmocka_unit_test(test_carve_sphere),
+        cmocka_unit_test(test_window_corner_and_extract),
+        cmocka_unit_test(test_add_force),
+        cmocka_unit_test(test_springs_push_lowers_density),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
