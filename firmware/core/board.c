@@ -245,8 +245,8 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
 
     /* Swap a complete window in at this tick boundary, once its predecessor's impulses are out. */
     if (window_pending(&b->window) && !b->impulse_pending) {
+        /* impulse_ns is all zero here: every entry went out before the swap. */
         window_swap(&b->window);
-        memset(b->impulse_ns, 0, sizeof(b->impulse_ns));
         haptics_reset_path(&b->haptics);
         b->fade_from_n = b->force_n;
         b->fade_left = b->cfg.crossfade_ticks;
@@ -265,8 +265,9 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
                         safety_may_sculpt(&b->safety), dt_s, b->impulse_ns, &h);
         if (h.sculpting)
             b->impulse_pending = true;
-        /* Step the springs in a box around the tool: the nodes the tool can reach and a margin. */
-        const float reach = b->tool.radius_m + 3.0f * w->spacing_m;
+        /* Step the springs only in a box around the tool — the nodes it can reach and one
+         * cell beyond — the board's own physical window (Hua & Qin §6.3). */
+        const float reach = b->tool.radius_m + w->spacing_m;
         int32_t lo[3], hi[3];
         const float p[3] = {b->pos_m.x - w->origin_m.x, b->pos_m.y - w->origin_m.y,
                             b->pos_m.z - w->origin_m.z};

@@ -42,7 +42,7 @@ static fault_code_t input_fault(const safety_inputs_t *in, const safety_t *s,
         return FAULT_DRIVE_HEARTBEAT;
     if (in->bus_error)
         return FAULT_BUS;
-    if (s->overruns_in_row >= cfg->overrun_streak)
+    if (cfg->overrun_streak > 0 && s->overruns_in_row >= cfg->overrun_streak)
         return FAULT_DEADLINE;
     if (in->force_limit_exceeded)
         return FAULT_FORCE_LIMIT;

@@ -31,7 +31,7 @@ typedef enum {
 typedef struct {
     uint32_t host_timeout_us;      /* host heartbeat silence that is a fault (default 50 ms) */
     uint32_t host_fade_us;         /* force fades to zero over this after the host is lost (20 ms) */
-    uint32_t overrun_streak;       /* consecutive deadline overruns that are a fault (3) */
+    uint32_t overrun_streak;       /* consecutive deadline overruns that are a fault (3); 0 = never */
 } safety_cfg_t;
 
 typedef struct {

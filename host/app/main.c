@@ -24,7 +24,7 @@ static void usage_sculpt(FILE *f)
 {
     fprintf(f,
             "usage: argil sculpt [--device sim] [--script FILE] [--out DIR] [--window N]\n"
-            "                    [--quiet]\n"
+            "                    [--quiet] [--no-deadline-fault]\n"
             "\n"
             "Runs a sculpting session. With --device sim (the default) the arm, its drives and\n"
             "the hand holding the stylus are simulated in lockstep on a virtual clock, so the\n"
@@ -40,6 +40,9 @@ static void usage_sculpt(FILE *f)
             "  --window N      edge of the board's local density window in samples, 4..32\n"
             "                  (default 16)\n"
             "  --quiet         no progress line and no summary\n"
+            "  --no-deadline-fault\n"
+            "                  count deadline misses but do not fault on a streak of them\n"
+            "                  (for profiling under valgrind, where every tick overruns)\n"
             "  -h, --help      this text\n");
 }
 
@@ -56,6 +59,8 @@ static int cmd_sculpt(int argc, char **argv)
             return 0;
         } else if (strcmp(a, "--quiet") == 0) {
             quiet = 1;
+        } else if (strcmp(a, "--no-deadline-fault") == 0) {
+            o.deadline_faults = false;
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--script") == 0 ||
                    strcmp(a, "--out") == 0 || strcmp(a, "--window") == 0) {
             if (!v) {
@@ -101,6 +106,8 @@ static int cmd_sculpt(int argc, char **argv)
                s.board_ticks, s.tick_hz);
         printf("  worst tick compute  %.1f us of a %u us period, deadline misses %u\n",
                s.worst_compute_ns / 1000.0, 1000000u / s.tick_hz, s.deadline_misses);
+        printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time)\n",
+               s.median_compute_ns / 1000u, s.p99_compute_ns / 1000u);
         printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
                (double)s.force_limit_n);
         printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,

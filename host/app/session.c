@@ -25,6 +25,7 @@
 #define SESSION_SPACING_M 0.00125f
 #define SESSION_TAIL_S 0.3f            /* simulated time after the script, to let the clay settle */
 #define SESSION_START_Z_M 0.060f       /* the workspace centre sits 60 mm in front of the clay */
+#define COMPUTE_HIST_BINS 2001u        /* 0 … 2000 µs; the last bin holds everything slower */
 
 void session_opts_default(session_opts_t *o)
 {
@@ -33,6 +34,7 @@ void session_opts_default(session_opts_t *o)
     o->window_edge = 16;
     o->progress = false;
     o->settle_s = 2.0f;
+    o->deadline_faults = true;
 }
 
 /* Everything a session owns; large, so it lives on the heap. */
@@ -50,6 +52,7 @@ typedef struct {
     uint32_t csv_rows;
     uint8_t rx[HAL_SIM_LINK_BYTES];
     vec3_t model_offset_m;             /* model = device + offset (scale 1) */
+    uint32_t compute_hist_us[COMPUTE_HIST_BINS]; /* tick compute times, 1 µs bins */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -143,6 +146,20 @@ static argil_err_t copy_file(const char *from, const char *to, char *err, size_t
     return ARGIL_OK;
 }
 
+/* The smallest bin value (µs) at or below which the fraction q of the samples lie. */
+static uint32_t hist_percentile_us(const uint32_t *hist, double q)
+{
+    uint64_t total = 0, seen = 0;
+    for (uint32_t i = 0; i < COMPUTE_HIST_BINS; i++)
+        total += hist[i];
+    for (uint32_t i = 0; i < COMPUTE_HIST_BINS; i++) {
+        seen += hist[i];
+        if (total > 0 && (double)seen >= q * (double)total)
+            return i;
+    }
+    return 0;
+}
+
 static void progress(const session_opts_t *o, double t_s, double total_s)
 {
     if (!o->progress)
@@ -163,6 +180,9 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         snprintf(err, err_len, "out of memory for the session");
         return ARGIL_ERR_NOMEM;
     }
+    /* Touch every page now, as the board daemon does with mlockall: no page faults inside
+     * ticks (explicit_bzero, because a plain memset after calloc may be optimised away). */
+    explicit_bzero(s, sizeof(*s));
     argil_err_t rc = ARGIL_OK;
     mesh_t mesh;
     mesh_init(&mesh);
@@ -180,6 +200,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     board_cfg_t bcfg;
     board_cfg_default(&bcfg);
     bcfg.arm = s->sim_params.arm.desc;
+    if (!opts->deadline_faults)
+        bcfg.safety.overrun_streak = 0;
     if (board_init(&s->board, &bcfg) != ARGIL_OK) {
         snprintf(err, err_len, "board configuration refused");
         rc = ARGIL_ERR_ARG;
@@ -292,7 +314,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         hal_sim_set_gpio_in(&s->hal, sim_device_gpio_in(&s->dev));
 
         /* The board's tick, then the host's. */
-        (void)board_run_tick(&s->board, &s->io, &s->hal);
+        const uint32_t compute_us = board_run_tick(&s->board, &s->io, &s->hal) / 1000u;
+        s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
         const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
         peer_tick(&s->peer, dt_us);
@@ -309,6 +332,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->tick_hz = 1000000u / dt_us;
     sum->worst_compute_ns = s->board.stats.worst_compute_ns;
     sum->deadline_misses = s->board.stats.deadline_misses;
+    sum->median_compute_ns = hist_percentile_us(s->compute_hist_us, 0.5) * 1000u;
+    sum->p99_compute_ns = hist_percentile_us(s->compute_hist_us, 0.99) * 1000u;
     sum->peak_force_n = s->board.stats.peak_force_n;
     sum->force_limit_n = s->board.cfg.max_force_n;
     sum->final_state = s->board.safety.state;

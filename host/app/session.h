@@ -17,6 +17,7 @@ typedef struct {
     int window_edge;              /* 16 or 32 */
     bool progress;                /* a progress line on stderr */
     float settle_s;               /* time allowed for the board to become ACTIVE */
+    bool deadline_faults;         /* an overrun streak faults the board (off only for profiling) */
 } session_opts_t;
 
 typedef struct {
@@ -24,6 +25,8 @@ typedef struct {
     uint32_t board_ticks;
     uint32_t tick_hz;
     uint32_t worst_compute_ns;
+    uint32_t median_compute_ns;   /* of every tick, 1 µs resolution */
+    uint32_t p99_compute_ns;
     uint32_t deadline_misses;
     float peak_force_n;
     float force_limit_n;

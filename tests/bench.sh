@@ -1,0 +1,47 @@
+#!/bin/sh
+# make bench: figures for the 1 kHz path and the whole lockstep session, on this machine.
+# Medians over repeated runs (the machine is shared and noisy); instruction counts from
+# callgrind are repeatable. Usage: tests/bench.sh REL_BUILD_DIR
+set -eu
+rel=$1
+bin="$rel/argil"
+script=scripts/default.scn
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+runs=5
+
+median() { sort -n | awk '{ a[NR] = $1 } END { if (NR == 0) print "n/a"; else print a[int((NR + 1) / 2)] }'; }
+
+echo "== default session ($script), release build, $runs runs per window size"
+for edge in 16 32; do
+    : >"$tmp/wall"; : >"$tmp/med"; : >"$tmp/p99"; : >"$tmp/worst"
+    for i in $(seq $runs); do
+        start=$(date +%s.%N)
+        "$bin" sculpt --script "$script" --out "$tmp/o" --window "$edge" >"$tmp/s"
+        end=$(date +%s.%N)
+        awk -v a="$start" -v b="$end" 'BEGIN { printf "%.4f\n", b - a }' >>"$tmp/wall"
+        sed -n 's/.*median \([0-9]*\) us, 99th percentile \([0-9]*\) us.*/\1/p' "$tmp/s" >>"$tmp/med"
+        sed -n 's/.*median \([0-9]*\) us, 99th percentile \([0-9]*\) us.*/\2/p' "$tmp/s" >>"$tmp/p99"
+        sed -n 's/.*worst tick compute *\([0-9.]*\) us.*/\1/p' "$tmp/s" >>"$tmp/worst"
+    done
+    sim_s=$(sed -n 's/.*simulated time *\([0-9.]*\) s.*/\1/p' "$tmp/s")
+    wall=$(median <"$tmp/wall")
+    printf '  window %2d^3: session wall %.3f s for %s s simulated (%.1fx real time); tick compute median %s us, p99 %s us, worst (median of runs) %s us\n' \
+        "$edge" "$wall" "$sim_s" "$(awk -v a="$sim_s" -v b="$wall" 'BEGIN { print a / b }')" "$(median <"$tmp/med")" \
+        "$(median <"$tmp/p99")" "$(median <"$tmp/worst")"
+done
+
+echo "== instructions per board tick (callgrind, board_tick inclusive, whole default session)"
+if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/null 2>&1; then
+    for edge in 16 32; do
+        valgrind --tool=callgrind --toggle-collect=board_tick --callgrind-out-file="$tmp/cg.$edge" \
+            "$bin" sculpt --script "$script" --out "$tmp/o" --window "$edge" --quiet --no-deadline-fault >/dev/null 2>&1
+        ir=$(callgrind_annotate "$tmp/cg.$edge" 2>/dev/null | sed -n 's/^ *\([0-9,]*\) .*PROGRAM TOTALS.*/\1/p' | tr -d ,)
+        ticks=$(($(wc -l <"$tmp/o/telemetry.csv") - 1))
+        printf '  window %2d^3: %s instructions in %s ticks = %s per tick (mean)\n' "$edge" "$ir" "$ticks" \
+            "$(awk -v a="$ir" -v b="$ticks" 'BEGIN { printf "%d", a / b }')"
+    done
+    echo "  (goal for issue 3: worst tick with a 16^3 window <= 150,000 instructions)"
+else
+    echo "  valgrind not installed: skipped"
+fi
