@@ -41,13 +41,22 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test fuzz bench cross hil clean deps check-freestanding tests-build
+.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-fuzz check-freestanding tests-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil check-freestanding
 
 deps:
 	@sh toolchain/install-deps.sh
+
+deps-build:
+	@sh toolchain/install-deps.sh build
+
+deps-test:
+	@sh toolchain/install-deps.sh test
+
+deps-fuzz:
+	@sh toolchain/install-deps.sh fuzz
 
 # Pattern rules: release and sanitizer objects.
 $(REL)/%.o: %.c
@@ -87,11 +96,11 @@ check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 
 tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil
 
-test: deps
+test: deps-test
 	@$(MAKE) --no-print-directory tests-build check-freestanding
 	@sh tests/run_all.sh $(SAN) $(REL)
 
-run: deps
+run: deps-build
 	@$(MAKE) --no-print-directory all
 	$(REL)/argil sculpt --device sim --script $(SCRIPT) --out $(OUT)
 
@@ -101,7 +110,7 @@ $(FZ)/%: tests/fuzz/%.c $(LIB_SRC)
 	@mkdir -p $(dir $@)
 	clang $(FUZZ_CFLAGS) $< $(LIB_SRC) -o $@ $(LDLIBS)
 
-fuzz: deps
+fuzz: deps-fuzz
 	@$(MAKE) --no-print-directory $(FUZZ_TARGETS:%=$(FZ)/%)
 	@for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(FZ)/corpus/$$t; \

@@ -1,36 +1,46 @@
 #!/bin/sh
 # Installs the Debian 12 packages argil needs to build and test, and only the
 # missing ones. Idempotent: a second run installs nothing and says so.
-# Usage: toolchain/install-deps.sh [--check]   (--check: list what is missing, exit 1 if any)
+# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz ...]
+#   build: what `make` and `make run` need; test: + the test tools; fuzz: + clang/libFuzzer.
+#   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
-# One line per package: what it is for is in the comment beside it.
-PACKAGES="
-make
-gcc
-libc6-dev
-libcmocka-dev
-clang
-libclang-rt-14-dev
-assimp-utils
-"
-# make, gcc, libc6-dev  : the build
-# libcmocka-dev         : unit-test runner
-# clang, libclang-rt-14-dev : libFuzzer targets (make fuzz)
-# assimp-utils          : tests load exported meshes with a third-party reader
+BUILD_PKGS="make gcc libc6-dev"          # the build
+TEST_PKGS="libcmocka-dev assimp-utils"   # unit-test runner; a third-party mesh reader for tests
+FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
+
+check_only=0
+groups=""
+for a in "$@"; do
+    case "$a" in
+        --check) check_only=1 ;;
+        build|test|fuzz) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz)" >&2; exit 2 ;;
+    esac
+done
+[ -n "$groups" ] || groups="build test fuzz"
+PACKAGES=""
+for g in $groups; do
+    case "$g" in
+        build) PACKAGES="$PACKAGES $BUILD_PKGS" ;;
+        test) PACKAGES="$PACKAGES $BUILD_PKGS $TEST_PKGS" ;;
+        fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $FUZZ_PKGS" ;;
+    esac
+done
 
 missing=""
-for p in $PACKAGES; do
+for p in $(echo $PACKAGES | tr ' ' '\n' | sort -u); do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
         missing="$missing $p"
     fi
 done
 
 if [ -z "$missing" ]; then
-    echo "toolchain: all build dependencies present"
+    echo "toolchain: all packages present for:$groups"
     exit 0
 fi
-if [ "${1:-}" = "--check" ]; then
+if [ "$check_only" = 1 ]; then
     echo "toolchain: missing:$missing"
     exit 1
 fi

@@ -1,5 +1,6 @@
 /* argil: the desktop program. Today: `argil sculpt` runs a scripted session on the simulated
  * arm and writes the result. */
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,6 +8,15 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/session.h"
+
+static volatile sig_atomic_t g_stop;
+
+/* Ctrl-C ends the session early; what was sculpted so far is still written. */
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_stop = 1;
+}
 
 static void usage_main(FILE *f)
 {
@@ -96,12 +106,16 @@ static int cmd_sculpt(int argc, char **argv)
         }
     }
     o.progress = !quiet && isatty(STDERR_FILENO);
+    o.stop = &g_stop;
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
     session_summary_t s;
     char err[1024] = "";
     const argil_err_t rc = session_run(&o, &s, err, sizeof(err));
     if (!quiet && s.board_ticks > 0) {
         const double vb = s.volume_before_m3 * 1e6, va = s.volume_after_m3 * 1e6;
-        printf("argil: session %s on the simulated arm\n", o.script_path);
+        printf("argil: session %s on the simulated arm%s\n", o.script_path,
+               s.interrupted ? " (interrupted: files hold the clay as it was then)" : "");
         printf("  simulated time      %.3f s (%u board ticks at %u Hz)\n", s.sim_seconds,
                s.board_ticks, s.tick_hz);
         printf("  worst tick compute  %.1f us of a %u us period, deadline misses %u\n",
@@ -128,7 +142,7 @@ static int cmd_sculpt(int argc, char **argv)
         fprintf(stderr, "argil sculpt: %s\n", err);
         return 1;
     }
-    return 0;
+    return s.interrupted ? 130 : 0;
 }
 
 int main(int argc, char **argv)

@@ -35,6 +35,7 @@ void session_opts_default(session_opts_t *o)
     o->progress = false;
     o->settle_s = 2.0f;
     o->deadline_faults = true;
+    o->stop = NULL;
 }
 
 /* Everything a session owns; large, so it lives on the heap. */
@@ -287,6 +288,10 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         }
         if (finished && t_s - finished_at_s >= SESSION_TAIL_S)
             break;
+        if (opts->stop && *opts->stop) {
+            sum->interrupted = true;
+            break;
+        }
         if (started && s->peer.have_tm &&
             (s->peer.last_tm.state == SAFETY_FAULT || s->peer.last_tm.state == SAFETY_ESTOP)) {
             snprintf(err, err_len, "the board stopped in %s at %.3f s: %s",

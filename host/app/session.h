@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <signal.h>
 #include <stdint.h>
 
 #include "shared/argil_err.h"
@@ -18,6 +19,7 @@ typedef struct {
     bool progress;                /* a progress line on stderr */
     float settle_s;               /* time allowed for the board to become ACTIVE */
     bool deadline_faults;         /* an overrun streak faults the board (off only for profiling) */
+    volatile sig_atomic_t *stop;  /* set (e.g. by SIGINT) to end early and keep what was made */
 } session_opts_t;
 
 typedef struct {
@@ -41,6 +43,7 @@ typedef struct {
     uint32_t impulse_frames;
     uint32_t link_errors;
     uint32_t telemetry_rows;
+    bool interrupted;             /* ended early through opts->stop */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);
