@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
+#include "host/app/commands.h"
 #include "host/app/session.h"
 
 static volatile sig_atomic_t g_stop;
@@ -18,16 +19,23 @@ static void on_signal(int sig)
     g_stop = 1;
 }
 
+/* Every subcommand: one line here and one declaration in commands.h. */
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} COMMANDS[] = {
+    {"sculpt", cmd_sculpt, "run a sculpting session (see 'argil sculpt --help')"},
+};
+
 static void usage_main(FILE *f)
 {
-    fprintf(f,
-            "usage: argil COMMAND [OPTIONS]\n"
-            "\n"
-            "argil is a haptic virtual-clay sculpting system.\n"
-            "\n"
-            "commands:\n"
-            "  sculpt    run a sculpting session (see 'argil sculpt --help')\n"
-            "  help      show this text\n");
+    fprintf(f, "usage: argil COMMAND [OPTIONS]\n\n"
+               "argil is a haptic virtual-clay sculpting system.\n\n"
+               "commands:\n");
+    for (size_t i = 0; i < sizeof(COMMANDS) / sizeof(COMMANDS[0]); i++)
+        fprintf(f, "  %-9s %s\n", COMMANDS[i].name, COMMANDS[i].summary);
+    fprintf(f, "  %-9s %s\n", "help", "show this text");
 }
 
 static void usage_sculpt(FILE *f)
@@ -56,7 +64,7 @@ static void usage_sculpt(FILE *f)
             "  -h, --help      this text\n");
 }
 
-static int cmd_sculpt(int argc, char **argv)
+int cmd_sculpt(int argc, char **argv)
 {
     session_opts_t o;
     session_opts_default(&o);
@@ -151,8 +159,9 @@ int main(int argc, char **argv)
         usage_main(stderr);
         return 2;
     }
-    if (strcmp(argv[1], "sculpt") == 0)
-        return cmd_sculpt(argc - 2, argv + 2);
+    for (size_t i = 0; i < sizeof(COMMANDS) / sizeof(COMMANDS[0]); i++)
+        if (strcmp(argv[1], COMMANDS[i].name) == 0)
+            return COMMANDS[i].run(argc - 2, argv + 2);
     if (strcmp(argv[1], "help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "--help") == 0) {
         usage_main(stdout);
