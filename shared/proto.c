@@ -14,9 +14,9 @@
 #define TELEMETRY_SIZE 64u
 #define IMPULSE_HEAD_SIZE 10u
 #define IMPULSE_ENTRY_SIZE 8u
-#define WINDOW_HEAD_SIZE 57u
+#define WINDOW_HEAD_SIZE 58u
 #define WINDOW_SAMPLE_SIZE 4u
-#define TOOL_SIZE 33u
+#define TOOL_SIZE 72u
 #define FAULT_SIZE 15u
 
 _Static_assert(IMPULSE_HEAD_SIZE + IMPULSE_ENTRY_SIZE * PROTO_IMPULSE_MAX <= PROTO_PAYLOAD_MAX,
@@ -45,8 +45,8 @@ static bool same_bits(float a, float b)
     return memcmp(&a, &b, sizeof a) == 0;
 }
 
-/* Samples in a window of these dims, or 0 when a dim is outside 2 … ARGIL_WINDOW_MAX. */
-static uint32_t window_samples(const uint8_t dims[3])
+/* Nodes in a window of these dims, or 0 when a dim is outside 2 … ARGIL_WINDOW_MAX. */
+static uint32_t window_nodes(const uint8_t dims[3])
 {
     uint32_t n = 1u;
     for (size_t i = 0; i < 3u; i++) {
@@ -57,6 +57,15 @@ static uint32_t window_samples(const uint8_t dims[3])
     return n;
 }
 
+/* Samples in the whole array of a window (channels × nodes), or 0 when dims or channels are
+ * out of range. */
+static uint32_t window_samples(const uint8_t dims[3], uint8_t channels)
+{
+    if (channels < 1u || channels > PROTO_WINDOW_CHANNELS_MAX)
+        return 0u;
+    return window_nodes(dims) * channels;
+}
+
 /* Samples chunk index of a window with total samples holds (index must be in range). */
 static uint16_t chunk_samples(uint32_t total, uint32_t index)
 {
@@ -65,20 +74,23 @@ static uint16_t chunk_samples(uint32_t total, uint32_t index)
     return (uint16_t)(left < PROTO_WINDOW_CHUNK_SAMPLES ? left : PROTO_WINDOW_CHUNK_SAMPLES);
 }
 
-/* Number of chunks a window of dims[0]*dims[1]*dims[2] samples takes; 0 for invalid dims. */
-uint16_t window_chunk_count(const uint8_t dims[3])
+/* Number of chunks the channels × dims[0]*dims[1]*dims[2] samples of a window take; 0 for
+ * dims or channels out of range. */
+uint16_t window_chunk_count(const uint8_t dims[3], uint8_t channels)
 {
-    uint32_t total = window_samples(dims);
+    uint32_t total = window_samples(dims, channels);
     return (uint16_t)((total + PROTO_WINDOW_CHUNK_SAMPLES - 1u) / PROTO_WINDOW_CHUNK_SAMPLES);
 }
 
 /* PROTO_OK when the chunk's window fields are valid, otherwise VALUE (range) or CHUNK
- * (chunk numbering inconsistent with its own dims). Reads samples only once sample_count fits. */
+ * (chunk numbering inconsistent with its own dims and channels). Reads samples only once
+ * sample_count fits. */
 static proto_err_t window_check(const msg_window_t *w)
 {
-    uint32_t total = window_samples(w->dims);
-    if (total == 0u)
+    uint32_t nodes = window_nodes(w->dims);
+    if (nodes == 0u || w->channels < 1u || w->channels > PROTO_WINDOW_CHANNELS_MAX)
         return PROTO_ERR_VALUE;
+    uint32_t total = nodes * w->channels;
     if (!all_finite(w->origin_m, 3u) || !isfinite(w->spacing_m) || !(w->spacing_m > 0.0f) ||
         !isfinite(w->iso))
         return PROTO_ERR_VALUE;
@@ -87,12 +99,60 @@ static proto_err_t window_check(const msg_window_t *w)
         !(w->stiffness >= 0.0f) || !isfinite(w->damping) || !(w->damping >= 0.0f) ||
         !isfinite(w->plastic_rate_hz) || !(w->plastic_rate_hz >= 0.0f))
         return PROTO_ERR_VALUE;
-    if (w->chunk_count != window_chunk_count(w->dims) || w->chunk_index >= w->chunk_count)
+    if (w->chunk_count != window_chunk_count(w->dims, w->channels) ||
+        w->chunk_index >= w->chunk_count)
         return PROTO_ERR_CHUNK;
     if (w->first_sample != (uint32_t)w->chunk_index * PROTO_WINDOW_CHUNK_SAMPLES ||
         w->sample_count != chunk_samples(total, w->chunk_index))
         return PROTO_ERR_CHUNK;
     if (!all_finite(w->samples, w->sample_count))
+        return PROTO_ERR_VALUE;
+    /* samples from index `nodes` of the array on are channel 2: spring stiffness, >= 0 */
+    uint32_t k = nodes > w->first_sample ? nodes - w->first_sample : 0u;
+    for (; k < w->sample_count; k++) {
+        if (!(w->samples[k] >= 0.0f))
+            return PROTO_ERR_VALUE;
+    }
+    return PROTO_OK;
+}
+
+/* True when the tool axis is unit length within 1e-3, compared squared (no square root):
+ * (1 - 1e-3)^2 <= |a|^2 <= (1 + 1e-3)^2. A huge component squares to +Inf and fails. */
+static bool unit_axis(const float a[3])
+{
+    float n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    return n2 >= (1.0f - 1e-3f) * (1.0f - 1e-3f) && n2 <= (1.0f + 1e-3f) * (1.0f + 1e-3f);
+}
+
+/* True when v is finite and >= 0. */
+static bool nonneg(float v)
+{
+    return isfinite(v) && v >= 0.0f;
+}
+
+/* True when v is finite and > 0. */
+static bool positive(float v)
+{
+    return isfinite(v) && v > 0.0f;
+}
+
+/* PROTO_OK when every TOOL field is in range (docs/protocol.md, TOOL), otherwise VALUE. */
+static proto_err_t tool_check(const msg_tool_t *t)
+{
+    if (t->kind >= TOOL_KIND_COUNT || t->shape >= TOOL_SHAPE_COUNT ||
+        t->filter >= BETA_FILTER_COUNT || (t->flags & ~TOOL_FLAG_ISO) != 0u)
+        return PROTO_ERR_VALUE;
+    if (!positive(t->radius_m) || !nonneg(t->length_m) || !all_finite(t->axis, 3u) ||
+        !unit_axis(t->axis))
+        return PROTO_ERR_VALUE;
+    if (!nonneg(t->alpha) || !nonneg(t->contact_stiffness_n_per_m) || !positive(t->max_force_n))
+        return PROTO_ERR_VALUE;
+    if (!isfinite(t->iso) || !(t->iso >= 0.0f && t->iso <= 1.0f))
+        return PROTO_ERR_VALUE;
+    if (!nonneg(t->yield_force_n) || !nonneg(t->friction) || !nonneg(t->probe_gain) ||
+        !nonneg(t->rope_stiffness_n_per_m))
+        return PROTO_ERR_VALUE;
+    if (!positive(t->model_scale) || !all_finite(t->model_offset_m, 3u))
         return PROTO_ERR_VALUE;
     return PROTO_OK;
 }
@@ -129,16 +189,8 @@ static proto_err_t msg_check(const proto_msg_t *msg)
     }
     case MSG_WINDOW:
         return window_check(&msg->u.window);
-    case MSG_TOOL: {
-        const msg_tool_t *t = &msg->u.tool;
-        if (t->kind >= TOOL_KIND_COUNT || !isfinite(t->radius_m) || !(t->radius_m > 0.0f) ||
-            !isfinite(t->alpha) || !isfinite(t->contact_stiffness_n_per_m) ||
-            !(t->contact_stiffness_n_per_m >= 0.0f) || !isfinite(t->max_force_n) ||
-            !(t->max_force_n > 0.0f) || !isfinite(t->model_scale) || !(t->model_scale > 0.0f) ||
-            !all_finite(t->model_offset_m, 3u))
-            return PROTO_ERR_VALUE;
-        return PROTO_OK;
-    }
+    case MSG_TOOL:
+        return tool_check(&msg->u.tool);
     case MSG_FAULT:
         return PROTO_OK;
     default:
@@ -237,6 +289,7 @@ static void put_payload(wire_writer_t *w, const proto_msg_t *msg)
         wire_put_u16(w, c->chunk_index);
         wire_put_u16(w, c->chunk_count);
         wire_put_bytes(w, c->dims, 3u);
+        wire_put_u8(w, c->channels);
         put_f32s(w, c->origin_m, 3u);
         wire_put_f32(w, c->spacing_m);
         wire_put_f32(w, c->iso);
@@ -255,10 +308,20 @@ static void put_payload(wire_writer_t *w, const proto_msg_t *msg)
     case MSG_TOOL: {
         const msg_tool_t *t = &msg->u.tool;
         wire_put_u8(w, t->kind);
+        wire_put_u8(w, t->shape);
+        wire_put_u8(w, t->filter);
+        wire_put_u8(w, t->flags);
         wire_put_f32(w, t->radius_m);
+        wire_put_f32(w, t->length_m);
+        put_f32s(w, t->axis, 3u);
         wire_put_f32(w, t->alpha);
         wire_put_f32(w, t->contact_stiffness_n_per_m);
         wire_put_f32(w, t->max_force_n);
+        wire_put_f32(w, t->iso);
+        wire_put_f32(w, t->yield_force_n);
+        wire_put_f32(w, t->friction);
+        wire_put_f32(w, t->probe_gain);
+        wire_put_f32(w, t->rope_stiffness_n_per_m);
         wire_put_f32(w, t->model_scale);
         put_f32s(w, t->model_offset_m, 3u);
         break;
@@ -350,10 +413,20 @@ static proto_err_t get_fixed(wire_reader_t *r, size_t plen, proto_msg_t *msg)
         if (plen != TOOL_SIZE)
             return PROTO_ERR_PAYLOAD;
         t->kind = wire_get_u8(r);
+        t->shape = wire_get_u8(r);
+        t->filter = wire_get_u8(r);
+        t->flags = wire_get_u8(r);
         t->radius_m = wire_get_f32(r);
+        t->length_m = wire_get_f32(r);
+        get_f32s(r, t->axis, 3u);
         t->alpha = wire_get_f32(r);
         t->contact_stiffness_n_per_m = wire_get_f32(r);
         t->max_force_n = wire_get_f32(r);
+        t->iso = wire_get_f32(r);
+        t->yield_force_n = wire_get_f32(r);
+        t->friction = wire_get_f32(r);
+        t->probe_gain = wire_get_f32(r);
+        t->rope_stiffness_n_per_m = wire_get_f32(r);
         t->model_scale = wire_get_f32(r);
         get_f32s(r, t->model_offset_m, 3u);
         return PROTO_OK;
@@ -403,6 +476,7 @@ static proto_err_t get_window(wire_reader_t *r, size_t plen, msg_window_t *c)
     c->chunk_index = wire_get_u16(r);
     c->chunk_count = wire_get_u16(r);
     wire_get_bytes(r, c->dims, 3u);
+    c->channels = wire_get_u8(r);
     get_f32s(r, c->origin_m, 3u);
     c->spacing_m = wire_get_f32(r);
     c->iso = wire_get_f32(r);
@@ -502,12 +576,13 @@ const char *proto_strerror(proto_err_t err)
     }
 }
 
-/* Fills chunk number index of the window described by head from samples[] (x fastest). */
+/* Fills chunk number index of the window described by head from samples[], the whole array
+ * (densities x fastest, then stiffnesses when head->channels = 2). */
 proto_err_t window_chunk_fill(const msg_window_t *head, const float *samples, uint16_t index,
                               msg_window_t *chunk)
 {
-    uint32_t total = window_samples(head->dims);
-    uint16_t count = window_chunk_count(head->dims);
+    uint32_t total = window_samples(head->dims, head->channels);
+    uint16_t count = window_chunk_count(head->dims, head->channels);
     if (index >= count)
         return PROTO_ERR_VALUE;
     memset(chunk, 0, sizeof *chunk);
@@ -515,6 +590,7 @@ proto_err_t window_chunk_fill(const msg_window_t *head, const float *samples, ui
     chunk->chunk_index = index;
     chunk->chunk_count = count;
     memcpy(chunk->dims, head->dims, sizeof chunk->dims);
+    chunk->channels = head->channels;
     memcpy(chunk->origin_m, head->origin_m, sizeof chunk->origin_m);
     chunk->spacing_m = head->spacing_m;
     chunk->iso = head->iso;
@@ -551,6 +627,7 @@ static bool same_window(const window_asm_t *a, const msg_window_t *c)
 {
     const msg_window_t *h = &a->head;
     return c->chunk_count == a->chunk_count && memcmp(c->dims, h->dims, sizeof h->dims) == 0 &&
+           c->channels == h->channels &&
            same_bits(c->origin_m[0], h->origin_m[0]) &&
            same_bits(c->origin_m[1], h->origin_m[1]) &&
            same_bits(c->origin_m[2], h->origin_m[2]) && same_bits(c->spacing_m, h->spacing_m) &&
@@ -572,6 +649,7 @@ static void asm_restart(window_asm_t *a, const msg_window_t *c)
     a->head.version = c->version;
     a->head.chunk_count = c->chunk_count;
     memcpy(a->head.dims, c->dims, sizeof a->head.dims);
+    a->head.channels = c->channels;
     memcpy(a->head.origin_m, c->origin_m, sizeof a->head.origin_m);
     a->head.spacing_m = c->spacing_m;
     a->head.iso = c->iso;
@@ -597,7 +675,7 @@ proto_err_t window_asm_feed(window_asm_t *a, const msg_window_t *chunk)
     proto_err_t err = window_check(chunk);
     if (err != PROTO_OK)
         return err;
-    if (window_samples(chunk->dims) > a->capacity)
+    if (window_samples(chunk->dims, chunk->channels) > a->capacity)
         return PROTO_ERR_CHUNK;
 
     if (!a->started || version_newer(chunk->version, a->version)) {

@@ -18,8 +18,10 @@
 #define PROTO_PAYLOAD_MAX (PROTO_FRAME_MAX - PROTO_HEADER_SIZE - PROTO_CRC_SIZE)
 #define PROTO_IMPULSE_MAX 124u         /* impulse entries in one IMPULSE frame */
 #define PROTO_WINDOW_CHUNK_SAMPLES 224u /* samples per WINDOW chunk (the last may hold fewer) */
-#define PROTO_WINDOW_CHUNKS_MAX \
-    ((ARGIL_WINDOW_SAMPLES_MAX + PROTO_WINDOW_CHUNK_SAMPLES - 1u) / PROTO_WINDOW_CHUNK_SAMPLES)
+#define PROTO_WINDOW_CHANNELS_MAX 2u  /* density, and optionally per-node spring stiffness */
+#define PROTO_WINDOW_CHUNKS_MAX                                                                   \
+    ((PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX + PROTO_WINDOW_CHUNK_SAMPLES - 1u) /    \
+     PROTO_WINDOW_CHUNK_SAMPLES)
 #define PROTO_NAME_LEN 16u
 
 /* Which rule a frame broke. Every decoder error is distinct so tests and logs can say why. */
@@ -103,12 +105,15 @@ typedef struct {
 } msg_impulse_t;
 
 /* WINDOW: host → board, one chunk of a versioned local density window.
- * Chunk i holds samples [i*PROTO_WINDOW_CHUNK_SAMPLES, …) of the x-fastest sample array. */
+ * The window's sample array is channels × dims[0]*dims[1]*dims[2] floats: the densities (x
+ * fastest), then, when channels = 2, each node's spring stiffness in the same order. Chunk i
+ * holds samples [i*PROTO_WINDOW_CHUNK_SAMPLES, …) of that array. */
 typedef struct {
     uint32_t version;
     uint16_t chunk_index;
     uint16_t chunk_count;
     uint8_t dims[3];         /* samples per axis, 2 … ARGIL_WINDOW_MAX */
+    uint8_t channels;        /* 1: density only (uniform stiffness below); 2: + per-node stiffness */
     float origin_m[3];       /* model-space position of sample (0,0,0) */
     float spacing_m;         /* > 0 */
     float iso;               /* iso-value of the surface */
@@ -123,20 +128,52 @@ typedef struct {
 } msg_window_t;
 
 typedef enum {
-    TOOL_TOUCH = 0,          /* feel only */
-    TOOL_PUSH = 1,           /* lower density where the tool moves (dent) */
-    TOOL_PULL = 2,           /* raise density where the tool moves (bulge) */
-    TOOL_CARVE = 3           /* host-side geometric removal; the board renders contact */
+    TOOL_TOUCH = 0,          /* feel the iso-surface (any iso-value: flag TOOL_FLAG_ISO) */
+    TOOL_PUSH = 1,           /* lower density along the tool's path once the clay yields (dent) */
+    TOOL_PULL = 2,           /* raise density along the path from the grab point (bulge) */
+    TOOL_CARVE = 3,          /* host-side geometric removal; the board renders a drag */
+    TOOL_PROBE = 4,          /* feel local stiffness as viscosity (Hua & Qin §6.1) */
+    TOOL_ROPE = 5            /* grab the nearest mass points and pull on a spring (Virtual Clay) */
 } tool_kind_t;
-#define TOOL_KIND_COUNT 4
+#define TOOL_KIND_COUNT 6
+
+/* How a sculpting tool samples its path (Hua & Qin §6.1). */
+typedef enum {
+    TOOL_SHAPE_POINT = 0,    /* one path: the tool tip's */
+    TOOL_SHAPE_CURVE = 1,    /* a segment of length_m along axis, centred on the tip */
+    TOOL_SHAPE_AREA = 2      /* a square of side length_m normal to axis, centred on the tip */
+} tool_shape_t;
+#define TOOL_SHAPE_COUNT 3
+
+/* The distance filter β that spreads a path's force over the nodes near it. */
+typedef enum {
+    BETA_CONSTANT = 0,
+    BETA_GAUSSIAN = 1,
+    BETA_SPHERICAL = 2,
+    BETA_CYLINDRICAL = 3,
+    BETA_CONICAL = 4
+} beta_filter_t;
+#define BETA_FILTER_COUNT 5
+
+#define TOOL_FLAG_ISO 0x01u  /* touch renders the iso-surface at `iso`, not the window's */
 
 /* TOOL: host → board, the active tool, its gains and the device-to-model transform. */
 typedef struct {
     uint8_t kind;            /* tool_kind_t */
-    float radius_m;          /* > 0 */
-    float alpha;             /* sculpting gain of Hua & Qin eq. 7 */
-    float contact_stiffness_n_per_m;
+    uint8_t shape;           /* tool_shape_t */
+    uint8_t filter;          /* beta_filter_t */
+    uint8_t flags;           /* TOOL_FLAG_* */
+    float radius_m;          /* > 0: tool sphere, and β's support */
+    float length_m;          /* ≥ 0: curve length or area side */
+    float axis[3];           /* tool axis in model space, unit length (curve/area orientation) */
+    float alpha;             /* ≥ 0: sculpting gain of Hua & Qin eq. 7 */
+    float contact_stiffness_n_per_m; /* ≥ 0 */
     float max_force_n;       /* > 0 */
+    float iso;               /* iso-value felt with TOOL_FLAG_ISO, 0 … 1 */
+    float yield_force_n;     /* ≥ 0: contact force at which push starts to flow the clay */
+    float friction;          /* ≥ 0: Coulomb coefficient limiting the contact point's slide */
+    float probe_gain;        /* ≥ 0: probe viscosity, N·s/m per unit stiffness */
+    float rope_stiffness_n_per_m; /* ≥ 0 */
     float model_scale;       /* model = scale * device + offset; > 0 */
     float model_offset_m[3];
 } msg_tool_t;
@@ -204,8 +241,8 @@ bool window_asm_complete(const window_asm_t *a);
 proto_err_t window_chunk_fill(const msg_window_t *head, const float *samples, uint16_t index,
                               msg_window_t *chunk);
 
-/* Number of chunks a window of dims[0]*dims[1]*dims[2] samples takes; 0 when a dim is
- * outside 2 … ARGIL_WINDOW_MAX. */
-uint16_t window_chunk_count(const uint8_t dims[3]);
+/* Number of chunks a window of channels × dims[0]*dims[1]*dims[2] samples takes; 0 when a dim
+ * is outside 2 … ARGIL_WINDOW_MAX or channels outside 1 … PROTO_WINDOW_CHANNELS_MAX. */
+uint16_t window_chunk_count(const uint8_t dims[3], uint8_t channels);
 
 #endif

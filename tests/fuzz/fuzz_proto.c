@@ -13,7 +13,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 #define FUZZ_BUF_MAX 65536u
 
-static float g_storage[ARGIL_WINDOW_SAMPLES_MAX];
+static float g_storage[PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX];
 static float g_small[1000];
 static uint8_t g_copy[FUZZ_BUF_MAX];
 
@@ -68,6 +68,7 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
         const msg_window_t *x = &a->u.window, *y = &b->u.window;
         return x->version == y->version && x->chunk_index == y->chunk_index &&
                x->chunk_count == y->chunk_count && memcmp(x->dims, y->dims, 3) == 0 &&
+               x->channels == y->channels &&
                same_f32(x->origin_m, y->origin_m, 3) && same_f32(&x->spacing_m, &y->spacing_m, 1) &&
                same_f32(&x->iso, &y->iso, 1) && same_f32(&x->node_mass, &y->node_mass, 1) &&
                same_f32(&x->stiffness, &y->stiffness, 1) && same_f32(&x->damping, &y->damping, 1) &&
@@ -79,10 +80,16 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
     }
     case MSG_TOOL: {
         const msg_tool_t *x = &a->u.tool, *y = &b->u.tool;
-        return x->kind == y->kind && same_f32(&x->radius_m, &y->radius_m, 1) &&
+        return x->kind == y->kind && x->shape == y->shape && x->filter == y->filter &&
+               x->flags == y->flags && same_f32(&x->radius_m, &y->radius_m, 1) &&
+               same_f32(&x->length_m, &y->length_m, 1) && same_f32(x->axis, y->axis, 3) &&
                same_f32(&x->alpha, &y->alpha, 1) &&
                same_f32(&x->contact_stiffness_n_per_m, &y->contact_stiffness_n_per_m, 1) &&
-               same_f32(&x->max_force_n, &y->max_force_n, 1) &&
+               same_f32(&x->max_force_n, &y->max_force_n, 1) && same_f32(&x->iso, &y->iso, 1) &&
+               same_f32(&x->yield_force_n, &y->yield_force_n, 1) &&
+               same_f32(&x->friction, &y->friction, 1) &&
+               same_f32(&x->probe_gain, &y->probe_gain, 1) &&
+               same_f32(&x->rope_stiffness_n_per_m, &y->rope_stiffness_n_per_m, 1) &&
                same_f32(&x->model_scale, &y->model_scale, 1) &&
                same_f32(x->model_offset_m, y->model_offset_m, 3);
     }
@@ -93,6 +100,38 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
     }
     default:
         return 0;
+    }
+}
+
+/* Checks what the decoder promises about a WINDOW chunk and a TOOL, independently of
+ * proto.c's own checks: the ranges of docs/protocol.md. */
+static void check_ranges(const proto_msg_t *m)
+{
+    if (m->type == MSG_WINDOW) {
+        const msg_window_t *w = &m->u.window;
+        check(w->channels >= 1u && w->channels <= PROTO_WINDOW_CHANNELS_MAX);
+        uint32_t nodes = (uint32_t)w->dims[0] * w->dims[1] * w->dims[2];
+        check(w->chunk_count == window_chunk_count(w->dims, w->channels));
+        check(w->chunk_count <= PROTO_WINDOW_CHUNKS_MAX);
+        check(w->sample_count <= PROTO_WINDOW_CHUNK_SAMPLES);
+        check(w->first_sample + w->sample_count <= nodes * w->channels);
+        for (uint32_t k = 0; k < w->sample_count; k++) {
+            check(w->samples[k] == w->samples[k]); /* not NaN */
+            if (w->first_sample + k >= nodes)
+                check(w->samples[k] >= 0.0f && w->samples[k] <= 3.5e38f); /* a stiffness */
+        }
+    } else if (m->type == MSG_TOOL) {
+        const msg_tool_t *t = &m->u.tool;
+        check(t->kind < TOOL_KIND_COUNT && t->shape < TOOL_SHAPE_COUNT &&
+              t->filter < BETA_FILTER_COUNT && (t->flags & ~TOOL_FLAG_ISO) == 0u);
+        check(t->radius_m > 0.0f && t->max_force_n > 0.0f && t->model_scale > 0.0f);
+        check(t->iso >= 0.0f && t->iso <= 1.0f);
+        double n2 = (double)t->axis[0] * t->axis[0] + (double)t->axis[1] * t->axis[1] +
+                    (double)t->axis[2] * t->axis[2];
+        check(n2 > 0.9979 && n2 < 1.0021);
+        check(t->length_m >= 0.0f && t->alpha >= 0.0f && t->contact_stiffness_n_per_m >= 0.0f &&
+              t->yield_force_n >= 0.0f && t->friction >= 0.0f && t->probe_gain >= 0.0f &&
+              t->rope_stiffness_n_per_m >= 0.0f);
     }
 }
 
@@ -146,6 +185,7 @@ static size_t decode_one(const uint8_t *buf, size_t len, window_asm_t *big, wind
     check(proto_encode(&m, m.seq, out, flen - 1u, &olen) == PROTO_ERR_NOSPACE);
     check(proto_decode(out, flen, &back, &blen) == PROTO_OK && blen == flen);
     check(msg_equal(&m, &back));
+    check_ranges(&m);
 
     if (m.type == MSG_WINDOW)
         feed_window(big, small, &m.u.window);
@@ -179,7 +219,7 @@ static void repair_crc(uint8_t *buf, size_t len)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     window_asm_t big, small;
-    window_asm_init(&big, g_storage, ARGIL_WINDOW_SAMPLES_MAX);
+    window_asm_init(&big, g_storage, PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX);
     window_asm_init(&small, g_small, 1000);
 
     /* as received: one frame, then as a stream */

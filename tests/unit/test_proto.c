@@ -40,21 +40,38 @@ static const uint8_t golden_impulse[42] = {
     0x00, 0x00, 0x00, 0x00, 0x00, 0x3b, 0x22, 0x04, 0x00, 0x00, 0x00, 0x00,
     0x00, 0xbf, 0x8b, 0x53, 0x5c, 0x7d,
 };
-static const uint8_t golden_window[81] = {
-    0x41, 0x52, 0x47, 0x4c, 0x01, 0x05, 0x41, 0x00, 0x05, 0x00, 0x00, 0x00,
-    0x08, 0x00, 0x00, 0x00, 0x02, 0x00, 0x03, 0x00, 0x0f, 0x0f, 0x02, 0x00,
-    0x00, 0x80, 0xbd, 0x00, 0x00, 0x00, 0x3e, 0x00, 0x00, 0x80, 0x3e, 0x00,
-    0x00, 0x00, 0x3c, 0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x80, 0x3a, 0x00,
-    0x00, 0x48, 0x43, 0x00, 0x00, 0x20, 0x40, 0x00, 0x00, 0x00, 0x3f, 0x2a,
-    0x00, 0x00, 0x00, 0xc0, 0x01, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x80,
-    0x3e, 0x00, 0x00, 0x40, 0x3f, 0xf1, 0x43, 0xa4, 0x26,
+static const uint8_t golden_window[82] = {
+    0x41, 0x52, 0x47, 0x4c, 0x01, 0x05, 0x42, 0x00, 0x05, 0x00, 0x00, 0x00,
+    0x08, 0x00, 0x00, 0x00, 0x02, 0x00, 0x03, 0x00, 0x0f, 0x0f, 0x02, 0x01,
+    0x00, 0x00, 0x80, 0xbd, 0x00, 0x00, 0x00, 0x3e, 0x00, 0x00, 0x80, 0x3e,
+    0x00, 0x00, 0x00, 0x3c, 0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x80, 0x3a,
+    0x00, 0x00, 0x48, 0x43, 0x00, 0x00, 0x20, 0x40, 0x00, 0x00, 0x00, 0x3f,
+    0x2a, 0x00, 0x00, 0x00, 0xc0, 0x01, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00,
+    0x80, 0x3e, 0x00, 0x00, 0x40, 0x3f, 0x0e, 0x50, 0x15, 0x02,
 };
-static const uint8_t golden_tool[49] = {
-    0x41, 0x52, 0x47, 0x4c, 0x01, 0x06, 0x21, 0x00, 0x06, 0x00, 0x00, 0x00,
-    0x01, 0x00, 0x00, 0x00, 0x3c, 0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x48,
-    0x44, 0x00, 0x00, 0x40, 0x40, 0x00, 0x00, 0x00, 0x40, 0x00, 0x00, 0x00,
-    0x00, 0x00, 0x00, 0x00, 0xbe, 0x00, 0x00, 0x80, 0x3d, 0xca, 0xfe, 0x6c,
-    0xa3,
+static const uint8_t golden_window2[138] = {
+    0x41, 0x52, 0x47, 0x4c, 0x01, 0x05, 0x7a, 0x00, 0x05, 0x00, 0x00, 0x00,
+    0x09, 0x00, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x02, 0x02, 0x02, 0x02,
+    0x00, 0x00, 0x80, 0x3e, 0x00, 0x00, 0x00, 0xbe, 0x00, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x3c, 0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x80, 0x3a,
+    0x00, 0x00, 0x48, 0x43, 0x00, 0x00, 0x20, 0x40, 0x00, 0x00, 0x00, 0x00,
+    0x2b, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x10, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x3e, 0x00, 0x00, 0x80, 0x3e, 0x00, 0x00,
+    0xc0, 0x3e, 0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x20, 0x3f, 0x00, 0x00,
+    0x40, 0x3f, 0x00, 0x00, 0x60, 0x3f, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x48, 0x42, 0x00, 0x00, 0xc8, 0x42, 0x00, 0x00, 0x16, 0x43, 0x00, 0x00,
+    0x48, 0x43, 0x00, 0x00, 0x7a, 0x43, 0x00, 0x00, 0x96, 0x43, 0x00, 0x40,
+    0xaf, 0x43, 0x6e, 0x86, 0x69, 0x4f,
+};
+static const uint8_t golden_tool[88] = {
+    0x41, 0x52, 0x47, 0x4c, 0x01, 0x06, 0x48, 0x00, 0x06, 0x00, 0x00, 0x00,
+    0x01, 0x01, 0x01, 0x01, 0x00, 0x00, 0x00, 0x3c, 0x00, 0x00, 0x80, 0x3c,
+    0x9a, 0x99, 0x19, 0x3f, 0x00, 0x00, 0x00, 0x00, 0xcd, 0xcc, 0x4c, 0x3f,
+    0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x48, 0x44, 0x00, 0x00, 0x40, 0x40,
+    0x00, 0x00, 0xc0, 0x3e, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0x80, 0x3e,
+    0x00, 0x00, 0x00, 0x3e, 0x00, 0x00, 0xc8, 0x43, 0x00, 0x00, 0x00, 0x40,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xbe, 0x00, 0x00, 0x80, 0x3d,
+    0xde, 0x2a, 0xbc, 0xbd,
 };
 static const uint8_t golden_fault[31] = {
     0x41, 0x52, 0x47, 0x4c, 0x01, 0x07, 0x0f, 0x00, 0x07, 0x00, 0x00, 0x00,
@@ -63,9 +80,11 @@ static const uint8_t golden_fault[31] = {
 };
 
 #define WINDOW_SAMPLES_32 (32u * 32u * 32u)
+#define ARRAY_MAX (PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX)
 
-static float g_src[ARGIL_WINDOW_SAMPLES_MAX];
-static float g_dst[ARGIL_WINDOW_SAMPLES_MAX];
+static float g_src[ARRAY_MAX];
+static float g_dst[ARRAY_MAX];
+static size_t g_frame_len; /* length of the frame received_chunk() last sent */
 
 /* ---- helpers ---- */
 
@@ -199,6 +218,7 @@ static void assert_msg_equal(const proto_msg_t *a, const proto_msg_t *b)
         assert_int_equal(x->chunk_index, y->chunk_index);
         assert_int_equal(x->chunk_count, y->chunk_count);
         assert_memory_equal(x->dims, y->dims, 3);
+        assert_int_equal(x->channels, y->channels);
         assert_f32s_equal(x->origin_m, y->origin_m, 3);
         assert_f32s_equal(&x->spacing_m, &y->spacing_m, 1);
         assert_f32s_equal(&x->iso, &y->iso, 1);
@@ -216,10 +236,20 @@ static void assert_msg_equal(const proto_msg_t *a, const proto_msg_t *b)
     case MSG_TOOL: {
         const msg_tool_t *x = &a->u.tool, *y = &b->u.tool;
         assert_int_equal(x->kind, y->kind);
+        assert_int_equal(x->shape, y->shape);
+        assert_int_equal(x->filter, y->filter);
+        assert_int_equal(x->flags, y->flags);
         assert_f32s_equal(&x->radius_m, &y->radius_m, 1);
+        assert_f32s_equal(&x->length_m, &y->length_m, 1);
+        assert_f32s_equal(x->axis, y->axis, 3);
         assert_f32s_equal(&x->alpha, &y->alpha, 1);
         assert_f32s_equal(&x->contact_stiffness_n_per_m, &y->contact_stiffness_n_per_m, 1);
         assert_f32s_equal(&x->max_force_n, &y->max_force_n, 1);
+        assert_f32s_equal(&x->iso, &y->iso, 1);
+        assert_f32s_equal(&x->yield_force_n, &y->yield_force_n, 1);
+        assert_f32s_equal(&x->friction, &y->friction, 1);
+        assert_f32s_equal(&x->probe_gain, &y->probe_gain, 1);
+        assert_f32s_equal(&x->rope_stiffness_n_per_m, &y->rope_stiffness_n_per_m, 1);
         assert_f32s_equal(&x->model_scale, &y->model_scale, 1);
         assert_f32s_equal(x->model_offset_m, y->model_offset_m, 3);
         break;
@@ -295,6 +325,7 @@ static proto_msg_t golden_msg(uint8_t type)
         w->dims[0] = 15;
         w->dims[1] = 15;
         w->dims[2] = 2;
+        w->channels = 1;
         w->origin_m[0] = -0.0625f;
         w->origin_m[1] = 0.125f;
         w->origin_m[2] = 0.25f;
@@ -314,10 +345,22 @@ static proto_msg_t golden_msg(uint8_t type)
     case MSG_TOOL: {
         msg_tool_t *t = &m.u.tool;
         t->kind = TOOL_PUSH;
+        t->shape = TOOL_SHAPE_CURVE;
+        t->filter = BETA_GAUSSIAN;
+        t->flags = TOOL_FLAG_ISO;
         t->radius_m = 0.0078125f;
+        t->length_m = 0.015625f;
+        t->axis[0] = 0.6f;
+        t->axis[1] = 0.0f;
+        t->axis[2] = 0.8f;
         t->alpha = 0.5f;
         t->contact_stiffness_n_per_m = 800.0f;
         t->max_force_n = 3.0f;
+        t->iso = 0.375f;
+        t->yield_force_n = 1.5f;
+        t->friction = 0.25f;
+        t->probe_gain = 0.125f;
+        t->rope_stiffness_n_per_m = 400.0f;
         t->model_scale = 2.0f;
         t->model_offset_m[0] = 0.0f;
         t->model_offset_m[1] = -0.125f;
@@ -336,10 +379,45 @@ static proto_msg_t golden_msg(uint8_t type)
     return m;
 }
 
-/* Encodes golden_msg(type) and asserts the exact golden bytes; decodes the bytes back. */
-static void check_golden(uint8_t type, const uint8_t *gold, size_t gold_len)
+/* The message behind golden_window2: the only chunk of a two-channel 2x2x2 window. */
+static proto_msg_t golden_window2_msg(void)
 {
-    proto_msg_t m = golden_msg(type);
+    proto_msg_t m;
+    memset(&m, 0, sizeof m);
+    m.type = MSG_WINDOW;
+    m.seq = MSG_WINDOW;
+    msg_window_t *w = &m.u.window;
+    w->version = 9;
+    w->chunk_index = 0;
+    w->chunk_count = 1;
+    w->dims[0] = 2;
+    w->dims[1] = 2;
+    w->dims[2] = 2;
+    w->channels = 2;
+    w->origin_m[0] = 0.25f;
+    w->origin_m[1] = -0.125f;
+    w->origin_m[2] = 0.0f;
+    w->spacing_m = 0.0078125f;
+    w->iso = 0.5f;
+    w->node_mass = 0.0009765625f;
+    w->stiffness = 200.0f;
+    w->damping = 2.5f;
+    w->plastic_rate_hz = 0.0f;
+    w->impulse_seq = 43;
+    w->first_sample = 0;
+    w->sample_count = 16;
+    const float stiff[8] = { 0.0f, 50.0f, 100.0f, 150.0f, 200.0f, 250.0f, 300.0f, 350.5f };
+    for (int i = 0; i < 8; i++) {
+        w->samples[i] = 0.125f * (float)i; /* densities */
+        w->samples[8 + i] = stiff[i];      /* then each node's stiffness */
+    }
+    return m;
+}
+
+/* Encodes m and asserts the exact golden bytes; decodes the bytes back to m's fields. */
+static void check_golden_msg(const proto_msg_t *mp, const uint8_t *gold, size_t gold_len)
+{
+    proto_msg_t m = *mp;
     uint8_t f[PROTO_FRAME_MAX];
     size_t len = 0;
     assert_int_equal(proto_encode(&m, m.seq, f, sizeof f, &len), PROTO_OK);
@@ -351,6 +429,13 @@ static void check_golden(uint8_t type, const uint8_t *gold, size_t gold_len)
     assert_int_equal(proto_decode(gold, gold_len, &back, &used), PROTO_OK);
     assert_int_equal(used, gold_len);
     assert_msg_equal(&m, &back);
+}
+
+/* Encodes golden_msg(type) and asserts the exact golden bytes; decodes the bytes back. */
+static void check_golden(uint8_t type, const uint8_t *gold, size_t gold_len)
+{
+    proto_msg_t m = golden_msg(type);
+    check_golden_msg(&m, gold, gold_len);
 }
 
 /* Encodes m and decodes it back; asserts equality and returns the frame length. */
@@ -368,7 +453,7 @@ static size_t round_trip(const proto_msg_t *m)
     return len;
 }
 
-/* A window head (no samples) for dims, with plausible clay. */
+/* A one-channel window head (no samples) for dims, with plausible clay. */
 static msg_window_t window_head(uint32_t version, uint8_t nx, uint8_t ny, uint8_t nz)
 {
     msg_window_t h;
@@ -377,6 +462,7 @@ static msg_window_t window_head(uint32_t version, uint8_t nx, uint8_t ny, uint8_
     h.dims[0] = nx;
     h.dims[1] = ny;
     h.dims[2] = nz;
+    h.channels = 1;
     h.origin_m[0] = -0.02f;
     h.origin_m[1] = 0.01f;
     h.origin_m[2] = 0.3f;
@@ -390,11 +476,14 @@ static msg_window_t window_head(uint32_t version, uint8_t nx, uint8_t ny, uint8_
     return h;
 }
 
-/* Fills g_src with a density ramp that differs at every sample. */
+/* Fills g_src for a window of n nodes: a density ramp that differs at every sample (and dips
+ * below 0: densities need only be finite), then n stiffnesses in 50 … 250 N/m for channel 2. */
 static void fill_source(uint32_t n)
 {
-    for (uint32_t i = 0; i < n; i++)
+    for (uint32_t i = 0; i < n; i++) {
         g_src[i] = (float)i / (float)n + 0.25f * sinf((float)i * 0.01f);
+        g_src[n + i] = 150.0f + 100.0f * cosf((float)i * 0.003f);
+    }
 }
 
 /* Chunk index of a window via encode + decode, as the board would receive it. */
@@ -409,6 +498,7 @@ static msg_window_t received_chunk(const msg_window_t *head, uint16_t index)
     size_t len = 0, used = 0;
     assert_int_equal(proto_encode(&m, m.seq, f, sizeof f, &len), PROTO_OK);
     assert_true(len <= 1024u);
+    g_frame_len = len;
     assert_int_equal(proto_decode(f, len, &back, &used), PROTO_OK);
     return back.u.window;
 }
@@ -416,7 +506,7 @@ static msg_window_t received_chunk(const msg_window_t *head, uint16_t index)
 /* Feeds every chunk of head except skip (pass chunk_count to skip none). */
 static void feed_all_but(window_asm_t *a, const msg_window_t *head, uint16_t skip)
 {
-    uint16_t n = window_chunk_count(head->dims);
+    uint16_t n = window_chunk_count(head->dims, head->channels);
     for (uint16_t i = 0; i < n; i++) {
         if (i == skip)
             continue;
@@ -468,6 +558,13 @@ static void test_golden_window_last_chunk_frame_matches_the_spec(void **state)
 {
     (void)state;
     check_golden(MSG_WINDOW, golden_window, sizeof golden_window);
+}
+
+static void test_golden_two_channel_window_frame_matches_the_spec(void **state)
+{
+    (void)state;
+    proto_msg_t m = golden_window2_msg();
+    check_golden_msg(&m, golden_window2, sizeof golden_window2);
 }
 
 static void test_golden_tool_frame_matches_the_spec(void **state)
@@ -526,13 +623,39 @@ static void test_every_message_type_survives_a_round_trip_at_its_extremes(void *
     m.u.window.plastic_rate_hz = 0.0f;
     for (uint32_t i = 0; i < PROTO_WINDOW_CHUNK_SAMPLES; i++)
         m.u.window.samples[i] = (float)i / 224.0f - 0.5f;
-    assert_int_equal(round_trip(&m), 12u + 57u + 4u * PROTO_WINDOW_CHUNK_SAMPLES + 4u);
+    assert_int_equal(round_trip(&m), 12u + 58u + 4u * PROTO_WINDOW_CHUNK_SAMPLES + 4u);
+    /* two channels: chunk 2 of 15x15x2 (900 samples) holds stiffnesses only */
+    m.u.window.channels = 2;
+    m.u.window.chunk_count = 5;
+    for (uint32_t i = 0; i < PROTO_WINDOW_CHUNK_SAMPLES; i++)
+        m.u.window.samples[i] = (float)i * 10.0f;
+    m.u.window.samples[7] = -0.0f; /* >= 0 */
+    assert_int_equal(round_trip(&m), 12u + 58u + 4u * PROTO_WINDOW_CHUNK_SAMPLES + 4u);
+    m = golden_window2_msg();
+    assert_int_equal(round_trip(&m), 12u + 58u + 4u * 16u + 4u);
 
     m = golden_msg(MSG_TOOL);
-    m.u.tool.kind = TOOL_CARVE;
-    m.u.tool.alpha = -1.0f;
+    m.u.tool.kind = TOOL_ROPE;
+    m.u.tool.shape = TOOL_SHAPE_AREA;
+    m.u.tool.filter = BETA_CONICAL;
+    m.u.tool.flags = 0;
+    m.u.tool.length_m = 0.0f;
+    m.u.tool.axis[0] = -1.0f;
+    m.u.tool.axis[2] = 0.0f;
+    m.u.tool.alpha = 0.0f;
     m.u.tool.contact_stiffness_n_per_m = 0.0f;
-    assert_int_equal(round_trip(&m), 12u + 33u + 4u);
+    m.u.tool.iso = 1.0f;
+    m.u.tool.yield_force_n = 0.0f;
+    m.u.tool.friction = 0.0f;
+    m.u.tool.probe_gain = 0.0f;
+    m.u.tool.rope_stiffness_n_per_m = 3.4e38f;
+    m.u.tool.model_offset_m[0] = -0.0f;
+    assert_int_equal(round_trip(&m), 12u + 72u + 4u);
+    m.u.tool.kind = TOOL_PROBE;
+    m.u.tool.shape = TOOL_SHAPE_POINT;
+    m.u.tool.filter = BETA_CONSTANT;
+    m.u.tool.iso = 0.0f;
+    assert_int_equal(round_trip(&m), 12u + 72u + 4u);
 
     m = golden_msg(MSG_FAULT);
     m.u.fault.code = 0xFFFF;
@@ -674,7 +797,7 @@ static void test_payload_length_that_does_not_fit_the_type_is_refused(void **sta
                      PROTO_ERR_PAYLOAD);
     /* WINDOW: shorter than its fixed part, or samples not matching sample_count */
     uint16_t wp = (uint16_t)(sizeof golden_window - 16u);
-    assert_int_equal(decode_resized(golden_window, sizeof golden_window, 56), PROTO_ERR_PAYLOAD);
+    assert_int_equal(decode_resized(golden_window, sizeof golden_window, 57), PROTO_ERR_PAYLOAD);
     assert_int_equal(decode_resized(golden_window, sizeof golden_window, wp + 4u),
                      PROTO_ERR_PAYLOAD);
     assert_int_equal(decode_resized(golden_window, sizeof golden_window, wp - 4u),
@@ -696,12 +819,16 @@ static void test_non_finite_floats_are_refused_in_every_message(void **state)
                          PROTO_ERR_VALUE);
         assert_int_equal(decode_patched_f32(golden_impulse, sizeof golden_impulse, 34, v),
                          PROTO_ERR_VALUE);
-        for (size_t at = 23; at < 59; at += 4) /* origin, spacing, iso, material */
+        for (size_t at = 24; at < 60; at += 4) /* origin, spacing, iso, material */
             assert_int_equal(decode_patched_f32(golden_window, sizeof golden_window, at, v),
                              PROTO_ERR_VALUE);
-        assert_int_equal(decode_patched_f32(golden_window, sizeof golden_window, 73, v),
+        assert_int_equal(decode_patched_f32(golden_window, sizeof golden_window, 74, v),
                          PROTO_ERR_VALUE); /* a sample */
-        for (size_t at = 13; at < 45; at += 4) /* every tool float */
+        assert_int_equal(decode_patched_f32(golden_window2, sizeof golden_window2, 70, v),
+                         PROTO_ERR_VALUE); /* a density of a two-channel window */
+        assert_int_equal(decode_patched_f32(golden_window2, sizeof golden_window2, 102, v),
+                         PROTO_ERR_VALUE); /* a stiffness */
+        for (size_t at = 16; at < 84; at += 4) /* every tool float */
             assert_int_equal(decode_patched_f32(golden_tool, sizeof golden_tool, at, v),
                              PROTO_ERR_VALUE);
     }
@@ -729,9 +856,9 @@ static void test_out_of_range_fields_are_refused(void **state)
                      PROTO_ERR_VALUE);
     /* WINDOW: spacing <= 0, dims 0, 1 or above ARGIL_WINDOW_MAX, massless or negative clay */
     const size_t W = sizeof golden_window;
-    assert_int_equal(decode_patched_f32(golden_window, W, 35, 0.0f), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_f32(golden_window, W, 35, -0.0f), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_f32(golden_window, W, 35, -0.001f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 36, 0.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 36, -0.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 36, -0.001f), PROTO_ERR_VALUE);
     for (size_t axis = 0; axis < 3; axis++) {
         assert_int_equal(decode_patched_u8(golden_window, W, 20 + axis, 0), PROTO_ERR_VALUE);
         assert_int_equal(decode_patched_u8(golden_window, W, 20 + axis, 1), PROTO_ERR_VALUE);
@@ -739,25 +866,12 @@ static void test_out_of_range_fields_are_refused(void **state)
                          PROTO_ERR_VALUE);
         assert_int_equal(decode_patched_u8(golden_window, W, 20 + axis, 0xFF), PROTO_ERR_VALUE);
     }
-    assert_int_equal(decode_patched_f32(golden_window, W, 43, 0.0f), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_f32(golden_window, W, 47, -1.0f), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_f32(golden_window, W, 51, -1.0f), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_f32(golden_window, W, 55, -1.0f), PROTO_ERR_VALUE);
-    /* TOOL: unknown kind, radius / max force / scale <= 0, negative contact stiffness */
-    const size_t T = sizeof golden_tool;
-    assert_int_equal(decode_patched_u8(golden_tool, T, 12, TOOL_KIND_COUNT), PROTO_ERR_VALUE);
-    assert_int_equal(decode_patched_u8(golden_tool, T, 12, 0xFF), PROTO_ERR_VALUE);
-    const size_t positive[] = { 13, 25, 29 };
-    for (size_t i = 0; i < 3; i++) {
-        assert_int_equal(decode_patched_f32(golden_tool, T, positive[i], 0.0f), PROTO_ERR_VALUE);
-        assert_int_equal(decode_patched_f32(golden_tool, T, positive[i], -2.0f),
-                         PROTO_ERR_VALUE);
-    }
-    assert_int_equal(decode_patched_f32(golden_tool, T, 21, -1.0f), PROTO_ERR_VALUE);
-    /* accepted edge values stay accepted */
+    assert_int_equal(decode_patched_f32(golden_window, W, 44, 0.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 48, -1.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 52, -1.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_f32(golden_window, W, 56, -1.0f), PROTO_ERR_VALUE);
+    /* accepted edge values stay accepted (TOOL: test_every_tool_rule_is_enforced_...) */
     assert_int_equal(decode_patched_u8(golden_window, W, 20, ARGIL_WINDOW_MAX), PROTO_ERR_CHUNK);
-    assert_int_equal(decode_patched_u8(golden_tool, T, 12, TOOL_CARVE), PROTO_OK);
-    assert_int_equal(decode_patched_f32(golden_tool, T, 17, -3.0f), PROTO_OK); /* alpha */
 }
 
 static void test_window_chunk_numbering_that_contradicts_itself_is_refused(void **state)
@@ -770,8 +884,10 @@ static void test_window_chunk_numbering_that_contradicts_itself_is_refused(void 
     assert_int_equal(decode_patched_u16(golden_window, W, 18, 4), PROTO_ERR_CHUNK);
     assert_int_equal(decode_patched_u16(golden_window, W, 18, 2), PROTO_ERR_CHUNK);
     assert_int_equal(decode_patched_u16(golden_window, W, 18, 0), PROTO_ERR_CHUNK);
-    assert_int_equal(decode_patched_u32(golden_window, W, 63, 447), PROTO_ERR_CHUNK);
-    assert_int_equal(decode_patched_u32(golden_window, W, 63, 0), PROTO_ERR_CHUNK);
+    assert_int_equal(decode_patched_u32(golden_window, W, 64, 447), PROTO_ERR_CHUNK);
+    assert_int_equal(decode_patched_u32(golden_window, W, 64, 0), PROTO_ERR_CHUNK);
+    /* the same frame claiming two channels: 900 samples make 5 chunks, not 3 */
+    assert_int_equal(decode_patched_u8(golden_window, W, 23, 2), PROTO_ERR_CHUNK);
     /* chunk 1 claiming the samples of chunk 2 */
     uint8_t f[PROTO_FRAME_MAX];
     memcpy(f, golden_window, W);
@@ -782,26 +898,26 @@ static void test_window_chunk_numbering_that_contradicts_itself_is_refused(void 
     /* sample_count wrong for its chunk, with a payload length that matches it */
     memset(f, 0, sizeof f);
     memcpy(f, golden_window, W - 4u);
-    put_u16(f + 67, 3);
-    size_t flen = reseal(f, (uint16_t)(57u + 3u * 4u));
+    put_u16(f + 68, 3);
+    size_t flen = reseal(f, (uint16_t)(58u + 3u * 4u));
     assert_int_equal(decode_err(f, flen), PROTO_ERR_CHUNK);
-    put_u16(f + 67, 1);
-    flen = reseal(f, (uint16_t)(57u + 1u * 4u));
+    put_u16(f + 68, 1);
+    flen = reseal(f, (uint16_t)(58u + 1u * 4u));
     assert_int_equal(decode_err(f, flen), PROTO_ERR_CHUNK);
-    put_u16(f + 67, 0);
-    flen = reseal(f, 57u);
+    put_u16(f + 68, 0);
+    flen = reseal(f, 58u);
     assert_int_equal(decode_err(f, flen), PROTO_ERR_CHUNK);
     /* chunk 0 of the same window must hold 224 samples, not 223 and not 225 */
     put_u16(f + 16, 0);
-    put_u32(f + 63, 0);
-    put_u16(f + 67, 223);
-    flen = reseal(f, (uint16_t)(57u + 223u * 4u));
+    put_u32(f + 64, 0);
+    put_u16(f + 68, 223);
+    flen = reseal(f, (uint16_t)(58u + 223u * 4u));
     assert_int_equal(decode_err(f, flen), PROTO_ERR_CHUNK);
-    put_u16(f + 67, 225);
-    flen = reseal(f, (uint16_t)(57u + 225u * 4u));
+    put_u16(f + 68, 225);
+    flen = reseal(f, (uint16_t)(58u + 225u * 4u));
     assert_int_equal(decode_err(f, flen), PROTO_ERR_CHUNK);
-    put_u16(f + 67, 224);
-    flen = reseal(f, (uint16_t)(57u + 224u * 4u));
+    put_u16(f + 68, 224);
+    flen = reseal(f, (uint16_t)(58u + 224u * 4u));
     assert_int_equal(decode_err(f, flen), PROTO_OK);
 }
 
@@ -877,6 +993,15 @@ static void test_encoder_refuses_what_the_decoder_would_refuse(void **state)
     m.u.window.samples[1] = NAN;
     assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
     m = golden_msg(MSG_WINDOW);
+    m.u.window.channels = 0;
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    m = golden_window2_msg();
+    m.u.window.samples[9] = -50.0f;
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    m = golden_msg(MSG_WINDOW);
+    m.u.window.channels = 2;
+    assert_int_equal(encode_err(&m), PROTO_ERR_CHUNK);
+    m = golden_msg(MSG_WINDOW);
     m.u.window.chunk_index = 3;
     assert_int_equal(encode_err(&m), PROTO_ERR_CHUNK);
     m = golden_msg(MSG_WINDOW);
@@ -901,6 +1026,141 @@ static void test_encoder_refuses_what_the_decoder_would_refuse(void **state)
     m = golden_msg(MSG_TOOL);
     m.u.tool.model_offset_m[2] = -INFINITY;
     assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    m = golden_msg(MSG_TOOL);
+    m.u.tool.axis[1] = NAN;
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+}
+
+/* ---- TOOL rules ---- */
+
+/* The float of t at frame offset at of a TOOL frame (docs/protocol.md: payload offset + 12). */
+static float *tool_float(msg_tool_t *t, size_t at)
+{
+    switch (at) {
+    case 16: return &t->radius_m;
+    case 20: return &t->length_m;
+    case 24: return &t->axis[0];
+    case 28: return &t->axis[1];
+    case 32: return &t->axis[2];
+    case 36: return &t->alpha;
+    case 40: return &t->contact_stiffness_n_per_m;
+    case 44: return &t->max_force_n;
+    case 48: return &t->iso;
+    case 52: return &t->yield_force_n;
+    case 56: return &t->friction;
+    case 60: return &t->probe_gain;
+    case 64: return &t->rope_stiffness_n_per_m;
+    case 68: return &t->model_scale;
+    case 72: return &t->model_offset_m[0];
+    case 76: return &t->model_offset_m[1];
+    case 80: return &t->model_offset_m[2];
+    default: fail_msg("no tool float at %zu", at);
+    }
+    return NULL;
+}
+
+/* Verdicts of the decoder on the golden TOOL frame with the float at `at` set to v, and of
+ * the encoder on the golden tool with the same field set; asserts both are want. */
+static void check_tool_float(size_t at, float v, proto_err_t want)
+{
+    assert_int_equal(decode_patched_f32(golden_tool, sizeof golden_tool, at, v), want);
+    proto_msg_t m = golden_msg(MSG_TOOL);
+    *tool_float(&m.u.tool, at) = v;
+    assert_int_equal(encode_err(&m), want);
+}
+
+/* The same for the byte at `at` (kind 12, shape 13, filter 14, flags 15). */
+static void check_tool_byte(size_t at, uint8_t v, proto_err_t want)
+{
+    assert_int_equal(decode_patched_u8(golden_tool, sizeof golden_tool, at, v), want);
+    proto_msg_t m = golden_msg(MSG_TOOL);
+    uint8_t *field[4] = { &m.u.tool.kind, &m.u.tool.shape, &m.u.tool.filter, &m.u.tool.flags };
+    *field[at - 12u] = v;
+    assert_int_equal(encode_err(&m), want);
+}
+
+/* The same for the whole axis. */
+static void check_tool_axis(float x, float y, float z, proto_err_t want)
+{
+    uint8_t f[sizeof golden_tool];
+    memcpy(f, golden_tool, sizeof f);
+    put_f32(f + 24, x);
+    put_f32(f + 28, y);
+    put_f32(f + 32, z);
+    reseal(f, (uint16_t)(sizeof f - PROTO_HEADER_SIZE - PROTO_CRC_SIZE));
+    assert_int_equal(decode_err(f, sizeof f), want);
+    proto_msg_t m = golden_msg(MSG_TOOL);
+    m.u.tool.axis[0] = x;
+    m.u.tool.axis[1] = y;
+    m.u.tool.axis[2] = z;
+    assert_int_equal(encode_err(&m), want);
+}
+
+static void test_every_tool_rule_is_enforced_by_decoder_and_encoder(void **state)
+{
+    (void)state;
+    const proto_err_t V = PROTO_ERR_VALUE;
+    /* enumerations: kind < 6, shape < 3, filter < 5; flags: only TOOL_FLAG_ISO */
+    check_tool_byte(12, TOOL_KIND_COUNT, V);
+    check_tool_byte(12, 0xFF, V);
+    check_tool_byte(13, TOOL_SHAPE_COUNT, V);
+    check_tool_byte(13, 0xFF, V);
+    check_tool_byte(14, BETA_FILTER_COUNT, V);
+    check_tool_byte(14, 0xFF, V);
+    for (unsigned bit = 1; bit < 8; bit++) {
+        check_tool_byte(15, (uint8_t)(1u << bit), V);
+        check_tool_byte(15, (uint8_t)(TOOL_FLAG_ISO | (1u << bit)), V);
+    }
+    check_tool_byte(12, TOOL_ROPE, PROTO_OK);
+    check_tool_byte(12, TOOL_PROBE, PROTO_OK);
+    check_tool_byte(12, TOOL_TOUCH, PROTO_OK);
+    check_tool_byte(13, TOOL_SHAPE_AREA, PROTO_OK);
+    check_tool_byte(13, TOOL_SHAPE_POINT, PROTO_OK);
+    check_tool_byte(14, BETA_CONICAL, PROTO_OK);
+    check_tool_byte(14, BETA_CONSTANT, PROTO_OK);
+    check_tool_byte(15, 0, PROTO_OK);
+
+    /* > 0: radius, max force, model scale */
+    const size_t positive[] = { 16, 44, 68 };
+    for (size_t i = 0; i < 3; i++) {
+        check_tool_float(positive[i], 0.0f, V);
+        check_tool_float(positive[i], -0.0f, V);
+        check_tool_float(positive[i], -2.0f, V);
+        check_tool_float(positive[i], 1e-30f, PROTO_OK);
+    }
+    /* >= 0: length, alpha, contact stiffness, yield, friction, probe gain, rope stiffness */
+    const size_t nonneg[] = { 20, 36, 40, 52, 56, 60, 64 };
+    for (size_t i = 0; i < sizeof nonneg / sizeof nonneg[0]; i++) {
+        check_tool_float(nonneg[i], -1e-6f, V);
+        check_tool_float(nonneg[i], -1.0f, V);
+        check_tool_float(nonneg[i], 0.0f, PROTO_OK);
+        check_tool_float(nonneg[i], 3.4e38f, PROTO_OK);
+    }
+    /* iso in 0 … 1 */
+    check_tool_float(48, -0.001f, V);
+    check_tool_float(48, 1.001f, V);
+    check_tool_float(48, 2.0f, V);
+    check_tool_float(48, 0.0f, PROTO_OK);
+    check_tool_float(48, 1.0f, PROTO_OK);
+    /* the model offset may be anything finite */
+    check_tool_float(76, -1000.0f, PROTO_OK);
+    /* every float must be finite */
+    for (size_t at = 16; at < 84; at += 4) {
+        check_tool_float(at, NAN, V);
+        check_tool_float(at, INFINITY, V);
+        check_tool_float(at, -INFINITY, V);
+    }
+    /* the axis is a unit vector within 1e-3 */
+    check_tool_axis(0.0f, 0.0f, 0.0f, V);
+    check_tool_axis(0.0f, 0.0f, 1.0011f, V);
+    check_tool_axis(0.0f, 0.0f, 0.9989f, V);
+    check_tool_axis(1.0f, 1.0f, 0.0f, V);
+    check_tool_axis(0.6f, 0.0f, 0.0f, V);
+    check_tool_axis(3e38f, 3e38f, 0.0f, V); /* |a|^2 overflows */
+    check_tool_axis(0.0f, 0.0f, 1.0009f, PROTO_OK);
+    check_tool_axis(0.0f, 0.0f, 0.9991f, PROTO_OK);
+    check_tool_axis(0.0f, -1.0f, 0.0f, PROTO_OK);
+    check_tool_axis(0.577f, -0.577f, 0.5775f, PROTO_OK);
 }
 
 static void test_every_error_has_its_own_readable_name(void **state)
@@ -921,6 +1181,112 @@ static void test_every_error_has_its_own_readable_name(void **state)
     assert_string_equal(proto_strerror((proto_err_t)-99), "unknown error");
 }
 
+/* ---- WINDOW channels and per-node stiffness ---- */
+
+static void test_window_channels_other_than_1_or_2_are_refused(void **state)
+{
+    (void)state;
+    const uint8_t bad[] = { 0, 3, 0xFF };
+    for (size_t i = 0; i < sizeof bad; i++) {
+        /* decoder: the channels byte (frame offset 23) of both golden windows */
+        assert_int_equal(decode_patched_u8(golden_window, sizeof golden_window, 23, bad[i]),
+                         PROTO_ERR_VALUE);
+        assert_int_equal(decode_patched_u8(golden_window2, sizeof golden_window2, 23, bad[i]),
+                         PROTO_ERR_VALUE);
+        /* encoder, counting, cutting, assembling */
+        proto_msg_t m = golden_msg(MSG_WINDOW);
+        m.u.window.channels = bad[i];
+        assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+        assert_int_equal(window_chunk_count(m.u.window.dims, bad[i]), 0);
+        msg_window_t head = window_head(1, 4, 4, 4), c;
+        head.channels = bad[i];
+        fill_source(64);
+        assert_int_equal(window_chunk_fill(&head, g_src, 0, &c), PROTO_ERR_VALUE);
+        window_asm_t a;
+        window_asm_init(&a, g_dst, ARRAY_MAX);
+        m = golden_msg(MSG_WINDOW);
+        m.u.window.channels = bad[i];
+        assert_int_equal(window_asm_feed(&a, &m.u.window), PROTO_ERR_VALUE);
+        assert_false(a.started);
+    }
+    assert_int_equal(decode_patched_u8(golden_window2, sizeof golden_window2, 23, 2), PROTO_OK);
+}
+
+/* Frame of chunk index of head (samples from g_src) with array element `element` set to v,
+ * resealed; returns its decoder verdict. */
+static proto_err_t decode_chunk_with(const msg_window_t *head, uint16_t index, uint32_t element,
+                                     float v)
+{
+    proto_msg_t m;
+    memset(&m, 0, sizeof m);
+    m.type = MSG_WINDOW;
+    assert_int_equal(window_chunk_fill(head, g_src, index, &m.u.window), PROTO_OK);
+    uint8_t f[PROTO_FRAME_MAX];
+    size_t len = 0;
+    assert_int_equal(proto_encode(&m, 1, f, sizeof f, &len), PROTO_OK);
+    uint32_t k = element - m.u.window.first_sample;
+    assert_true(k < m.u.window.sample_count);
+    put_f32(f + PROTO_HEADER_SIZE + 58u + 4u * k, v);
+    reseal(f, (uint16_t)(len - PROTO_HEADER_SIZE - PROTO_CRC_SIZE));
+    return decode_err(f, len);
+}
+
+static void test_negative_or_non_finite_node_stiffness_is_refused(void **state)
+{
+    (void)state;
+    const size_t W2 = sizeof golden_window2;
+    /* golden 2x2x2 two-channel chunk: samples 0…7 densities (frame offset 70…98), 8…15
+     * stiffnesses (102…130) */
+    for (size_t k = 0; k < 8; k++) {
+        size_t dens = 70u + 4u * k, stiff = 102u + 4u * k;
+        assert_int_equal(decode_patched_f32(golden_window2, W2, stiff, -1.0f), PROTO_ERR_VALUE);
+        assert_int_equal(decode_patched_f32(golden_window2, W2, stiff, -1e-30f),
+                         PROTO_ERR_VALUE);
+        assert_int_equal(decode_patched_f32(golden_window2, W2, stiff, NAN), PROTO_ERR_VALUE);
+        assert_int_equal(decode_patched_f32(golden_window2, W2, stiff, -INFINITY),
+                         PROTO_ERR_VALUE);
+        assert_int_equal(decode_patched_f32(golden_window2, W2, stiff, 0.0f), PROTO_OK);
+        /* a density only needs to be finite */
+        assert_int_equal(decode_patched_f32(golden_window2, W2, dens, -1.0f), PROTO_OK);
+        assert_int_equal(decode_patched_f32(golden_window2, W2, dens, NAN), PROTO_ERR_VALUE);
+    }
+    /* a one-channel window has densities only: a negative sample is fine */
+    assert_int_equal(decode_patched_f32(golden_window, sizeof golden_window, 74, -1.0f),
+                     PROTO_OK);
+
+    /* 10x10x3 two channels (N = 300, 600 samples): chunk 1 holds elements 224…447, the
+     * densities up to 299 and the stiffnesses from 300 on */
+    msg_window_t head = window_head(3, 10, 10, 3);
+    head.channels = 2;
+    fill_source(300);
+    assert_int_equal(decode_chunk_with(&head, 1, 299, -1.0f), PROTO_OK);
+    assert_int_equal(decode_chunk_with(&head, 1, 300, -1.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_chunk_with(&head, 1, 447, -1.0f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_chunk_with(&head, 1, 300, NAN), PROTO_ERR_VALUE);
+    assert_int_equal(decode_chunk_with(&head, 0, 0, -1.0f), PROTO_OK);
+    assert_int_equal(decode_chunk_with(&head, 2, 599, -0.5f), PROTO_ERR_VALUE);
+    assert_int_equal(decode_chunk_with(&head, 2, 599, 0.0f), PROTO_OK);
+
+    /* the encoder and the assembly refuse it too, and the assembly does not start */
+    g_src[300] = -1.0f;
+    proto_msg_t m;
+    memset(&m, 0, sizeof m);
+    m.type = MSG_WINDOW;
+    assert_int_equal(window_chunk_fill(&head, g_src, 1, &m.u.window), PROTO_OK);
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    window_asm_t a;
+    window_asm_init(&a, g_dst, ARRAY_MAX);
+    assert_int_equal(window_asm_feed(&a, &m.u.window), PROTO_ERR_VALUE);
+    assert_false(a.started);
+    g_src[300] = NAN;
+    assert_int_equal(window_chunk_fill(&head, g_src, 1, &m.u.window), PROTO_OK);
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    g_src[300] = 0.0f;
+    g_src[299] = -5.0f;
+    assert_int_equal(window_chunk_fill(&head, g_src, 1, &m.u.window), PROTO_OK);
+    assert_int_equal(encode_err(&m), PROTO_OK);
+}
+
 /* ---- window chunking and reassembly ---- */
 
 static void test_chunk_count_follows_the_window_size(void **state)
@@ -928,13 +1294,17 @@ static void test_chunk_count_follows_the_window_size(void **state)
     (void)state;
     const uint8_t full[3] = { 32, 32, 32 }, tiny[3] = { 2, 2, 2 }, gold[3] = { 15, 15, 2 };
     const uint8_t exact[3] = { 14, 16, 2 }, flat[3] = { 1, 32, 32 }, big[3] = { 33, 2, 2 };
-    assert_int_equal(window_chunk_count(full), 147);
-    assert_int_equal(window_chunk_count(full), PROTO_WINDOW_CHUNKS_MAX);
-    assert_int_equal(window_chunk_count(tiny), 1);
-    assert_int_equal(window_chunk_count(gold), 3);
-    assert_int_equal(window_chunk_count(exact), 2); /* 448 samples: two full chunks */
-    assert_int_equal(window_chunk_count(flat), 0);
-    assert_int_equal(window_chunk_count(big), 0);
+    assert_int_equal(window_chunk_count(full, 1), 147);
+    assert_int_equal(window_chunk_count(full, 2), 293); /* 65536 samples */
+    assert_int_equal(window_chunk_count(full, 2), PROTO_WINDOW_CHUNKS_MAX);
+    assert_int_equal(window_chunk_count(tiny, 1), 1);
+    assert_int_equal(window_chunk_count(tiny, 2), 1);
+    assert_int_equal(window_chunk_count(gold, 1), 3);
+    assert_int_equal(window_chunk_count(gold, 2), 5); /* 900 samples */
+    assert_int_equal(window_chunk_count(exact, 1), 2); /* 448 samples: two full chunks */
+    assert_int_equal(window_chunk_count(exact, 2), 4);
+    assert_int_equal(window_chunk_count(flat, 1), 0);
+    assert_int_equal(window_chunk_count(big, 2), 0);
 
     msg_window_t head = window_head(1, 15, 15, 2), c;
     fill_source(450);
@@ -942,29 +1312,48 @@ static void test_chunk_count_follows_the_window_size(void **state)
     assert_int_equal(c.first_sample, 448);
     assert_int_equal(c.sample_count, 2);
     assert_int_equal(c.chunk_count, 3);
+    assert_int_equal(c.channels, 1);
     assert_f32s_equal(c.samples, g_src + 448, 2);
     assert_int_equal(window_chunk_fill(&head, g_src, 3, &c), PROTO_ERR_VALUE);
+    /* two channels: the array is 450 densities then 450 stiffnesses */
+    head.channels = 2;
+    assert_int_equal(window_chunk_fill(&head, g_src, 2, &c), PROTO_OK);
+    assert_int_equal(c.sample_count, 224);
+    assert_int_equal(c.chunk_count, 5);
+    assert_int_equal(c.channels, 2);
+    assert_f32s_equal(c.samples, g_src + 448, 224); /* 2 densities, then 222 stiffnesses */
+    assert_int_equal(window_chunk_fill(&head, g_src, 4, &c), PROTO_OK);
+    assert_int_equal(c.first_sample, 896);
+    assert_int_equal(c.sample_count, 4);
+    assert_f32s_equal(c.samples, g_src + 896, 4);
+    assert_int_equal(window_chunk_fill(&head, g_src, 5, &c), PROTO_ERR_VALUE);
     head.dims[0] = 0;
     assert_int_equal(window_chunk_fill(&head, g_src, 0, &c), PROTO_ERR_VALUE);
 }
 
-static void test_full_window_arrives_in_any_order_with_duplicates_and_is_exact(void **state)
+/* Sends a channels-channel 32^3 window as frames, each chunk once in a shuffled order (fixed
+ * LCG) plus repeats, and asserts every frame fits in 1 KiB and the assembly is exact. */
+static void check_full_window(uint8_t channels, uint16_t want_chunks)
 {
-    (void)state;
     msg_window_t head = window_head(7, 32, 32, 32);
+    head.channels = channels;
     fill_source(WINDOW_SAMPLES_32);
-    uint16_t n = window_chunk_count(head.dims);
-    assert_int_equal(n, 147);
+    const uint32_t total = channels * WINDOW_SAMPLES_32;
+    uint16_t n = window_chunk_count(head.dims, head.channels);
+    assert_int_equal(n, want_chunks);
 
-    /* every chunk as a frame fits in 1 KiB */
-    static msg_window_t chunks[147];
+    static msg_window_t chunks[PROTO_WINDOW_CHUNKS_MAX];
     for (uint16_t i = 0; i < n; i++) {
         chunks[i] = received_chunk(&head, i);
         assert_int_equal(chunks[i].chunk_index, i);
+        assert_true(g_frame_len <= PROTO_FRAME_MAX);
+        if (i + 1u < n)
+            assert_int_equal(g_frame_len, 12u + 58u + 4u * 224u + 4u); /* 970 */
     }
+    /* the last chunk holds what is left of the array */
+    assert_int_equal(chunks[n - 1u].sample_count, total - (n - 1u) * 224u);
 
-    /* a shuffled order (fixed LCG), each chunk sent once plus every 5th chunk sent again */
-    uint16_t order[147];
+    uint16_t order[PROTO_WINDOW_CHUNKS_MAX];
     for (uint16_t i = 0; i < n; i++)
         order[i] = i;
     uint32_t seed = 12345u;
@@ -978,7 +1367,7 @@ static void test_full_window_arrives_in_any_order_with_duplicates_and_is_exact(v
 
     window_asm_t a;
     memset(g_dst, 0, sizeof g_dst);
-    window_asm_init(&a, g_dst, ARGIL_WINDOW_SAMPLES_MAX);
+    window_asm_init(&a, g_dst, ARRAY_MAX);
     assert_false(window_asm_complete(&a));
     for (uint16_t k = 0; k < n; k++) {
         assert_false(window_asm_complete(&a));
@@ -991,13 +1380,29 @@ static void test_full_window_arrives_in_any_order_with_duplicates_and_is_exact(v
     }
     assert_true(window_asm_complete(&a));
     assert_int_equal(a.version, 7);
-    assert_f32s_equal(g_dst, g_src, WINDOW_SAMPLES_32);
+    assert_f32s_equal(g_dst, g_src, total);
     assert_memory_equal(a.head.dims, head.dims, 3);
+    assert_int_equal(a.head.channels, channels);
     assert_int_equal(a.head.impulse_seq, head.impulse_seq);
     /* late duplicates keep it complete and unchanged */
     assert_int_equal(window_asm_feed(&a, &chunks[100]), PROTO_OK);
     assert_true(window_asm_complete(&a));
-    assert_f32s_equal(g_dst, g_src, WINDOW_SAMPLES_32);
+    assert_f32s_equal(g_dst, g_src, total);
+}
+
+static void test_full_window_arrives_in_any_order_with_duplicates_and_is_exact(void **state)
+{
+    (void)state;
+    check_full_window(1, 147);
+}
+
+static void test_full_two_channel_window_arrives_in_any_order_and_is_exact(void **state)
+{
+    (void)state;
+    check_full_window(2, 293);
+    /* node i's stiffness is array element N + i: chunk 146 holds both channels */
+    assert_f32s_equal(g_dst + WINDOW_SAMPLES_32, g_src + WINDOW_SAMPLES_32, WINDOW_SAMPLES_32);
+    assert_true(g_dst[WINDOW_SAMPLES_32] >= 50.0f && g_dst[2u * WINDOW_SAMPLES_32 - 1u] <= 250.0f);
 }
 
 static void test_window_is_complete_only_when_the_last_missing_chunk_arrives(void **state)
@@ -1028,7 +1433,8 @@ static void check_sibling_refused(const msg_window_t *sibling_head)
     window_asm_t a;
     window_asm_init(&a, g_dst, ARGIL_WINDOW_SAMPLES_MAX);
     feed_all_but(&a, &head, 4);
-    uint16_t idx = (uint16_t)(window_chunk_count(sibling_head->dims) - 1u);
+    uint16_t idx =
+        (uint16_t)(window_chunk_count(sibling_head->dims, sibling_head->channels) - 1u);
     msg_window_t odd = received_chunk(sibling_head, idx);
     assert_int_equal(window_asm_feed(&a, &odd), PROTO_ERR_CHUNK);
     assert_false(window_asm_complete(&a));
@@ -1079,6 +1485,38 @@ static void test_sibling_chunk_describing_another_window_spoils_that_version(voi
     s = window_head(11, 15, 15, 4);
     s.impulse_seq = 100;
     check_sibling_refused(&s);
+}
+
+static void test_sibling_chunk_with_other_channels_spoils_that_version(void **state)
+{
+    (void)state;
+    /* 15x15x4 with two channels: 1800 samples, 9 chunks instead of 5 */
+    msg_window_t s = window_head(11, 15, 15, 4);
+    s.channels = 2;
+    check_sibling_refused(&s);
+    /* 4x4x4 (64 nodes) is one chunk with either channel count: only channels differ */
+    msg_window_t one = window_head(20, 4, 4, 4), two = window_head(20, 4, 4, 4);
+    two.channels = 2;
+    assert_int_equal(window_chunk_count(one.dims, 1), window_chunk_count(two.dims, 2));
+    fill_source(64);
+    window_asm_t a;
+    window_asm_init(&a, g_dst, ARRAY_MAX);
+    msg_window_t c = received_chunk(&one, 0);
+    assert_int_equal(window_asm_feed(&a, &c), PROTO_OK);
+    assert_true(window_asm_complete(&a));
+    c = received_chunk(&two, 0);
+    assert_int_equal(window_asm_feed(&a, &c), PROTO_ERR_CHUNK);
+    assert_false(window_asm_complete(&a));
+    assert_f32s_equal(g_dst, g_src, 64);
+    /* and the other way round, at the next version */
+    one.version = two.version = 21;
+    c = received_chunk(&two, 0);
+    assert_int_equal(window_asm_feed(&a, &c), PROTO_OK);
+    assert_true(window_asm_complete(&a));
+    assert_int_equal(a.head.channels, 2);
+    c = received_chunk(&one, 0);
+    assert_int_equal(window_asm_feed(&a, &c), PROTO_ERR_CHUNK);
+    assert_false(window_asm_complete(&a));
 }
 
 static void test_repeated_chunk_with_other_samples_spoils_that_version(void **state)
@@ -1221,6 +1659,20 @@ static void test_window_larger_than_the_storage_is_refused(void **state)
     assert_int_equal(window_asm_feed(&a, &c), PROTO_ERR_CHUNK);
     assert_true(window_asm_complete(&a));
     assert_int_equal(a.version, 2);
+    /* two channels need twice the storage: 10x10x5 fills it exactly, 10x10x10 does not fit */
+    msg_window_t two = window_head(4, 10, 10, 10);
+    two.channels = 2;
+    fill_source(1000);
+    c = received_chunk(&two, 0);
+    assert_int_equal(window_asm_feed(&a, &c), PROTO_ERR_CHUNK);
+    assert_int_equal(a.version, 2);
+    assert_true(window_asm_complete(&a));
+    msg_window_t half = window_head(5, 10, 10, 5);
+    half.channels = 2;
+    fill_source(500);
+    feed_all_but(&a, &half, 0xFFFF);
+    assert_true(window_asm_complete(&a));
+    assert_f32s_equal(small, g_src, 1000);
     /* no storage at all */
     window_asm_init(&a, NULL, 1000);
     c = received_chunk(&fits, 0);
@@ -1236,6 +1688,7 @@ int main(void)
         cmocka_unit_test(test_golden_telemetry_frame_matches_the_spec),
         cmocka_unit_test(test_golden_impulse_frame_with_two_entries_matches_the_spec),
         cmocka_unit_test(test_golden_window_last_chunk_frame_matches_the_spec),
+        cmocka_unit_test(test_golden_two_channel_window_frame_matches_the_spec),
         cmocka_unit_test(test_golden_tool_frame_matches_the_spec),
         cmocka_unit_test(test_golden_fault_frame_matches_the_spec),
         cmocka_unit_test(test_every_message_type_survives_a_round_trip_at_its_extremes),
@@ -1252,11 +1705,16 @@ int main(void)
         cmocka_unit_test(test_window_chunk_numbering_that_contradicts_itself_is_refused),
         cmocka_unit_test(test_encoder_reports_a_buffer_too_small_and_writes_nothing_past_it),
         cmocka_unit_test(test_encoder_refuses_what_the_decoder_would_refuse),
+        cmocka_unit_test(test_every_tool_rule_is_enforced_by_decoder_and_encoder),
+        cmocka_unit_test(test_window_channels_other_than_1_or_2_are_refused),
+        cmocka_unit_test(test_negative_or_non_finite_node_stiffness_is_refused),
         cmocka_unit_test(test_every_error_has_its_own_readable_name),
         cmocka_unit_test(test_chunk_count_follows_the_window_size),
         cmocka_unit_test(test_full_window_arrives_in_any_order_with_duplicates_and_is_exact),
+        cmocka_unit_test(test_full_two_channel_window_arrives_in_any_order_and_is_exact),
         cmocka_unit_test(test_window_is_complete_only_when_the_last_missing_chunk_arrives),
         cmocka_unit_test(test_sibling_chunk_describing_another_window_spoils_that_version),
+        cmocka_unit_test(test_sibling_chunk_with_other_channels_spoils_that_version),
         cmocka_unit_test(test_repeated_chunk_with_other_samples_spoils_that_version),
         cmocka_unit_test(test_chunk_with_a_broken_chunk_number_is_refused_by_the_assembly),
         cmocka_unit_test(test_newer_window_version_restarts_the_assembly),
