@@ -1,0 +1,626 @@
+/* Matrix-free density-spring dynamics on coefficients: separable A and Aᵀ, the sample-space
+ * operators M, D, K, explicit and implicit (Hua & Qin eq. 12) steps, CG with elimination of
+ * fixed coefficients and hard rows (eq. 14-16). */
+#include "host/model/solver.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SOLVER_BOX_MAX ((int64_t)1 << 26)
+
+void solver_cfg_default(solver_cfg_t *c)
+{
+    c->dt_s = 1.0e-3f;
+    c->dt_min_s = 1.0e-6f;
+    c->acc_threshold = 1.0e6f;
+    c->cg_iters_max = SOLVER_CG_ITERS_MAX;
+    c->cg_tol = 1.0e-4f;
+}
+
+static bool solver_cfg_ok(const solver_cfg_t *c)
+{
+    return isfinite(c->dt_s) && c->dt_s > 0.0f && isfinite(c->dt_min_s) && c->dt_min_s > 0.0f &&
+           c->dt_min_s <= c->dt_s && !isnan(c->acc_threshold) && c->acc_threshold > 0.0f &&
+           c->cg_iters_max >= 1 && c->cg_iters_max <= SOLVER_CG_ITERS_MAX && isfinite(c->cg_tol) &&
+           c->cg_tol >= 0.0f;
+}
+
+void solver_free(solver_t *s)
+{
+    for (int a = 0; a < 3; a++) {
+        free(s->tap_first[a]);
+        free(s->tap_w[a]);
+        free(s->kedge[a]);
+    }
+    free(s->p);
+    free(s->p_prev);
+    free(s->fixed);
+    free(s->d_fixed);
+    free(s->mass_kg);
+    free(s->damp_n_s);
+    free(s->kscale);
+    free(s->rest);
+    free(s->force_n);
+    free(s->soft);
+    free(s->hard);
+    free(s->mlump);
+    free(s->dlump);
+    for (int i = 0; i < 6; i++)
+        free(s->w_nc[i]);
+    for (int i = 0; i < 4; i++)
+        free(s->w_ns[i]);
+    free(s->w_mid);
+    memset(s, 0, sizeof(*s));
+}
+
+argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], const solver_cfg_t *cfg)
+{
+    memset(s, 0, sizeof(*s));
+    int64_t vc = 1, vs = 1;
+    for (int a = 0; a < 3; a++) {
+        if (nc[a] < 4 || ns[a] < 1)
+            return ARGIL_ERR_ARG;
+        vc *= nc[a];
+        vs *= ns[a];
+        if (vc > SOLVER_BOX_MAX || vs > SOLVER_BOX_MAX)
+            return ARGIL_ERR_ARG;
+    }
+    if (cfg == NULL || !solver_cfg_ok(cfg))
+        return ARGIL_ERR_ARG;
+    memcpy(s->nc, nc, sizeof(s->nc));
+    memcpy(s->ns, ns, sizeof(s->ns));
+    s->ncoef = (size_t)vc;
+    s->nsamp = (size_t)vs;
+    s->cfg = *cfg;
+    s->dt_prev_s = cfg->dt_s;
+    s->k_rest_n = 1.0f;
+    s->coupling_n = 2.0f;
+    bool ok = true;
+    for (int a = 0; a < 3; a++) {
+        s->tap_first[a] = calloc((size_t)ns[a], sizeof(int32_t));
+        s->tap_w[a] = calloc((size_t)ns[a] * 4, sizeof(float));
+        s->kedge[a] = calloc(s->nsamp, sizeof(float));
+        ok = ok && s->tap_first[a] && s->tap_w[a] && s->kedge[a];
+    }
+    s->p = calloc(s->ncoef, sizeof(float));
+    s->p_prev = calloc(s->ncoef, sizeof(float));
+    s->fixed = calloc(s->ncoef, 1);
+    s->mlump = calloc(s->ncoef, sizeof(float));
+    s->dlump = calloc(s->ncoef, sizeof(float));
+    s->d_fixed = calloc(s->nsamp, sizeof(float));
+    s->mass_kg = malloc(s->nsamp * sizeof(float));
+    s->damp_n_s = malloc(s->nsamp * sizeof(float));
+    s->kscale = malloc(s->nsamp * sizeof(float));
+    s->rest = calloc(s->nsamp, sizeof(float));
+    s->force_n = calloc(s->nsamp, sizeof(float));
+    for (int i = 0; i < 6; i++) {
+        s->w_nc[i] = calloc(s->ncoef, sizeof(float));
+        ok = ok && s->w_nc[i];
+    }
+    for (int i = 0; i < 4; i++) {
+        s->w_ns[i] = calloc(s->nsamp, sizeof(float));
+        ok = ok && s->w_ns[i];
+    }
+    const size_t mid = (size_t)ns[0] * nc[1] * nc[2] + (size_t)ns[0] * ns[1] * nc[2];
+    s->w_mid = malloc(mid * sizeof(float));
+    ok = ok && s->p && s->p_prev && s->fixed && s->mlump && s->dlump && s->d_fixed && s->mass_kg &&
+         s->damp_n_s && s->kscale && s->rest && s->force_n && s->w_mid;
+    if (!ok) {
+        solver_free(s);
+        return ARGIL_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < s->nsamp; i++) {
+        s->mass_kg[i] = 1.0e-3f;
+        s->damp_n_s[i] = 0.05f;
+        s->kscale[i] = 1.0f;
+    }
+    solver_material_changed(s);
+    return ARGIL_OK;
+}
+
+/* d = A x (samples from coefficients), separable: x, then y, then z. */
+static void solver_apply_A(solver_t *s, const float *x, float *y)
+{
+    const int32_t *nc = s->nc, *ns = s->ns;
+    float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
+    const size_t rows = (size_t)nc[1] * nc[2];
+    for (size_t r = 0; r < rows; r++) {
+        const float *src = x + r * nc[0];
+        float *dst = T1 + r * ns[0];
+        for (int32_t i = 0; i < ns[0]; i++) {
+            const float *w = s->tap_w[0] + 4 * i;
+            const float *q = src + s->tap_first[0][i];
+            dst[i] = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3] * q[3];
+        }
+    }
+    const size_t st = (size_t)ns[0];
+    for (int32_t z = 0; z < nc[2]; z++)
+        for (int32_t j = 0; j < ns[1]; j++) {
+            const float *w = s->tap_w[1] + 4 * j;
+            const float *q = T1 + st * ((size_t)s->tap_first[1][j] + (size_t)nc[1] * z);
+            float *dst = T2 + st * ((size_t)j + (size_t)ns[1] * z);
+            for (int32_t i = 0; i < ns[0]; i++)
+                dst[i] = w[0] * q[i] + w[1] * q[i + st] + w[2] * q[i + 2 * st] + w[3] * q[i + 3 * st];
+        }
+    const size_t plane = (size_t)ns[0] * ns[1];
+    for (int32_t k = 0; k < ns[2]; k++) {
+        const float *w = s->tap_w[2] + 4 * k;
+        const float *q = T2 + plane * (size_t)s->tap_first[2][k];
+        float *dst = y + plane * (size_t)k;
+        for (size_t i = 0; i < plane; i++)
+            dst[i] = w[0] * q[i] + w[1] * q[i + plane] + w[2] * q[i + 2 * plane] + w[3] * q[i + 3 * plane];
+    }
+}
+
+/* x = Aᵀ y (coefficients from samples), the transpose of solver_apply_A. */
+static void solver_apply_At(solver_t *s, const float *y, float *x)
+{
+    const int32_t *nc = s->nc, *ns = s->ns;
+    float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
+    const size_t plane = (size_t)ns[0] * ns[1];
+    memset(T2, 0, sizeof(float) * plane * (size_t)nc[2]);
+    for (int32_t k = 0; k < ns[2]; k++) {
+        const float *w = s->tap_w[2] + 4 * k;
+        float *q = T2 + plane * (size_t)s->tap_first[2][k];
+        const float *src = y + plane * (size_t)k;
+        for (size_t i = 0; i < plane; i++) {
+            const float v = src[i];
+            q[i] += w[0] * v;
+            q[i + plane] += w[1] * v;
+            q[i + 2 * plane] += w[2] * v;
+            q[i + 3 * plane] += w[3] * v;
+        }
+    }
+    const size_t st = (size_t)ns[0];
+    memset(T1, 0, sizeof(float) * st * (size_t)nc[1] * nc[2]);
+    for (int32_t z = 0; z < nc[2]; z++)
+        for (int32_t j = 0; j < ns[1]; j++) {
+            const float *w = s->tap_w[1] + 4 * j;
+            float *q = T1 + st * ((size_t)s->tap_first[1][j] + (size_t)nc[1] * z);
+            const float *src = T2 + st * ((size_t)j + (size_t)ns[1] * z);
+            for (int32_t i = 0; i < ns[0]; i++) {
+                const float v = src[i];
+                q[i] += w[0] * v;
+                q[i + st] += w[1] * v;
+                q[i + 2 * st] += w[2] * v;
+                q[i + 3 * st] += w[3] * v;
+            }
+        }
+    const size_t rows = (size_t)nc[1] * nc[2];
+    memset(x, 0, sizeof(float) * s->ncoef);
+    for (size_t r = 0; r < rows; r++) {
+        const float *src = T1 + r * ns[0];
+        float *dst = x + r * nc[0];
+        for (int32_t i = 0; i < ns[0]; i++) {
+            const float *w = s->tap_w[0] + 4 * i;
+            float *q = dst + s->tap_first[0][i];
+            const float v = src[i];
+            q[0] += w[0] * v;
+            q[1] += w[1] * v;
+            q[2] += w[2] * v;
+            q[3] += w[3] * v;
+        }
+    }
+}
+
+void solver_material_changed(solver_t *s)
+{
+    const size_t stride[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
+    for (int a = 0; a < 3; a++) {
+        for (int32_t z = 0; z < s->ns[2]; z++)
+            for (int32_t y = 0; y < s->ns[1]; y++)
+                for (int32_t x = 0; x < s->ns[0]; x++) {
+                    const int32_t c[3] = {x, y, z};
+                    const size_t i = (size_t)x + stride[1] * y + stride[2] * z;
+                    /* the 4D spring between neighbours; with fixed sample positions only its
+                     * density component acts (Hua & Qin §5.1): stiffness = mean of the two scales */
+                    s->kedge[a][i] = c[a] + 1 < s->ns[a]
+                                         ? 0.5f * s->coupling_n * (s->kscale[i] + s->kscale[i + stride[a]])
+                                         : 0.0f;
+                }
+    }
+    /* lumped mass Aᵀ (m ⊙ A 1) for the explicit solver */
+    float *one = s->w_nc[5], *d = s->w_ns[3], *a1 = s->w_ns[2];
+    for (size_t i = 0; i < s->ncoef; i++)
+        one[i] = 1.0f;
+    solver_apply_A(s, one, a1);
+    for (size_t i = 0; i < s->nsamp; i++)
+        d[i] = a1[i] * s->mass_kg[i];
+    solver_apply_At(s, d, s->mlump);
+    for (size_t i = 0; i < s->nsamp; i++)
+        d[i] = a1[i] * s->damp_n_s[i];
+    solver_apply_At(s, d, s->dlump);
+    for (size_t i = 0; i < s->ncoef; i++)
+        if (!(s->dlump[i] >= 0.0f))
+            s->dlump[i] = 0.0f;
+    for (size_t i = 0; i < s->ncoef; i++)
+        if (!(s->mlump[i] > 1.0e-12f))
+            s->mlump[i] = 1.0e-12f;
+}
+
+/* out = K e on samples: rest springs plus the six neighbour springs (Hua & Qin eq. 6). */
+static void solver_apply_K(const solver_t *s, const float *e, float *out)
+{
+    for (size_t i = 0; i < s->nsamp; i++)
+        out[i] = s->k_rest_n * s->kscale[i] * e[i];
+    const size_t stride[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
+    for (int a = 0; a < 3; a++) {
+        const float *k = s->kedge[a];
+        const size_t st = stride[a];
+        for (size_t i = 0; i + st < s->nsamp; i++) {
+            const float f = k[i] * (e[i] - e[i + st]);
+            out[i] += f;
+            out[i + st] -= f;
+        }
+    }
+}
+
+void solver_densities(solver_t *s, float *d)
+{
+    solver_apply_A(s, s->p, d);
+    for (size_t i = 0; i < s->nsamp; i++)
+        d[i] += s->d_fixed[i];
+}
+
+static float solver_row_dot(const solver_row_t *r, const float *x)
+{
+    float v = 0.0f;
+    for (int32_t j = 0; j < r->n; j++)
+        v += r->w[j] * x[r->idx[j]];
+    return v;
+}
+
+static argil_err_t solver_row_check(const solver_t *s, const solver_row_t *r)
+{
+    if (r->n < 1 || r->n > SOLVER_ROW_MAX || !isfinite(r->target) || !isfinite(r->k_n) || r->k_n < 0.0f)
+        return ARGIL_ERR_ARG;
+    for (int32_t j = 0; j < r->n; j++)
+        if (r->idx[j] < 0 || (size_t)r->idx[j] >= s->ncoef || !isfinite(r->w[j]))
+            return ARGIL_ERR_ARG;
+    return ARGIL_OK;
+}
+
+static argil_err_t solver_push(solver_row_t **rows, int32_t *n, int32_t *cap, const solver_row_t *r)
+{
+    if (*n == *cap) {
+        const int32_t nc = *cap ? 2 * *cap : 16;
+        solver_row_t *p = realloc(*rows, sizeof(solver_row_t) * (size_t)nc);
+        if (p == NULL)
+            return ARGIL_ERR_NOMEM;
+        *rows = p;
+        *cap = nc;
+    }
+    (*rows)[(*n)++] = *r;
+    return ARGIL_OK;
+}
+
+argil_err_t solver_add_soft(solver_t *s, const solver_row_t *row)
+{
+    argil_err_t e = solver_row_check(s, row);
+    return e != ARGIL_OK ? e : solver_push(&s->soft, &s->nsoft, &s->soft_cap, row);
+}
+
+argil_err_t solver_add_hard(solver_t *s, const solver_row_t *row)
+{
+    argil_err_t e = solver_row_check(s, row);
+    if (e != ARGIL_OK)
+        return e;
+    solver_row_t r = *row;
+    r.pivot = 0;
+    for (int32_t j = 1; j < r.n; j++)
+        if (fabsf(r.w[j]) > fabsf(r.w[r.pivot]))
+            r.pivot = j;
+    const int32_t piv = r.idx[r.pivot];
+    if (!(fabsf(r.w[r.pivot]) > 1.0e-6f) || s->fixed[piv])
+        return ARGIL_ERR_ARG;
+    for (int32_t j = 0; j < r.n; j++)
+        if (j != r.pivot && r.idx[j] == piv)
+            return ARGIL_ERR_ARG;
+    for (int32_t h = 0; h < s->nhard; h++) {
+        const solver_row_t *o = &s->hard[h];
+        const int32_t opiv = o->idx[o->pivot];
+        for (int32_t j = 0; j < o->n; j++)
+            if (o->idx[j] == piv)
+                return ARGIL_ERR_ARG;
+        for (int32_t j = 0; j < r.n; j++)
+            if (r.idx[j] == opiv)
+                return ARGIL_ERR_ARG;
+    }
+    return solver_push(&s->hard, &s->nhard, &s->hard_cap, &r);
+}
+
+/* d = G h (+ h0 when affine): pivots from their rows (Hua & Qin eq. 14). */
+static void solver_expand(const solver_t *s, float *x, bool affine)
+{
+    for (int32_t h = 0; h < s->nhard; h++) {
+        const solver_row_t *r = &s->hard[h];
+        const int32_t piv = r->idx[r->pivot];
+        float acc = affine ? -r->target : 0.0f;
+        for (int32_t j = 0; j < r->n; j++)
+            if (j != r->pivot)
+                acc += r->w[j] * x[r->idx[j]];
+        x[piv] = -acc / r->w[r->pivot];
+    }
+}
+
+/* y = Gᵀ y, with the eliminated and fixed entries zeroed (eq. 15-16). */
+static void solver_reduce(const solver_t *s, float *y)
+{
+    for (int32_t h = 0; h < s->nhard; h++) {
+        const solver_row_t *r = &s->hard[h];
+        const int32_t piv = r->idx[r->pivot];
+        const float yp = y[piv];
+        for (int32_t j = 0; j < r->n; j++)
+            if (j != r->pivot)
+                y[r->idx[j]] -= r->w[j] / r->w[r->pivot] * yp;
+        y[piv] = 0.0f;
+    }
+    for (size_t i = 0; i < s->ncoef; i++)
+        if (s->fixed[i])
+            y[i] = 0.0f;
+}
+
+/* y = (2 M~ + dt D~ + 2 dt² K~) x, matrix-free (left side of Hua & Qin eq. 12). */
+static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
+{
+    float *d = s->w_ns[0], *kd = s->w_ns[1];
+    solver_apply_A(s, x, d);
+    solver_apply_K(s, d, kd);
+    const float c2 = 2.0f * dt * dt;
+    for (size_t i = 0; i < s->nsamp; i++)
+        kd[i] = (2.0f * s->mass_kg[i] + dt * s->damp_n_s[i]) * d[i] + c2 * kd[i];
+    solver_apply_At(s, kd, y);
+    for (int32_t r = 0; r < s->nsoft; r++) {
+        const solver_row_t *row = &s->soft[r];
+        const float v = c2 * row->k_n * solver_row_dot(row, x);
+        for (int32_t j = 0; j < row->n; j++)
+            y[row->idx[j]] += row->w[j] * v;
+    }
+}
+
+static double solver_dot(const float *a, const float *b, size_t n)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; i++)
+        v += (double)a[i] * b[i];
+    return v;
+}
+
+/* p_prev moved so that (p - p_prev) / dt keeps the velocity when the step changes. */
+static void solver_prev_for_dt(const solver_t *s, float dt, float *pp)
+{
+    const float q = dt / s->dt_prev_s;
+    for (size_t i = 0; i < s->ncoef; i++)
+        pp[i] = s->p[i] - (s->p[i] - s->p_prev[i]) * q;
+}
+
+static float solver_max_acc(const solver_t *s, const float *pn, const float *pp, float dt)
+{
+    float m = 0.0f;
+    const float inv = 1.0f / (dt * dt);
+    for (size_t i = 0; i < s->ncoef; i++) {
+        const float a = fabsf((pn[i] - 2.0f * s->p[i] + pp[i]) * inv);
+        if (a > m || isnan(a))
+            m = isnan(a) ? INFINITY : a;
+    }
+    return m;
+}
+
+argil_err_t solver_step_implicit(solver_t *s)
+{
+    float *pp = s->w_nc[0], *rhs = s->w_nc[1], *x = s->w_nc[2], *r = s->w_nc[3], *q = s->w_nc[4],
+          *Sq = s->w_nc[5];
+    float *dA = s->w_ns[2], *dB = s->w_ns[3];
+    s->stats.halvings = 0;
+    for (;;) {
+        const float dt = s->cfg.dt_s;
+        solver_prev_for_dt(s, dt, pp);
+        /* right side of eq. 12: 2dt² f_p + 4 M~ p_i - (2 M~ - dt D~) p_{i-1}, with
+         * f_p = Aᵀ (f + K (r - d_fixed)) (eq. 8, 11) */
+        solver_apply_A(s, s->p, dA);
+        solver_apply_A(s, pp, dB);
+        float *e = s->w_ns[0], *ke = s->w_ns[1];
+        for (size_t i = 0; i < s->nsamp; i++)
+            e[i] = s->rest[i] - s->d_fixed[i];
+        solver_apply_K(s, e, ke);
+        const float c2 = 2.0f * dt * dt;
+        for (size_t i = 0; i < s->nsamp; i++)
+            ke[i] = c2 * (s->force_n[i] + ke[i]) + 4.0f * s->mass_kg[i] * dA[i] -
+                    (2.0f * s->mass_kg[i] - dt * s->damp_n_s[i]) * dB[i];
+        solver_apply_At(s, ke, rhs);
+        for (int32_t k = 0; k < s->nsoft; k++) {
+            const solver_row_t *row = &s->soft[k];
+            for (int32_t j = 0; j < row->n; j++)
+                rhs[row->idx[j]] += c2 * row->k_n * row->target * row->w[j];
+        }
+        /* warm start: the previous motion continued; fixed coefficients stay; pivots from rows */
+        for (size_t i = 0; i < s->ncoef; i++)
+            x[i] = s->fixed[i] ? s->p[i] : 2.0f * s->p[i] - pp[i];
+        solver_expand(s, x, true);
+        solver_apply_S(s, x, Sq, dt);
+        for (size_t i = 0; i < s->ncoef; i++)
+            r[i] = rhs[i] - Sq[i];
+        solver_reduce(s, r);
+        solver_reduce(s, rhs);
+        const double bnorm = sqrt(solver_dot(rhs, rhs, s->ncoef));
+        double rr = solver_dot(r, r, s->ncoef);
+        memcpy(q, r, sizeof(float) * s->ncoef);
+        int32_t it = 0;
+        const double tol2 = (double)s->cfg.cg_tol * s->cfg.cg_tol * bnorm * bnorm;
+        /* conjugate gradients on the reduced system G'ᵀ S G' δ = Gᵀ r (eq. 16) */
+        while (it < s->cfg.cg_iters_max && rr > tol2 && rr > 0.0) {
+            solver_expand(s, q, false);
+            solver_apply_S(s, q, Sq, dt);
+            solver_reduce(s, Sq);
+            const double qSq = solver_dot(q, Sq, s->ncoef);
+            if (!(qSq > 0.0))
+                break;
+            const double alpha = rr / qSq;
+            for (size_t i = 0; i < s->ncoef; i++) {
+                x[i] += (float)alpha * q[i];
+                r[i] -= (float)alpha * Sq[i];
+            }
+            const double rr_new = solver_dot(r, r, s->ncoef);
+            const double beta = rr_new / rr;
+            rr = rr_new;
+            for (size_t i = 0; i < s->ncoef; i++)
+                q[i] = r[i] + (float)beta * q[i];
+            for (int32_t h = 0; h < s->nhard; h++)
+                q[s->hard[h].idx[s->hard[h].pivot]] = 0.0f;
+            it++;
+        }
+        solver_expand(s, x, true);
+        const float acc = solver_max_acc(s, x, pp, dt);
+        if (acc > s->cfg.acc_threshold && dt * 0.5f >= s->cfg.dt_min_s) {
+            s->cfg.dt_s = dt * 0.5f; /* Hua & Qin §7: halve the step while |p''| is too large */
+            s->stats.halvings++;
+            continue;
+        }
+        for (size_t i = 0; i < s->ncoef; i++)
+            if (!isfinite(x[i]))
+                return ARGIL_ERR_NONFINITE;
+        memcpy(s->p_prev, s->p, sizeof(float) * s->ncoef);
+        memcpy(s->p, x, sizeof(float) * s->ncoef);
+        s->dt_prev_s = dt;
+        s->stats.cg_iters = it;
+        s->stats.residual = bnorm > 0.0 ? (float)(sqrt(rr) / bnorm) : 0.0f;
+        s->stats.max_acc = acc;
+        return ARGIL_OK;
+    }
+}
+
+/* F = Aᵀ (f - K (A p + d_fixed - r)) - D_L v - soft springs: the net force on coefficients,
+ * with mass and damping lumped alike so every mode keeps the material's damping ratio. */
+static void solver_force(solver_t *s, const float *p, const float *v, float *F)
+{
+    float *d = s->w_ns[0], *kd = s->w_ns[1];
+    solver_apply_A(s, p, d);
+    for (size_t i = 0; i < s->nsamp; i++)
+        d[i] += s->d_fixed[i] - s->rest[i];
+    solver_apply_K(s, d, kd);
+    for (size_t i = 0; i < s->nsamp; i++)
+        kd[i] = s->force_n[i] - kd[i];
+    solver_apply_At(s, kd, F);
+    for (size_t i = 0; i < s->ncoef; i++)
+        F[i] -= s->dlump[i] * v[i];
+    for (int32_t k = 0; k < s->nsoft; k++) {
+        const solver_row_t *row = &s->soft[k];
+        const float g = row->k_n * (solver_row_dot(row, p) - row->target);
+        for (int32_t j = 0; j < row->n; j++)
+            F[row->idx[j]] -= g * row->w[j];
+    }
+}
+
+argil_err_t solver_step_explicit(solver_t *s)
+{
+    float *v = s->w_nc[0], *F = s->w_nc[1], *pn = s->w_nc[2];
+    s->stats.halvings = 0;
+    for (size_t i = 0; i < s->ncoef; i++)
+        v[i] = (s->p[i] - s->p_prev[i]) / s->dt_prev_s;
+    solver_force(s, s->p, v, F);
+    float amax = 0.0f;
+    for (size_t i = 0; i < s->ncoef; i++) {
+        F[i] = s->fixed[i] ? 0.0f : F[i] / s->mlump[i];
+        const float a = fabsf(F[i]);
+        if (a > amax || isnan(a))
+            amax = isnan(a) ? INFINITY : a;
+    }
+    while (amax > s->cfg.acc_threshold && s->cfg.dt_s * 0.5f >= s->cfg.dt_min_s) {
+        s->cfg.dt_s *= 0.5f; /* Hua & Qin §7 */
+        s->stats.halvings++;
+    }
+    const float dt = s->cfg.dt_s;
+    for (size_t i = 0; i < s->ncoef; i++)
+        pn[i] = s->p[i] + dt * (v[i] + dt * F[i]); /* semi-implicit Euler */
+    solver_expand(s, pn, true);
+    for (size_t i = 0; i < s->ncoef; i++)
+        if (!isfinite(pn[i]))
+            return ARGIL_ERR_NONFINITE;
+    memcpy(s->p_prev, s->p, sizeof(float) * s->ncoef);
+    memcpy(s->p, pn, sizeof(float) * s->ncoef);
+    s->dt_prev_s = dt;
+    s->stats.max_acc = amax;
+    return ARGIL_OK;
+}
+
+/* Largest eigenvalue of M_L⁻¹ X~ by power iteration, X = K (stiff = true) or D. */
+static double solver_power(solver_t *s, bool stiff)
+{
+    float *x = s->w_nc[3], *y = s->w_nc[4];
+    float *d = s->w_ns[2], *kd = s->w_ns[3];
+    for (size_t i = 0; i < s->ncoef; i++)
+        x[i] = s->fixed[i] ? 0.0f : ((i * 2654435761u) % 1000u) / 1000.0f - 0.5f;
+    double lambda = 0.0;
+    for (int it = 0; it < 60; it++) {
+        solver_apply_A(s, x, d);
+        if (stiff) {
+            solver_apply_K(s, d, kd);
+            solver_apply_At(s, kd, y);
+        } else {
+            for (size_t i = 0; i < s->ncoef; i++)
+                y[i] = s->dlump[i] * x[i];
+        }
+        if (stiff)
+            for (int32_t k = 0; k < s->nsoft; k++) {
+                const solver_row_t *row = &s->soft[k];
+                const float g = row->k_n * solver_row_dot(row, x);
+                for (int32_t j = 0; j < row->n; j++)
+                    y[row->idx[j]] += g * row->w[j];
+            }
+        for (size_t i = 0; i < s->ncoef; i++)
+            y[i] = s->fixed[i] ? 0.0f : y[i] / s->mlump[i];
+        const double nx = sqrt(solver_dot(x, x, s->ncoef)), ny = sqrt(solver_dot(y, y, s->ncoef));
+        if (!(nx > 0.0) || !(ny > 0.0))
+            return 0.0;
+        lambda = ny / nx;
+        for (size_t i = 0; i < s->ncoef; i++)
+            x[i] = (float)(y[i] / ny);
+    }
+    return lambda;
+}
+
+float solver_explicit_dt_max_s(solver_t *s)
+{
+    /* semi-implicit Euler on x'' + γ x' + λ x = 0 is stable while λ dt² + 2 γ dt < 4 */
+    const double lambda = solver_power(s, true), gamma = solver_power(s, false);
+    if (!(lambda > 0.0))
+        return INFINITY;
+    return (float)((-gamma + sqrt(gamma * gamma + 4.0 * lambda)) / lambda);
+}
+
+argil_err_t solver_init_patch(solver_t *s, const bspline_t *b, const int32_t ns[3],
+                              const solver_cfg_t *cfg)
+{
+    argil_err_t e = solver_init(s, b->n, ns, cfg);
+    if (e != ARGIL_OK)
+        return e;
+    for (int a = 0; a < 3; a++) {
+        const double *U = b->knots[a];
+        const int32_t n = b->n[a];
+        for (int32_t i = 0; i < ns[a]; i++) {
+            const double t = ns[a] == 1 ? 0.5 * (U[3] + U[n])
+                                        : U[3] + (U[n] - U[3]) * (double)i / (double)(ns[a] - 1);
+            const int32_t span = bspline_span(U, n, t);
+            double N[4], dN[4];
+            bspline_basis(U, span, t, N, dN);
+            s->tap_first[a][i] = span - 3;
+            for (int j = 0; j < 4; j++)
+                s->tap_w[a][4 * i + j] = (float)N[j];
+        }
+    }
+    memcpy(s->p, b->coef, sizeof(float) * s->ncoef);
+    memcpy(s->p_prev, b->coef, sizeof(float) * s->ncoef);
+    /* the outermost coefficient layers see the domain only through a 1/6 tail of their basis;
+     * they are held, as Hua & Qin §3.2 hold a patch's boundary layers */
+    for (int32_t z = 0; z < s->nc[2]; z++)
+        for (int32_t y = 0; y < s->nc[1]; y++)
+            for (int32_t x = 0; x < s->nc[0]; x++)
+                if (x == 0 || y == 0 || z == 0 || x == s->nc[0] - 1 || y == s->nc[1] - 1 || z == s->nc[2] - 1)
+                    s->fixed[(size_t)x + (size_t)s->nc[0] * ((size_t)y + (size_t)s->nc[1] * z)] = 1;
+    float *d = s->w_ns[2];
+    solver_apply_A(s, s->p, d);
+    memcpy(s->rest, d, sizeof(float) * s->nsamp);
+    solver_material_changed(s);
+    return ARGIL_OK;
+}

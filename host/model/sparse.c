@@ -1,0 +1,253 @@
+/* Hash table of blocks keyed by block coordinates (linear probing, grows at half load). */
+#include "host/model/sparse.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int32_t sparse_block_of(int32_t i)
+{
+    return i >= 0 ? i / SPARSE_B : -((-i + SPARSE_B - 1) / SPARSE_B);
+}
+
+static int32_t sparse_local(int32_t i)
+{
+    return i - sparse_block_of(i) * SPARSE_B;
+}
+
+static size_t sparse_hash(const int32_t key[3], size_t cap)
+{
+    uint32_t h = (uint32_t)key[0] * 73856093u ^ (uint32_t)key[1] * 19349663u ^
+                 (uint32_t)key[2] * 83492791u;
+    h ^= h >> 15;
+    h *= 0x2c1b3c6du;
+    h ^= h >> 12;
+    return (size_t)h & (cap - 1);
+}
+
+argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults)
+{
+    memset(s, 0, sizeof(*s));
+    if (nch < 1 || nch > SPARSE_CH_MAX || defaults == NULL)
+        return ARGIL_ERR_ARG;
+    for (int c = 0; c < nch; c++)
+        if (!isfinite(defaults[c]))
+            return ARGIL_ERR_NONFINITE;
+    s->nch = nch;
+    memcpy(s->defaults, defaults, sizeof(float) * (size_t)nch);
+    s->cap = 64;
+    s->slots = calloc(s->cap, sizeof(sparse_block_t));
+    return s->slots == NULL ? ARGIL_ERR_NOMEM : ARGIL_OK;
+}
+
+void sparse_free(sparse_t *s)
+{
+    for (size_t i = 0; i < s->cap && s->slots != NULL; i++)
+        free(s->slots[i].data);
+    free(s->slots);
+    s->slots = NULL;
+    s->cap = s->count = 0;
+}
+
+sparse_block_t *sparse_find(const sparse_t *s, const int32_t key[3])
+{
+    size_t h = sparse_hash(key, s->cap);
+    for (;;) {
+        sparse_block_t *b = &s->slots[h];
+        if (b->data == NULL)
+            return NULL;
+        if (b->key[0] == key[0] && b->key[1] == key[1] && b->key[2] == key[2])
+            return b;
+        h = (h + 1) & (s->cap - 1);
+    }
+}
+
+static argil_err_t sparse_grow(sparse_t *s)
+{
+    const size_t ncap = s->cap * 2;
+    sparse_block_t *ns = calloc(ncap, sizeof(sparse_block_t));
+    if (ns == NULL)
+        return ARGIL_ERR_NOMEM;
+    for (size_t i = 0; i < s->cap; i++) {
+        if (s->slots[i].data == NULL)
+            continue;
+        size_t h = sparse_hash(s->slots[i].key, ncap);
+        while (ns[h].data != NULL)
+            h = (h + 1) & (ncap - 1);
+        ns[h] = s->slots[i];
+    }
+    free(s->slots);
+    s->slots = ns;
+    s->cap = ncap;
+    return ARGIL_OK;
+}
+
+argil_err_t sparse_touch(sparse_t *s, const int32_t key[3], sparse_block_t **out)
+{
+    sparse_block_t *b = sparse_find(s, key);
+    if (b == NULL) {
+        if ((s->count + 1) * 2 > s->cap) {
+            argil_err_t e = sparse_grow(s);
+            if (e != ARGIL_OK)
+                return e;
+        }
+        float *data = malloc(sizeof(float) * (size_t)s->nch * SPARSE_BN);
+        if (data == NULL)
+            return ARGIL_ERR_NOMEM;
+        for (int c = 0; c < s->nch; c++)
+            for (int i = 0; i < SPARSE_BN; i++)
+                data[c * SPARSE_BN + i] = s->defaults[c];
+        size_t h = sparse_hash(key, s->cap);
+        while (s->slots[h].data != NULL)
+            h = (h + 1) & (s->cap - 1);
+        b = &s->slots[h];
+        memcpy(b->key, key, sizeof(b->key));
+        b->data = data;
+        b->dirty = true;
+        s->count++;
+    }
+    *out = b;
+    return ARGIL_OK;
+}
+
+float sparse_get(const sparse_t *s, int ch, int32_t i, int32_t j, int32_t k)
+{
+    const int32_t key[3] = {sparse_block_of(i), sparse_block_of(j), sparse_block_of(k)};
+    const sparse_block_t *b = sparse_find(s, key);
+    if (b == NULL)
+        return s->defaults[ch];
+    return b->data[ch * SPARSE_BN + sparse_local(i) +
+                   SPARSE_B * (sparse_local(j) + SPARSE_B * sparse_local(k))];
+}
+
+argil_err_t sparse_set(sparse_t *s, int ch, int32_t i, int32_t j, int32_t k, float v)
+{
+    if (ch < 0 || ch >= s->nch)
+        return ARGIL_ERR_ARG;
+    const int32_t key[3] = {sparse_block_of(i), sparse_block_of(j), sparse_block_of(k)};
+    sparse_block_t *b;
+    argil_err_t e = sparse_touch(s, key, &b);
+    if (e != ARGIL_OK)
+        return e;
+    b->data[ch * SPARSE_BN + sparse_local(i) + SPARSE_B * (sparse_local(j) + SPARSE_B * sparse_local(k))] = v;
+    b->dirty = true;
+    return ARGIL_OK;
+}
+
+static bool sparse_box_ok(const sparse_t *s, int ch, const int32_t lo[3], const int32_t dims[3])
+{
+    if (ch < 0 || ch >= s->nch)
+        return false;
+    for (int a = 0; a < 3; a++)
+        if (dims[a] < 0 || lo[a] < -SPARSE_INDEX_MAX || lo[a] > SPARSE_INDEX_MAX ||
+            dims[a] > SPARSE_INDEX_MAX)
+            return false;
+    return true;
+}
+
+void sparse_read_box(const sparse_t *s, int ch, const int32_t lo[3], const int32_t dims[3],
+                     float *out)
+{
+    if (!sparse_box_ok(s, ch, lo, dims))
+        return;
+    const int32_t hi[3] = {lo[0] + dims[0], lo[1] + dims[1], lo[2] + dims[2]};
+    for (int32_t bz = sparse_block_of(lo[2]); bz <= sparse_block_of(hi[2] - 1); bz++)
+        for (int32_t by = sparse_block_of(lo[1]); by <= sparse_block_of(hi[1] - 1); by++)
+            for (int32_t bx = sparse_block_of(lo[0]); bx <= sparse_block_of(hi[0] - 1); bx++) {
+                const int32_t key[3] = {bx, by, bz};
+                const sparse_block_t *b = sparse_find(s, key);
+                const int32_t z0 = bz * SPARSE_B > lo[2] ? bz * SPARSE_B : lo[2];
+                const int32_t z1 = (bz + 1) * SPARSE_B < hi[2] ? (bz + 1) * SPARSE_B : hi[2];
+                const int32_t y0 = by * SPARSE_B > lo[1] ? by * SPARSE_B : lo[1];
+                const int32_t y1 = (by + 1) * SPARSE_B < hi[1] ? (by + 1) * SPARSE_B : hi[1];
+                const int32_t x0 = bx * SPARSE_B > lo[0] ? bx * SPARSE_B : lo[0];
+                const int32_t x1 = (bx + 1) * SPARSE_B < hi[0] ? (bx + 1) * SPARSE_B : hi[0];
+                for (int32_t z = z0; z < z1; z++)
+                    for (int32_t y = y0; y < y1; y++) {
+                        float *dst = out + (size_t)(x0 - lo[0]) +
+                                     (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
+                        if (b == NULL) {
+                            for (int32_t x = x0; x < x1; x++)
+                                *dst++ = s->defaults[ch];
+                        } else {
+                            const float *src = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
+                                               SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
+                            memcpy(dst, src, sizeof(float) * (size_t)(x1 - x0));
+                        }
+                    }
+            }
+}
+
+argil_err_t sparse_write_box(sparse_t *s, int ch, const int32_t lo[3], const int32_t dims[3],
+                             const float *in)
+{
+    if (!sparse_box_ok(s, ch, lo, dims))
+        return ARGIL_ERR_ARG;
+    const int32_t hi[3] = {lo[0] + dims[0], lo[1] + dims[1], lo[2] + dims[2]};
+    for (int32_t bz = sparse_block_of(lo[2]); bz <= sparse_block_of(hi[2] - 1); bz++)
+        for (int32_t by = sparse_block_of(lo[1]); by <= sparse_block_of(hi[1] - 1); by++)
+            for (int32_t bx = sparse_block_of(lo[0]); bx <= sparse_block_of(hi[0] - 1); bx++) {
+                const int32_t key[3] = {bx, by, bz};
+                sparse_block_t *b = sparse_find(s, key);
+                const int32_t z0 = bz * SPARSE_B > lo[2] ? bz * SPARSE_B : lo[2];
+                const int32_t z1 = (bz + 1) * SPARSE_B < hi[2] ? (bz + 1) * SPARSE_B : hi[2];
+                const int32_t y0 = by * SPARSE_B > lo[1] ? by * SPARSE_B : lo[1];
+                const int32_t y1 = (by + 1) * SPARSE_B < hi[1] ? (by + 1) * SPARSE_B : hi[1];
+                const int32_t x0 = bx * SPARSE_B > lo[0] ? bx * SPARSE_B : lo[0];
+                const int32_t x1 = (bx + 1) * SPARSE_B < hi[0] ? (bx + 1) * SPARSE_B : hi[0];
+                bool differs = false;
+                for (int32_t z = z0; z < z1 && !differs; z++)
+                    for (int32_t y = y0; y < y1 && !differs; y++) {
+                        const float *src = in + (size_t)(x0 - lo[0]) +
+                                           (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
+                        if (b == NULL) {
+                            for (int32_t x = x0; x < x1; x++)
+                                if (memcmp(&src[x - x0], &s->defaults[ch], sizeof(float)) != 0)
+                                    differs = true;
+                        } else {
+                            const float *dst = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
+                                               SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
+                            differs = memcmp(dst, src, sizeof(float) * (size_t)(x1 - x0)) != 0;
+                        }
+                    }
+                if (!differs)
+                    continue;
+                if (b == NULL) {
+                    argil_err_t e = sparse_touch(s, key, &b);
+                    if (e != ARGIL_OK)
+                        return e;
+                }
+                b->dirty = true;
+                for (int32_t z = z0; z < z1; z++)
+                    for (int32_t y = y0; y < y1; y++) {
+                        const float *src = in + (size_t)(x0 - lo[0]) +
+                                           (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
+                        float *dst = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
+                                     SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
+                        memcpy(dst, src, sizeof(float) * (size_t)(x1 - x0));
+                    }
+            }
+    return ARGIL_OK;
+}
+
+size_t sparse_take_dirty(sparse_t *s, int32_t (*keys)[3], size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < s->cap; i++) {
+        sparse_block_t *b = &s->slots[i];
+        if (b->data == NULL || !b->dirty)
+            continue;
+        if (keys != NULL) {
+            if (n < max)
+                memcpy(keys[n], b->key, sizeof(b->key));
+            b->dirty = false;
+        }
+        n++;
+    }
+    return n;
+}
+
+size_t sparse_bytes(const sparse_t *s)
+{
+    return s->count * sizeof(float) * (size_t)s->nch * SPARSE_BN + s->cap * sizeof(sparse_block_t);
+}

@@ -1,0 +1,503 @@
+/* Tool application: the union of the tool's poses (stroke points, mirror images) gives one signed
+ * distance per point; the action turns it into new coefficients (or colours), then the touched
+ * samples are refreshed from the coefficients and the rest shape follows the edit. */
+#include "host/model/tools.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TOOL_POSES_MAX 4096
+#define TOOL_BOX_MAX ((int64_t)1 << 26)
+
+void tool_params_default(tool_params_t *p, tool_action_t action)
+{
+    memset(p, 0, sizeof(*p));
+    p->action = action;
+    p->strength = 0.5f;
+    p->rgb[0] = 0.8f;
+    p->rgb[1] = 0.3f;
+    p->rgb[2] = 0.2f;
+    p->stamp.s = 1.0f;   /* tool surface at v = s (v is the distance from the tool centre in radii) */
+    p->stamp.m = 0.3f;
+    p->stamp.r = 0.5f;
+    p->stamp.k = 2.0f;
+    p->stamp.n = 0.3f;
+    p->depth_m = 0.0f;
+    p->alpha = -1.0f;
+}
+
+void tool_pose_at(tool_pose_t *pose, vec3_t pos_m)
+{
+    memset(pose, 0, sizeof(*pose));
+    pose->pos_m = pos_m;
+    pose->rot[0][0] = pose->rot[1][1] = pose->rot[2][2] = 1.0f;
+}
+
+static float tool_freeform_sd(const tool_freeform_t *ff, vec3_t l)
+{
+    const float u[3] = {(l.x - ff->origin_m.x) / ff->spacing_m, (l.y - ff->origin_m.y) / ff->spacing_m,
+                        (l.z - ff->origin_m.z) / ff->spacing_m};
+    int32_t i0[3];
+    float t[3];
+    for (int a = 0; a < 3; a++) {
+        if (!(u[a] >= 0.0f) || !(u[a] <= (float)(ff->dims[a] - 1)))
+            return -2.0f * ff->band_m * ff->iso;
+        i0[a] = (int32_t)u[a];
+        if (i0[a] > ff->dims[a] - 2)
+            i0[a] = ff->dims[a] - 2 < 0 ? 0 : ff->dims[a] - 2;
+        t[a] = u[a] - (float)i0[a];
+    }
+    float v = 0.0f; /* Ferley §4.1.2: trilinear reconstruction of the copied field */
+    for (int c = 0; c < 8; c++) {
+        int32_t q[3];
+        float w = 1.0f;
+        for (int a = 0; a < 3; a++) {
+            const int bit = (c >> a) & 1;
+            q[a] = i0[a] + bit < ff->dims[a] ? i0[a] + bit : ff->dims[a] - 1;
+            w *= bit ? t[a] : 1.0f - t[a];
+        }
+        v += w * ff->density[q[0] + (size_t)ff->dims[0] * (q[1] + (size_t)ff->dims[1] * q[2])];
+    }
+    return (v - ff->iso) * 2.0f * ff->band_m; /* inverse of the ramp profile */
+}
+
+float tool_sd(const tool_shape_t *t, vec3_t l)
+{
+    switch (t->kind) {
+    case TOOL_SPHERE:
+        return t->radius_m - vec3_norm(l);
+    case TOOL_CYLINDER: {
+        const float dr = sqrtf(l.x * l.x + l.y * l.y) - t->radius_m, dz = fabsf(l.z) - t->half_len_m;
+        const float ox = dr > 0.0f ? dr : 0.0f, oz = dz > 0.0f ? dz : 0.0f;
+        const float in = dr > dz ? dr : dz;
+        return -(sqrtf(ox * ox + oz * oz) + (in < 0.0f ? in : 0.0f));
+    }
+    case TOOL_BOX: {
+        const float q[3] = {fabsf(l.x) - t->half_m.x, fabsf(l.y) - t->half_m.y, fabsf(l.z) - t->half_m.z};
+        float o = 0.0f, mx = q[0];
+        for (int a = 0; a < 3; a++) {
+            o += q[a] > 0.0f ? q[a] * q[a] : 0.0f;
+            mx = q[a] > mx ? q[a] : mx;
+        }
+        return -(sqrtf(o) + (mx < 0.0f ? mx : 0.0f));
+    }
+    case TOOL_TORUS: {
+        const float qx = sqrtf(l.x * l.x + l.y * l.y) - t->radius_m;
+        return t->radius2_m - sqrtf(qx * qx + l.z * l.z);
+    }
+    case TOOL_CUSTOM:
+        return t->custom(t->custom_ctx, l);
+    default:
+        return tool_freeform_sd(t->freeform, l);
+    }
+}
+
+float tool_bound_m(const tool_shape_t *t)
+{
+    switch (t->kind) {
+    case TOOL_SPHERE:
+        return t->radius_m;
+    case TOOL_CYLINDER:
+        return sqrtf(t->radius_m * t->radius_m + t->half_len_m * t->half_len_m);
+    case TOOL_BOX:
+        return vec3_norm(t->half_m);
+    case TOOL_TORUS:
+        return t->radius_m + t->radius2_m;
+    case TOOL_CUSTOM:
+        return t->custom_bound_m;
+    default: {
+        const tool_freeform_t *ff = t->freeform;
+        const vec3_t far = vec3(ff->origin_m.x + ff->spacing_m * (float)(ff->dims[0] - 1),
+                                ff->origin_m.y + ff->spacing_m * (float)(ff->dims[1] - 1),
+                                ff->origin_m.z + ff->spacing_m * (float)(ff->dims[2] - 1));
+        const float a = vec3_norm(ff->origin_m), b = vec3_norm(far);
+        return a > b ? a : b;
+    }
+    }
+}
+
+float tool_stamp_def(const tool_stamp_t *st, float v)
+{
+    /* Ferley et al. Fig. 11, with k read as the slope at v = s */
+    const float s = st->s, m = st->m, r = st->r, k = st->k, n = st->n;
+    if (v < 0.0f)
+        v = 0.0f;
+    if (v < s)
+        return (s * k - 2.0f) / (s * s * s) * v * v * v + (3.0f - s * k) / (s * s) * v * v - 1.0f;
+    if (v < s + m) {
+        const float o = v - s;
+        return (k * m - 2.0f * n) / (m * m * m) * o * o * o + (3.0f * n - 2.0f * k * m) / (m * m) * o * o + k * o;
+    }
+    if (v < s + m + r) {
+        const float o = v - s - m;
+        return 2.0f * n / (r * r * r) * o * o * o - 3.0f * n / (r * r) * o * o + n;
+    }
+    return 0.0f;
+}
+
+static bool tool_shape_ok(const tool_shape_t *t)
+{
+    switch (t->kind) {
+    case TOOL_SPHERE:
+        return isfinite(t->radius_m) && t->radius_m > 0.0f;
+    case TOOL_CYLINDER:
+        return isfinite(t->radius_m) && t->radius_m > 0.0f && isfinite(t->half_len_m) && t->half_len_m > 0.0f;
+    case TOOL_BOX:
+        return vec3_isfinite(t->half_m) && t->half_m.x > 0.0f && t->half_m.y > 0.0f && t->half_m.z > 0.0f;
+    case TOOL_TORUS:
+        return isfinite(t->radius_m) && isfinite(t->radius2_m) && t->radius2_m > 0.0f && t->radius_m > 0.0f;
+    case TOOL_CUSTOM:
+        return t->custom != NULL && isfinite(t->custom_bound_m) && t->custom_bound_m > 0.0f;
+    case TOOL_FREEFORM:
+        return t->freeform != NULL && t->freeform->density != NULL && t->freeform->dims[0] >= 2 &&
+               t->freeform->dims[1] >= 2 && t->freeform->dims[2] >= 2 && t->freeform->spacing_m > 0.0f;
+    default:
+        return false;
+    }
+}
+
+static bool tool_params_ok(const tool_params_t *p)
+{
+    const tool_stamp_t *s = &p->stamp;
+    return (unsigned)p->action <= TOOL_CONTACT && isfinite(p->strength) && p->strength >= 0.0f &&
+           isfinite(p->depth_m) && isfinite(p->alpha) && isfinite(p->rgb[0]) && isfinite(p->rgb[1]) &&
+           isfinite(p->rgb[2]) && vec3_isfinite(p->mirror_origin_m) && (p->mirror >> 3) == 0 &&
+           (p->action != TOOL_STAMP || (s->s > 0.0f && s->m > 0.0f && s->r > 0.0f && isfinite(s->k) &&
+                                        isfinite(s->n) && isfinite(s->s + s->m + s->r)));
+}
+
+/* Local coordinates of x for pose: rotᵀ (x - pos); mirrored poses carry a reflection in rot. */
+static vec3_t tool_local(const tool_pose_t *q, vec3_t x)
+{
+    const vec3_t d = vec3_sub(x, q->pos_m);
+    return vec3(q->rot[0][0] * d.x + q->rot[1][0] * d.y + q->rot[2][0] * d.z,
+                q->rot[0][1] * d.x + q->rot[1][1] * d.y + q->rot[2][1] * d.z,
+                q->rot[0][2] * d.x + q->rot[1][2] * d.y + q->rot[2][2] * d.z);
+}
+
+typedef struct {
+    const tool_shape_t *t;
+    const tool_pose_t *poses;
+    size_t n;
+    float reach_m;
+} tool_union_t;
+
+/* Signed distance of the union of all poses at x (-inf when no pose reaches x). */
+static float tool_union_sd(const tool_union_t *U, vec3_t x)
+{
+    float best = -INFINITY;
+    const float r2 = U->reach_m * U->reach_m;
+    for (size_t i = 0; i < U->n; i++) {
+        const vec3_t d = vec3_sub(x, U->poses[i].pos_m);
+        if (vec3_dot(d, d) > r2)
+            continue;
+        const float sd = tool_sd(U->t, tool_local(&U->poses[i], x));
+        if (sd > best)
+            best = sd;
+    }
+    return best;
+}
+
+static float tool_clamp01(float v)
+{
+    return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+}
+
+/* New coefficient value from the old one and the union's signed distance at the coefficient. */
+static float tool_action_coef(const field_t *f, const tool_params_t *p, float bound, float pold,
+                              float sd, vec3_t x, const float *nb6)
+{
+    const float phi = field_profile(sd, f->band_m);
+    switch (p->action) {
+    case TOOL_CARVE:
+        return pold < 1.0f - phi ? pold : 1.0f - phi;
+    case TOOL_ADD:
+        return pold > phi ? pold : phi;
+    case TOOL_TOOTHPASTE: /* Ferley §4.2: add the tool's contribution */
+        return tool_clamp01(pold + p->strength * phi);
+    case TOOL_SOFT_ERASE:
+        return tool_clamp01(pold - p->strength * phi);
+    case TOOL_SMOOTH: {
+        const float avg = (nb6[0] + nb6[1] + nb6[2] + nb6[3] + nb6[4] + nb6[5]) / 6.0f;
+        const float a = tool_clamp01(p->strength * phi);
+        return pold + a * (avg - pold);
+    }
+    case TOOL_STAMP: { /* Ferley §4.3: v_deformTool = def(v_tool(P)) */
+        const float v = p->stamp.s * (1.0f - sd / bound);
+        return tool_clamp01(pold + p->strength * tool_stamp_def(&p->stamp, v));
+    }
+    case TOOL_CHISEL:
+    case TOOL_SQUIRT: { /* shifting the level set by depth along the normal: Δf = |∇f| depth */
+        vec3_t g;
+        (void)field_eval(f, x, &g);
+        const float dv = vec3_norm(g) * p->depth_m * phi;
+        return tool_clamp01(p->action == TOOL_CHISEL ? pold - dv : pold + dv);
+    }
+    case TOOL_INTERIOR_CARVE: /* only coefficients deeper than the density ramp: the shell stays */
+        if (pold < 1.0f)
+            return pold;
+        return pold < 1.0f - phi ? pold : 1.0f - phi;
+    case TOOL_CONTACT: { /* Zhang et al. eq. 2-3: h = f + β g, g = α (f_tool - c) in V1, β = 1 there */
+        const float c = f->iso;
+        if (phi <= c)
+            return pold; /* outside V1 g = 0, so β = f_tool / c has nothing to scale */
+        return tool_clamp01(pold + p->alpha * (phi - c));
+    }
+    default:
+        return pold;
+    }
+}
+
+static argil_err_t tool_apply_union(field_t *f, const tool_union_t *U, const tool_params_t *p,
+                                    undo_t *u, tool_stats_t *stats)
+{
+    const float bound = tool_bound_m(U->t);
+    vec3_t lo = U->poses[0].pos_m, hi = lo;
+    for (size_t i = 1; i < U->n; i++) {
+        const vec3_t q = U->poses[i].pos_m;
+        lo = vec3(fminf(lo.x, q.x), fminf(lo.y, q.y), fminf(lo.z, q.z));
+        hi = vec3(fmaxf(hi.x, q.x), fmaxf(hi.y, q.y), fmaxf(hi.z, q.z));
+    }
+    const float lw[3] = {lo.x - U->reach_m, lo.y - U->reach_m, lo.z - U->reach_m};
+    const float hw[3] = {hi.x + U->reach_m, hi.y + U->reach_m, hi.z + U->reach_m};
+    const float o[3] = {f->origin_m.x, f->origin_m.y, f->origin_m.z};
+    const bool paint = p->action == TOOL_PAINT || p->action == TOOL_SOFT_PAINT;
+    const float h = paint ? f->sample_spacing_m : f->coef_spacing_m;
+    int32_t blo[3], bhi[3], bn[3];
+    int64_t vol = 1;
+    for (int a = 0; a < 3; a++) {
+        const double l = ceil(((double)lw[a] - o[a]) / h), r = floor(((double)hw[a] - o[a]) / h);
+        if (!isfinite(l) || !isfinite(r) || fabs(l) > SPARSE_INDEX_MAX / 4 || fabs(r) > SPARSE_INDEX_MAX / 4)
+            return ARGIL_ERR_ARG;
+        blo[a] = (int32_t)l;
+        bhi[a] = (int32_t)r + 1;
+        if (bhi[a] <= blo[a])
+            return ARGIL_OK; /* the tool falls between lattice points */
+        bn[a] = bhi[a] - blo[a];
+        vol *= bn[a] + 2;
+        if (vol > TOOL_BOX_MAX)
+            return ARGIL_ERR_ARG;
+    }
+    argil_err_t e = ARGIL_OK;
+    if (paint) {
+        if (u != NULL && (e = undo_begin(u, f, blo, blo, 0, blo, bhi,
+                                          (1u << FS_R) | (1u << FS_G) | (1u << FS_B))) != ARGIL_OK)
+            return e;
+        const size_t n = (size_t)vol;
+        float *buf = malloc(sizeof(float) * n * 4);
+        if (buf == NULL)
+            return ARGIL_ERR_NOMEM;
+        float *d = buf + 3 * n;
+        for (int c = 0; c < 3; c++)
+            sparse_read_box(&f->samp, FS_R + c, blo, bn, buf + (size_t)c * n);
+        sparse_read_box(&f->samp, FS_D, blo, bn, d);
+        size_t i = 0;
+        for (int32_t z = 0; z < bn[2]; z++)
+            for (int32_t y = 0; y < bn[1]; y++)
+                for (int32_t x = 0; x < bn[0]; x++, i++) {
+                    const int32_t s[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
+                    const float phi = field_profile(tool_union_sd(U, field_sample_pos(f, s)), f->band_m);
+                    for (int c = 0; c < 3; c++) {
+                        float *col = buf + (size_t)c * n + i;
+                        if (p->action == TOOL_PAINT) {
+                            if (phi >= f->iso)
+                                *col = p->rgb[c];
+                        } else { /* soft paint takes the sample's own density into account */
+                            *col += (p->rgb[c] - *col) * tool_clamp01(p->strength * phi * d[i]);
+                        }
+                    }
+                }
+        for (int c = 0; c < 3 && e == ARGIL_OK; c++)
+            e = sparse_write_box(&f->samp, FS_R + c, blo, bn, buf + (size_t)c * n);
+        free(buf);
+        if (stats != NULL)
+            stats->samples_refreshed += n;
+        return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
+    }
+    /* coefficients: read with one extra ring (smoothing neighbours) */
+    int32_t rlo[3], rn[3], slo[3], shi[3], sn[3];
+    for (int a = 0; a < 3; a++) {
+        rlo[a] = blo[a] - 1;
+        rn[a] = bn[a] + 2;
+    }
+    field_samples_of_coefs(f, blo, bhi, slo, shi);
+    size_t ns = 1;
+    for (int a = 0; a < 3; a++) {
+        sn[a] = shi[a] - slo[a];
+        ns *= (size_t)sn[a];
+    }
+    if (u != NULL && (e = undo_begin(u, f, blo, bhi, 1u << FC_P, slo, shi,
+                                      (1u << FS_D) | (1u << FS_REST))) != ARGIL_OK)
+        return e;
+    const size_t nr = (size_t)rn[0] * rn[1] * rn[2], nb = (size_t)bn[0] * bn[1] * bn[2];
+    float *P = malloc(sizeof(float) * (nr + nb + 3 * ns));
+    if (P == NULL)
+        return ARGIL_ERR_NOMEM;
+    float *Pn = P + nr, *d0 = Pn + nb, *d1 = d0 + ns, *rest = d1 + ns;
+    sparse_read_box(&f->coef, FC_P, rlo, rn, P);
+    size_t changed = 0, i = 0;
+    const size_t sy = (size_t)rn[0], sz = (size_t)rn[0] * rn[1];
+    for (int32_t z = 0; z < bn[2]; z++)
+        for (int32_t y = 0; y < bn[1]; y++)
+            for (int32_t x = 0; x < bn[0]; x++, i++) {
+                const size_t ri = (size_t)(x + 1) + sy * (size_t)(y + 1) + sz * (size_t)(z + 1);
+                const float pold = P[ri];
+                const int32_t c[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
+                const vec3_t xc = field_coef_pos(f, c);
+                const float sd = tool_union_sd(U, xc);
+                if (sd == -INFINITY) {
+                    Pn[i] = pold;
+                    continue;
+                }
+                const float nb6[6] = {P[ri - 1], P[ri + 1], P[ri - sy], P[ri + sy], P[ri - sz], P[ri + sz]};
+                Pn[i] = tool_action_coef(f, p, bound, pold, sd, xc, nb6);
+                changed += Pn[i] != pold;
+            }
+    if (stats != NULL) {
+        stats->coefs_visited += nb;
+        stats->coefs_changed += changed;
+        stats->samples_refreshed += ns;
+    }
+    if (changed == 0) {
+        free(P);
+        return u != NULL ? undo_commit(u, f) : ARGIL_OK;
+    }
+    e = sparse_write_box(&f->coef, FC_P, blo, bn, Pn);
+    /* samples: d = A p again; the rest shape moves by the same edit (a plastic change) */
+    if (e == ARGIL_OK) {
+        sparse_read_box(&f->samp, FS_D, slo, sn, d0);
+        e = field_refresh(f, slo, shi);
+    }
+    if (e == ARGIL_OK) {
+        sparse_read_box(&f->samp, FS_D, slo, sn, d1);
+        sparse_read_box(&f->samp, FS_REST, slo, sn, rest);
+        for (size_t k = 0; k < ns; k++)
+            rest[k] += d1[k] - d0[k];
+        e = sparse_write_box(&f->samp, FS_REST, slo, sn, rest);
+    }
+    free(P);
+    if (e == ARGIL_OK && u != NULL)
+        e = undo_commit(u, f);
+    return e;
+}
+
+/* Reach of the tool's influence beyond its origin for this action. */
+static float tool_reach(const field_t *f, const tool_shape_t *t, const tool_params_t *p)
+{
+    const float b = tool_bound_m(t);
+    float r = b + f->band_m + f->coef_spacing_m;
+    if (p->action == TOOL_STAMP) {
+        const float rs = b * (p->stamp.s + p->stamp.m + p->stamp.r) / p->stamp.s;
+        r = rs > r ? rs : r;
+    }
+    return r;
+}
+
+/* Adds the mirror images of pose q (bits of mirror) to out; returns the count written. */
+static size_t tool_mirrors(const tool_pose_t *q, const tool_params_t *p, tool_pose_t *out)
+{
+    size_t n = 0;
+    const float o[3] = {p->mirror_origin_m.x, p->mirror_origin_m.y, p->mirror_origin_m.z};
+    for (uint32_t m = 0; m < 8; m++) {
+        if ((m & ~p->mirror) != 0)
+            continue;
+        tool_pose_t r = *q;
+        float pos[3] = {q->pos_m.x, q->pos_m.y, q->pos_m.z};
+        for (int a = 0; a < 3; a++)
+            if (m & (1u << a)) {
+                pos[a] = 2.0f * o[a] - pos[a];
+                for (int c = 0; c < 3; c++)
+                    r.rot[a][c] = -r.rot[a][c]; /* reflection S·rot */
+            }
+        r.pos_m = vec3(pos[0], pos[1], pos[2]);
+        out[n++] = r;
+    }
+    return n;
+}
+
+/* Every stroke point (spaced ≤ band / 2) and its mirror images, applied as one union. */
+static argil_err_t tool_run(field_t *f, const tool_shape_t *t, const tool_pose_t *pose,
+                            const vec3_t *pts, size_t n, const tool_params_t *p, undo_t *u,
+                            tool_stats_t *stats)
+{
+    if (f == NULL || t == NULL || pose == NULL || pts == NULL || p == NULL || n == 0 ||
+        !tool_shape_ok(t) || !tool_params_ok(p))
+        return ARGIL_ERR_ARG;
+    for (size_t i = 0; i < n; i++)
+        if (!vec3_isfinite(pts[i]))
+            return ARGIL_ERR_NONFINITE;
+    const float step = 0.5f * f->band_m;
+    size_t count = 1;
+    for (size_t i = 1; i < n; i++) {
+        const float len = vec3_norm(vec3_sub(pts[i], pts[i - 1]));
+        count += (size_t)ceilf(len / step);
+        if (count > TOOL_POSES_MAX)
+            return ARGIL_ERR_ARG;
+    }
+    tool_pose_t *poses = malloc(sizeof(tool_pose_t) * count * 8);
+    if (poses == NULL)
+        return ARGIL_ERR_NOMEM;
+    size_t np = 0;
+    tool_pose_t q = *pose;
+    q.pos_m = pts[0];
+    np += tool_mirrors(&q, p, poses + np);
+    for (size_t i = 1; i < n; i++) {
+        const vec3_t d = vec3_sub(pts[i], pts[i - 1]);
+        const size_t k = (size_t)ceilf(vec3_norm(d) / step);
+        for (size_t j = 1; j <= k; j++) {
+            q.pos_m = vec3_add(pts[i - 1], vec3_scale(d, (float)j / (float)k));
+            np += tool_mirrors(&q, p, poses + np);
+        }
+    }
+    const tool_union_t U = {t, poses, np, tool_reach(f, t, p)};
+    argil_err_t e = tool_apply_union(f, &U, p, u, stats);
+    free(poses);
+    return e;
+}
+
+argil_err_t tool_apply(field_t *f, const tool_shape_t *t, const tool_pose_t *pose,
+                       const tool_params_t *p, undo_t *u, tool_stats_t *stats)
+{
+    if (pose == NULL)
+        return ARGIL_ERR_ARG;
+    return tool_run(f, t, pose, &pose->pos_m, 1, p, u, stats);
+}
+
+argil_err_t tool_stroke(field_t *f, const tool_shape_t *t, const tool_pose_t *pose,
+                        const vec3_t *pts_m, size_t n, const tool_params_t *p, undo_t *u)
+{
+    return tool_run(f, t, pose, pts_m, n, p, u, NULL);
+}
+
+argil_err_t tool_freeform_from_field(tool_freeform_t *ff, const field_t *f, const int32_t slo[3],
+                                     const int32_t shi[3])
+{
+    memset(ff, 0, sizeof(*ff));
+    int64_t vol = 1;
+    for (int a = 0; a < 3; a++) {
+        ff->dims[a] = shi[a] - slo[a];
+        if (ff->dims[a] < 2)
+            return ARGIL_ERR_ARG;
+        vol *= ff->dims[a];
+        if (vol > TOOL_BOX_MAX)
+            return ARGIL_ERR_ARG;
+    }
+    ff->density = malloc(sizeof(float) * (size_t)vol);
+    if (ff->density == NULL)
+        return ARGIL_ERR_NOMEM;
+    sparse_read_box(&f->samp, FS_D, slo, ff->dims, ff->density);
+    ff->spacing_m = f->sample_spacing_m;
+    ff->origin_m = vec3(-0.5f * ff->spacing_m * (float)(ff->dims[0] - 1),
+                        -0.5f * ff->spacing_m * (float)(ff->dims[1] - 1),
+                        -0.5f * ff->spacing_m * (float)(ff->dims[2] - 1));
+    ff->iso = f->iso;
+    ff->band_m = f->band_m;
+    return ARGIL_OK;
+}
+
+void tool_freeform_free(tool_freeform_t *ff)
+{
+    free(ff->density);
+    ff->density = NULL;
+}

@@ -1,0 +1,189 @@
+/* make bench: the host model against Hua & Qin Tables 1-2 and Ferley et al.'s performance table.
+ * Medians of repeated runs on this machine; the papers' figures are printed beside ours. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "host/model/physwin.h"
+#include "host/model/tools.h"
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof(double), cmp);
+    return v[n / 2];
+}
+
+static float g_radius;
+static float sd_ball(void *ctx, vec3_t x)
+{
+    (void)ctx;
+    return g_radius - vec3_norm(x);
+}
+
+/* Hua & Qin Table 1: geometric tool update (new coefficients, d = A p over the tool, dirty
+ * blocks marked, undo step recorded) in a working space sampled at 128^3. */
+static void table1(void)
+{
+    static const struct { int coefs, tool; double paper_ms; } rows[] = {
+        {64, 10, 0.4}, {64, 20, 3.0}, {64, 40, 23.5}, {128, 20, 8.3}, {128, 40, 59.8}};
+    printf("== Hua & Qin Table 1: geometric tool (sphere carve), working space sampled at 128^3\n");
+    printf("  coefficients  tool (samples)  paper (2.2 GHz PC)  ours: with undo / without   coefs changed  dirty blocks\n");
+    for (size_t r = 0; r < sizeof(rows) / sizeof(rows[0]); r++) {
+        field_t f;
+        const int ratio = 128 / rows[r].coefs;
+        const float hc = 1.0f / (float)rows[r].coefs;
+        field_init(&f, hc, ratio, vec3(0, 0, 0));
+        g_radius = 0.4f;
+        field_fill(&f, sd_ball, NULL, vec3(-0.5f, -0.5f, -0.5f), vec3(0.5f, 0.5f, 0.5f));
+        undo_t u;
+        undo_init(&u, (size_t)256 << 20);
+        tool_shape_t t;
+        memset(&t, 0, sizeof(t));
+        t.kind = TOOL_SPHERE;
+        t.radius_m = 0.5f * (float)rows[r].tool * f.sample_spacing_m;
+        tool_params_t p;
+        tool_params_default(&p, TOOL_CARVE);
+        enum { RUNS = 9 };
+        double ms[2][RUNS];
+        size_t changed[RUNS], dirty[RUNS];
+        int32_t keys[1][3];
+        for (int k = 0; k < 2; k++)
+            for (int i = 0; i < RUNS; i++) {
+                tool_pose_t pose; /* points on the ball's equator: every application cuts material */
+                const float a = 0.7f * (float)i + 0.35f * (float)k;
+                tool_pose_at(&pose, vec3(0.4f * cosf(a), 0.4f * sinf(a), 0.0f));
+                (void)sparse_take_dirty(&f.samp, keys, 0); /* the mesher took the older blocks */
+                tool_stats_t st = {0, 0, 0};
+                const double t0 = now_ms();
+                tool_apply(&f, &t, &pose, &p, k == 0 ? &u : NULL, &st); /* marks blocks dirty */
+                ms[k][i] = now_ms() - t0;
+                changed[i] = st.coefs_changed;
+                dirty[i] = sparse_take_dirty(&f.samp, NULL, 0);
+            }
+        double c[RUNS], dd[RUNS];
+        for (int i = 0; i < RUNS; i++) {
+            c[i] = (double)changed[i];
+            dd[i] = (double)dirty[i];
+        }
+        printf("  %4d^3        %3d^3           %6.1f ms           %7.3f / %7.3f ms       %8.0f       %6.0f\n",
+               rows[r].coefs, rows[r].tool, rows[r].paper_ms, median(ms[0], RUNS), median(ms[1], RUNS),
+               median(c, RUNS), median(dd, RUNS));
+        undo_free(&u);
+        field_free(&f);
+    }
+}
+
+/* Hua & Qin Table 2: one simulation loop (implicit step, ≤ 8 CG iterations) + d = A p. */
+static void table2(void)
+{
+    static const struct { int coefs, samples; double paper_ms; } rows[] = {
+        {5, 10, 1.0}, {10, 10, 6.9}, {10, 15, 15.8}, {15, 15, 38.2}, {15, 20, 74.9}, {32, 64, -1.0}};
+    printf("== Hua & Qin Table 2: one implicit step (eq. 12, CG <= 8 iterations) + d = A p\n");
+    printf("  coefficients  samples   paper (2.2 GHz PC)  ours median   CG iterations  residual\n");
+    for (size_t r = 0; r < sizeof(rows) / sizeof(rows[0]); r++) {
+        bspline_t b;
+        const int32_t n[3] = {rows[r].coefs, rows[r].coefs, rows[r].coefs};
+        const int32_t ns[3] = {rows[r].samples, rows[r].samples, rows[r].samples};
+        const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+        bspline_init_uniform(&b, n, lo, hi);
+        for (int i = 0; i < n[0] * n[1] * n[2]; i++)
+            b.coef[i] = 0.5f;
+        solver_cfg_t cfg;
+        solver_cfg_default(&cfg);
+        cfg.dt_s = 0.01f;
+        cfg.cg_tol = 0.0f; /* always the full 8 iterations: the worst case */
+        solver_t s;
+        solver_init_patch(&s, &b, ns, &cfg);
+        for (size_t i = 0; i < s.nsamp; i += 7)
+            s.force_n[i] = 0.3f;
+        float *d = malloc(sizeof(float) * s.nsamp);
+        enum { RUNS = 15 };
+        double ms[RUNS];
+        for (int i = 0; i < RUNS; i++) {
+            const double t0 = now_ms();
+            solver_step_implicit(&s);
+            solver_densities(&s, d);
+            ms[i] = now_ms() - t0;
+        }
+        char paper[32];
+        if (rows[r].paper_ms > 0)
+            snprintf(paper, sizeof(paper), "%6.1f ms", rows[r].paper_ms);
+        else
+            snprintf(paper, sizeof(paper), "goal <= 16 ms");
+        printf("  %4d^3        %3d^3     %-18s  %7.3f ms    %d              %.1e\n", rows[r].coefs,
+               rows[r].samples, paper, median(ms, RUNS), s.stats.cg_iters, (double)s.stats.residual);
+        free(d);
+        solver_free(&s);
+        bspline_free(&b);
+    }
+}
+
+/* Ferley et al. §6: toothpaste tools touching ~200 / ~950 / ~2,100 corners. */
+static void ferley(void)
+{
+    static const struct { const char *name; int corners; const char *paper; } rows[] = {
+        {"small", 203, "19-23 frames/s (43-53 ms/frame)"},
+        {"medium", 975, "7-8 frames/s (125-143 ms/frame)"},
+        {"large", 2197, "3-4 frames/s (250-333 ms/frame)"}};
+    printf("== Ferley et al. performance table: toothpaste, one application (SGI Onyx2 R10k 195 MHz)\n");
+    printf("  tool    corners computed (paper / ours)  paper                              ours median\n");
+    for (size_t r = 0; r < 3; r++) {
+        field_t f;
+        field_init(&f, 0.01f, 1, vec3(0, 0, 0));
+        g_radius = 0.2f;
+        field_fill(&f, sd_ball, NULL, vec3(-0.3f, -0.3f, -0.3f), vec3(0.3f, 0.3f, 0.3f));
+        undo_t u;
+        undo_init(&u, (size_t)64 << 20);
+        /* a sphere whose influence ball holds ~corners lattice points: (4/3) pi R^3 / h^3 */
+        tool_shape_t t;
+        memset(&t, 0, sizeof(t));
+        t.kind = TOOL_SPHERE;
+        const float reach = cbrtf(3.0f * (float)rows[r].corners / (4.0f * (float)M_PI)) * f.coef_spacing_m;
+        t.radius_m = reach - f.band_m;
+        if (t.radius_m < 0.5f * f.coef_spacing_m)
+            t.radius_m = 0.5f * f.coef_spacing_m;
+        tool_params_t p;
+        tool_params_default(&p, TOOL_TOOTHPASTE);
+        p.strength = 0.2f;
+        enum { RUNS = 15 };
+        double ms[RUNS];
+        tool_stats_t st;
+        size_t computed = 0;
+        for (int i = 0; i < RUNS; i++) {
+            tool_pose_t pose;
+            tool_pose_at(&pose, vec3(0.2f * cosf(0.4f * (float)i), 0.2f * sinf(0.4f * (float)i), 0.0f));
+            memset(&st, 0, sizeof(st));
+            const double t0 = now_ms();
+            tool_apply(&f, &t, &pose, &p, &u, &st);
+            ms[i] = now_ms() - t0;
+            computed = st.coefs_changed;
+        }
+        printf("  %-6s  %4d / %4zu                       %-33s  %7.3f ms\n", rows[r].name, rows[r].corners,
+               computed, rows[r].paper, median(ms, RUNS));
+        undo_free(&u);
+        field_free(&f);
+    }
+}
+
+int main(void)
+{
+    table1();
+    table2();
+    ferley();
+    return 0;
+}

@@ -1,0 +1,308 @@
+/* Density-spring dynamics on coefficients: explicit vs implicit equilibrium, implicit stability
+ * at 10x the explicit limit, CG residual, adaptive step, constraints, window, painted material. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/model/constraints.h"
+#include "host/model/material.h"
+#include "host/model/physwin.h"
+#include "host/model/solver.h"
+
+static void make_region(solver_t *s, bspline_t *b, const solver_cfg_t *cfg)
+{
+    const int32_t n[3] = {8, 8, 8}, ns[3] = {12, 12, 12};
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    assert_int_equal(bspline_init_uniform(b, n, lo, hi), ARGIL_OK);
+    for (int i = 0; i < 512; i++)
+        b->coef[i] = 0.3f;
+    assert_int_equal(solver_init_patch(s, b, ns, cfg), ARGIL_OK);
+    /* a constant load on a few samples */
+    for (int32_t z = 4; z < 7; z++)
+        for (int32_t y = 5; y < 8; y++)
+            s->force_n[5 + 12 * (y + 12 * z)] = 0.5f;
+}
+
+static double disp_norm(const float *a, const float *b, size_t n)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; i++)
+        v += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+    return sqrt(v);
+}
+
+static void test_explicit_and_implicit_agree_at_equilibrium(void **state)
+{
+    (void)state;
+    solver_cfg_t cfg;
+    solver_cfg_default(&cfg);
+    cfg.acc_threshold = INFINITY;
+    bspline_t b;
+    solver_t ex, im;
+    make_region(&ex, &b, &cfg);
+    const float dtmax = solver_explicit_dt_max_s(&ex);
+    assert_true(dtmax > 0.0f && isfinite(dtmax));
+    ex.cfg.dt_s = ex.dt_prev_s = 0.8f * dtmax;
+    for (int i = 0; i < 1500; i++)
+        assert_int_equal(solver_step_explicit(&ex), ARGIL_OK);
+    cfg.dt_s = 0.1f;
+    cfg.cg_tol = 1e-8f; /* converge fully: this test compares equilibria */
+    bspline_free(&b);
+    make_region(&im, &b, &cfg);
+    bspline_free(&b);
+    for (int i = 0; i < 300; i++) {
+        assert_int_equal(solver_step_implicit(&im), ARGIL_OK);
+        assert_true(im.stats.cg_iters <= SOLVER_CG_ITERS_MAX);
+    }
+    assert_true(im.stats.residual < 1e-4f);
+    float *p0 = calloc(im.ncoef, sizeof(float));
+    for (size_t i = 0; i < im.ncoef; i++)
+        p0[i] = 0.3f;
+    const double d = disp_norm(ex.p, im.p, im.ncoef), m = disp_norm(im.p, p0, im.ncoef);
+    assert_true(m > 1e-3);          /* the load moved the clay */
+    assert_true(d / m < 0.01);      /* same static equilibrium within 1 % */
+    free(p0);
+    solver_free(&ex);
+    solver_free(&im);
+}
+
+static double max_abs_dev(const solver_t *s)
+{
+    double m = 0.0;
+    for (size_t i = 0; i < s->ncoef; i++)
+        m = fmax(m, fabs((double)s->p[i] - 0.3));
+    return m;
+}
+
+static void test_implicit_stable_at_ten_times_explicit_limit(void **state)
+{
+    (void)state;
+    solver_cfg_t cfg;
+    solver_cfg_default(&cfg);
+    cfg.acc_threshold = INFINITY;
+    bspline_t b;
+    solver_t s;
+    make_region(&s, &b, &cfg);
+    const float dtmax = solver_explicit_dt_max_s(&s);
+    s.cfg.dt_s = s.dt_prev_s = 2.0f * dtmax; /* the explicit solver blows up beyond its limit */
+    for (int i = 0; i < 300 && max_abs_dev(&s) < 1e3; i++)
+        if (solver_step_explicit(&s) != ARGIL_OK)
+            break;
+    assert_true(!(max_abs_dev(&s) < 1e3));
+    solver_free(&s);
+    bspline_free(&b);
+    make_region(&s, &b, &cfg);
+    s.cfg.dt_s = s.dt_prev_s = 10.0f * dtmax;
+    double last = 0.0;
+    for (int i = 0; i < 300; i++) {
+        assert_int_equal(solver_step_implicit(&s), ARGIL_OK);
+        last = max_abs_dev(&s);
+        assert_true(last < 1.0);
+    }
+    assert_true(last > 1e-3);
+    solver_free(&s);
+    bspline_free(&b);
+}
+
+static void test_adaptive_step_halves(void **state)
+{
+    (void)state;
+    solver_cfg_t cfg;
+    solver_cfg_default(&cfg);
+    cfg.dt_s = 0.01f;
+    cfg.acc_threshold = 1.0f; /* tiny: forces halving */
+    bspline_t b;
+    solver_t s;
+    make_region(&s, &b, &cfg);
+    assert_int_equal(solver_step_implicit(&s), ARGIL_OK);
+    assert_true(s.stats.halvings > 0);
+    assert_true(s.cfg.dt_s < 0.01f);
+    assert_true(s.stats.max_acc <= 1.0f || s.cfg.dt_s * 0.5f < s.cfg.dt_min_s);
+    solver_free(&s);
+    bspline_free(&b);
+    cfg.dt_s = 0.0f;
+    assert_int_equal(solver_init_patch(&s, &b, (const int32_t[3]){4, 4, 4}, &cfg), ARGIL_ERR_ARG);
+}
+
+static float sd_ball(void *ctx, vec3_t x)
+{
+    (void)ctx;
+    return 0.06f - vec3_norm(x);
+}
+
+static void make_ball(field_t *f)
+{
+    assert_int_equal(field_init(f, 0.01f, 2, vec3(0, 0, 0)), ARGIL_OK);
+    assert_int_equal(field_fill(f, sd_ball, NULL, vec3(-0.12f, -0.12f, -0.12f), vec3(0.12f, 0.12f, 0.12f)), ARGIL_OK);
+}
+
+static double inside_volume(const field_t *f)
+{
+    const int32_t lo[3] = {-22, -22, -22}, dims[3] = {45, 45, 45};
+    const size_t n = (size_t)dims[0] * dims[1] * dims[2];
+    float *d = malloc(n * sizeof(float));
+    sparse_read_box(&f->samp, FS_D, lo, dims, d);
+    double v = 0.0;
+    for (size_t i = 0; i < n; i++)
+        v += d[i] > f->iso ? 1.0 : 0.0;
+    free(d);
+    return v * pow(f->sample_spacing_m, 3);
+}
+
+static const int32_t whole_lo[3] = {-9, -9, -9}, whole_hi[3] = {10, 10, 10};
+
+static void run_window_box(field_t *f, int steps, const int32_t clo[3], const int32_t chi[3])
+{
+    physwin_t w;
+    solver_cfg_t cfg;
+    solver_cfg_default(&cfg);
+    cfg.dt_s = 0.05f;
+    assert_int_equal(physwin_open(&w, f, clo, chi, &cfg), ARGIL_OK);
+    for (int i = 0; i < steps; i++)
+        assert_int_equal(solver_step_implicit(&w.solver), ARGIL_OK);
+    assert_int_equal(physwin_store(&w, f), ARGIL_OK);
+    physwin_close(&w);
+}
+
+static void run_window(field_t *f, int steps)
+{
+    run_window_box(f, steps, whole_lo, whole_hi);
+}
+
+static void test_window_at_rest_stays_and_outside_is_fixed(void **state)
+{
+    (void)state;
+    field_t f;
+    make_ball(&f);
+    const float out_before = sparse_get(&f.coef, FC_P, 11, 0, 0);
+    const float d_before = sparse_get(&f.samp, FS_D, 0, 0, 12);
+    run_window(&f, 20);
+    assert_float_equal(sparse_get(&f.samp, FS_D, 0, 0, 12), d_before, 1e-4); /* at rest: no motion */
+    assert_true(sparse_get(&f.coef, FC_P, 11, 0, 0) == out_before);
+    field_free(&f);
+}
+
+static void test_inflate_increases_volume(void **state)
+{
+    (void)state;
+    field_t f;
+    make_ball(&f);
+    const double v0 = inside_volume(&f);
+    undo_t u;
+    undo_init(&u, 1u << 24);
+    assert_int_equal(material_paint(&f, FS_RESTLEN, vec3(0, 0, 0), 0.1f, 0.3f, MATERIAL_ADD, &u), ARGIL_OK);
+    run_window(&f, 15);
+    const double v1 = inside_volume(&f);
+    assert_true(v1 > v0 * 1.05);
+    /* deflate the other way */
+    field_t g;
+    make_ball(&g);
+    assert_int_equal(material_paint(&g, FS_RESTLEN, vec3(0, 0, 0), 0.1f, -0.3f, MATERIAL_ADD, NULL), ARGIL_OK);
+    run_window(&g, 15);
+    assert_true(inside_volume(&g) < v0 * 0.95);
+    /* reset rest shape: the inflated shape becomes permanent and stays */
+    const int32_t slo[3] = {-30, -30, -30}, shi[3] = {30, 30, 30};
+    assert_int_equal(material_reset_rest(&f, slo, shi, &u), ARGIL_OK);
+    run_window(&f, 10);
+    assert_float_equal(inside_volume(&f), v1, 0.02 * v1);
+    assert_int_equal(material_paint(&f, FS_D, vec3(0, 0, 0), 0.1f, 1.0f, MATERIAL_ADD, NULL), ARGIL_ERR_ARG);
+    undo_free(&u);
+    field_free(&f);
+    field_free(&g);
+}
+
+/* Surface displacement (m) along +x at y = z = 0 after pushing inward with a constant force. */
+static float push_displacement(float stiff_scale)
+{
+    field_t f;
+    make_ball(&f);
+    if (stiff_scale != 1.0f)
+        assert_int_equal(material_paint(&f, FS_STIFF, vec3(0, 0, 0), 1.0f, stiff_scale, MATERIAL_SCALE, NULL), ARGIL_OK);
+    float x0 = 0.0f;
+    for (float x = 0.0f; x < 0.1f; x += 0.0002f)
+        if (field_eval(&f, vec3(x, 0, 0), NULL) < f.iso) {
+            x0 = x;
+            break;
+        }
+    for (int32_t z = -1; z <= 1; z++)
+        for (int32_t y = -1; y <= 1; y++)
+            for (int32_t x = 10; x <= 13; x++)
+                assert_int_equal(sparse_set(&f.samp, FS_FORCE, x, y, z, -0.2f), ARGIL_OK);
+    const int32_t lo[3] = {1, -5, -5}, hi[3] = {11, 6, 6}; /* a physical window round the push */
+    run_window_box(&f, 40, lo, hi);
+    float x1 = 0.0f;
+    for (float x = 0.0f; x < 0.1f; x += 0.0002f)
+        if (field_eval(&f, vec3(x, 0, 0), NULL) < f.iso) {
+            x1 = x;
+            break;
+        }
+    field_free(&f);
+    return x0 - x1;
+}
+
+static void test_stiffness_four_times_moves_a_third(void **state)
+{
+    (void)state;
+    const float soft = push_displacement(1.0f), hard = push_displacement(4.0f);
+    assert_true(soft > 0.002f); /* the push dents the surface by > 2 mm */
+    assert_true(hard <= soft / 3.0f);
+}
+
+static void test_constraints_hold(void **state)
+{
+    (void)state;
+    field_t f;
+    make_ball(&f);
+    physwin_t w;
+    solver_cfg_t cfg;
+    solver_cfg_default(&cfg);
+    cfg.dt_s = 0.05f;
+    const int32_t clo[3] = {-9, -9, -9}, chi[3] = {10, 10, 10};
+    assert_int_equal(physwin_open(&w, &f, clo, chi, &cfg), ARGIL_OK);
+    for (size_t i = 0; i < w.solver.nsamp; i++)
+        w.solver.force_n[i] = 0.3f; /* everything swells */
+    const vec3_t hard_at = vec3(0.065f, 0.0f, 0.0f), soft_at = vec3(0.0f, 0.065f, 0.0f);
+    assert_int_equal(constraint_hard_point(&w, &f, hard_at, f.iso), ARGIL_OK);
+    assert_int_equal(constraint_point(&w, &f, soft_at, f.iso, 2000.0f), ARGIL_OK);
+    const vec3_t curve[2] = {vec3(-0.02f, 0.0f, 0.064f), vec3(0.02f, 0.0f, 0.064f)};
+    assert_int_equal(constraint_curve(&w, &f, curve, 2, f.iso, 2000.0f, 0.005f), ARGIL_OK);
+    assert_int_equal(constraint_hard_point(&w, &f, hard_at, f.iso), ARGIL_ERR_ARG); /* same pivot */
+    for (int i = 0; i < 40; i++)
+        assert_int_equal(solver_step_implicit(&w.solver), ARGIL_OK);
+    assert_int_equal(physwin_store(&w, &f), ARGIL_OK);
+    assert_float_equal(field_eval(&f, hard_at, NULL), f.iso, 1e-4);
+    const float free_pt = field_eval(&f, vec3(0.0f, -0.065f, 0.0f), NULL);
+    assert_true(free_pt > f.iso + 0.05f); /* unconstrained side swelled */
+    assert_true(fabsf(field_eval(&f, soft_at, NULL) - f.iso) < 0.3f * (free_pt - f.iso));
+    assert_true(fabsf(field_eval(&f, vec3(0.0f, 0.0f, 0.064f), NULL) - f.iso) < 0.3f * (free_pt - f.iso));
+    physwin_close(&w);
+    /* fixed points do not move */
+    assert_int_equal(material_fix(&f, vec3(0.06f, 0.0f, 0.0f), 0.015f, true, NULL), ARGIL_OK);
+    const float fixed_p = sparse_get(&f.coef, FC_P, 6, 0, 0);
+    assert_true(sparse_get(&f.coef, FC_FIXED, 6, 0, 0) == 1.0f);
+    for (int32_t x = 0; x < 20; x++)
+        assert_int_equal(sparse_set(&f.samp, FS_FORCE, x, 0, 0, 0.2f), ARGIL_OK);
+    run_window(&f, 10);
+    assert_true(sparse_get(&f.coef, FC_P, 6, 0, 0) == fixed_p);
+    field_free(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_explicit_and_implicit_agree_at_equilibrium),
+        cmocka_unit_test(test_implicit_stable_at_ten_times_explicit_limit),
+        cmocka_unit_test(test_adaptive_step_halves),
+        cmocka_unit_test(test_window_at_rest_stays_and_outside_is_fixed),
+        cmocka_unit_test(test_inflate_increases_volume),
+        cmocka_unit_test(test_stiffness_four_times_moves_a_third),
+        cmocka_unit_test(test_constraints_hold),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
