@@ -4,5 +4,8 @@
 #define ARGIL_COMMANDS_H
 
 int cmd_sculpt(int argc, char **argv);
+int cmd_mesh(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_fit(int argc, char **argv);
 
 #endif

@@ -26,6 +26,9 @@ static const struct {
     const char *summary;
 } COMMANDS[] = {
     {"sculpt", cmd_sculpt, "run a sculpting session (see 'argil sculpt --help')"},
+    {"fit", cmd_fit, "fit a point cloud, mesh or volume into a model (see 'argil fit --help')"},
+    {"mesh", cmd_mesh, "write a model's surface as PLY, STL or OBJ (see 'argil mesh --help')"},
+    {"info", cmd_info, "describe a model, mesh, point cloud or volume file"},
 };
 
 static void usage_main(FILE *f)

@@ -10,6 +10,8 @@ void mesh_init(mesh_t *m)
     m->pos = NULL;
     m->normal = NULL;
     m->tri = NULL;
+    m->rgb = NULL;
+    m->has_rgb = 0;
     m->n_vert = 0;
     m->n_tri = 0;
     m->cap_vert = 0;
@@ -21,6 +23,7 @@ void mesh_free(mesh_t *m)
     free(m->pos);
     free(m->normal);
     free(m->tri);
+    free(m->rgb);
     mesh_init(m);
 }
 
@@ -57,6 +60,12 @@ argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri)
         if (n == NULL)
             return ARGIL_ERR_NOMEM; /* pos grew already; cap_vert stays, which is safe */
         m->normal = n;
+        if (m->has_rgb) {
+            uint8_t *c = realloc(m->rgb, cap * 3);
+            if (c == NULL)
+                return ARGIL_ERR_NOMEM;
+            m->rgb = c;
+        }
         m->cap_vert = cap;
     }
     if (n_tri > m->cap_tri) {
@@ -67,6 +76,43 @@ argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri)
         m->tri = t;
         m->cap_tri = cap;
     }
+    return ARGIL_OK;
+}
+
+argil_err_t mesh_enable_rgb(mesh_t *m)
+{
+    if (m->has_rgb)
+        return ARGIL_OK;
+    const size_t cap = m->cap_vert > 0 ? m->cap_vert : 1;
+    uint8_t *c = malloc(cap * 3);
+    if (c == NULL)
+        return ARGIL_ERR_NOMEM;
+    for (size_t i = 0; i < 3 * m->n_vert; i++)
+        c[i] = 128;
+    m->rgb = c;
+    m->has_rgb = 1;
+    if (m->cap_vert == 0) {
+        /* keep rgb's size in step with cap_vert from the first growth on */
+        free(m->rgb);
+        m->rgb = NULL;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t mesh_add_vertex_rgb(mesh_t *m, vec3_t pos_m, vec3_t normal, const uint8_t rgb[3],
+                                uint32_t *index_out)
+{
+    if (!m->has_rgb)
+        return ARGIL_ERR_STATE;
+    uint32_t id;
+    argil_err_t e = mesh_add_vertex(m, pos_m, normal, &id);
+    if (e != ARGIL_OK)
+        return e;
+    m->rgb[3 * (size_t)id] = rgb[0];
+    m->rgb[3 * (size_t)id + 1] = rgb[1];
+    m->rgb[3 * (size_t)id + 2] = rgb[2];
+    if (index_out != NULL)
+        *index_out = id;
     return ARGIL_OK;
 }
 
@@ -87,6 +133,10 @@ argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *in
     n[0] = normal.x;
     n[1] = normal.y;
     n[2] = normal.z;
+    if (m->has_rgb) {
+        uint8_t *c = m->rgb + 3 * m->n_vert;
+        c[0] = c[1] = c[2] = 128;
+    }
     if (index_out != NULL)
         *index_out = (uint32_t)m->n_vert;
     m->n_vert++;

@@ -12,7 +12,9 @@ typedef struct {
     float *pos;      /* xyz per vertex, model-space m */
     float *normal;   /* xyz per vertex, unit, outward */
     uint32_t *tri;   /* 3 vertex indices per triangle, CCW seen from outside */
+    uint8_t *rgb;    /* r g b per vertex (painted material) when has_rgb, else NULL */
     size_t n_vert, n_tri, cap_vert, cap_tri;
+    int has_rgb;     /* set by mesh_enable_rgb: rgb grows with the vertices */
 } mesh_t;
 
 /* Makes m an empty mesh that owns no memory. */
@@ -28,8 +30,15 @@ void mesh_clear(mesh_t *m);
  * ARGIL_ERR_ARG beyond 2^32 vertices); the contents are kept. */
 argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri);
 
+/* Gives m a colour per vertex (existing vertices become mid grey 128); ARGIL_ERR_NOMEM. */
+argil_err_t mesh_enable_rgb(mesh_t *m);
+
 /* Appends a vertex and stores its index in *index_out (may be NULL). */
 argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *index_out);
+
+/* Appends a vertex with colour rgb (mesh_enable_rgb first, else ARGIL_ERR_STATE). */
+argil_err_t mesh_add_vertex_rgb(mesh_t *m, vec3_t pos_m, vec3_t normal, const uint8_t rgb[3],
+                                uint32_t *index_out);
 
 /* Appends triangle (a, b, c); ARGIL_ERR_ARG when an index names no vertex. */
 argil_err_t mesh_add_triangle(mesh_t *m, uint32_t a, uint32_t b, uint32_t c);

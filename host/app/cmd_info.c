@@ -1,0 +1,104 @@
+/* argil info: what a file holds (model, mesh, point cloud or volume), or why it cannot be read. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+#include "host/app/commands.h"
+#include "host/io/argil_file.h"
+#include "host/io/mesh_import.h"
+#include "host/io/volume.h"
+#include "host/mesh/mesh_check.h"
+
+static void usage_info(FILE *f)
+{
+    fprintf(f, "usage: argil info FILE\n\n"
+               "Prints what FILE holds: a model (.argil: grid, iso, material, tool, RBF form), a\n"
+               "mesh or point cloud (.ply .stl .obj .xyz .txt .pts: counts, bounds, normals,\n"
+               "colours, watertightness, volume) or a volume (.nrrd .nhdr: size, spacing, range).\n"
+               "A file that cannot be read gives one line naming the file, where and why.\n");
+}
+
+static int has_ext(const char *p, const char *e)
+{
+    const char *dot = strrchr(p, '.');
+    return dot != NULL && strcasecmp(dot, e) == 0;
+}
+
+int cmd_info(int argc, char **argv)
+{
+    if (argc != 1 || strcmp(argv[0], "-h") == 0 || strcmp(argv[0], "--help") == 0) {
+        usage_info(argc == 1 ? stdout : stderr);
+        return argc == 1 ? 0 : 2;
+    }
+    const char *path = argv[0];
+    char err[1024];
+    if (has_ext(path, ".argil")) {
+        argil_doc_t d;
+        if (argil_file_read(path, &d, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil info: %s\n", err);
+            return 1;
+        }
+        const grid_t *g = &d.grid;
+        printf("%s: argil model, format version %u\n", path, ARGIL_FILE_VERSION);
+        printf("  grid      %d x %d x %d samples, spacing %.4g mm, origin (%.4g, %.4g, %.4g) mm\n",
+               g->dims[0], g->dims[1], g->dims[2], g->spacing_m * 1e3, g->origin_m.x * 1e3,
+               g->origin_m.y * 1e3, g->origin_m.z * 1e3);
+        printf("  surface   iso %.3g, band %.4g mm, colours %s\n", g->iso, g->band_m * 1e3,
+               d.rgb != NULL ? "painted" : "none");
+        printf("  material  mass %g, stiffness %g, coupling %g, damping %g, plastic %g Hz\n",
+               g->material.node_mass, g->material.stiffness, g->material.coupling,
+               g->material.damping, g->material.plastic_rate_hz);
+        printf("  tool      kind %u, radius %.4g mm, strength %.3g\n", d.tool.tool_kind,
+               d.tool.radius_m * 1e3, d.tool.strength);
+        if (d.has_rbf)
+            printf("  rbf       %u centres (%u bytes), fit error rms %.4g mm, max %.4g mm\n",
+                   d.rbf.n, 28 + 16 * d.rbf.n, d.rbf.rms_err_m * 1e3, d.rbf.max_err_m * 1e3);
+        argil_doc_free(&d);
+        return 0;
+    }
+    if (has_ext(path, ".nrrd") || has_ext(path, ".nhdr")) {
+        volume_t v;
+        if (volume_read_nrrd(path, &v, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil info: %s\n", err);
+            return 1;
+        }
+        const size_t n = (size_t)v.dims[0] * (size_t)v.dims[1] * (size_t)v.dims[2];
+        float lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < n; i++) {
+            lo = fminf(lo, v.value[i]);
+            hi = fmaxf(hi, v.value[i]);
+        }
+        printf("%s: volume %d x %d x %d, spacing %g %g %g, values %g .. %g\n", path, v.dims[0],
+               v.dims[1], v.dims[2], v.spacing_m[0], v.spacing_m[1], v.spacing_m[2], lo, hi);
+        volume_free(&v);
+        return 0;
+    }
+    mesh_t m;
+    mesh_init(&m);
+    bool normals = false;
+    if (mesh_import(path, &m, &normals, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil info: %s\n", err);
+        mesh_free(&m);
+        return 1;
+    }
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < m.n_vert; i++)
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fminf(lo[a], m.pos[3 * i + (size_t)a]);
+            hi[a] = fmaxf(hi[a], m.pos[3 * i + (size_t)a]);
+        }
+    if (m.n_tri > 0) {
+        size_t boundary = 0, nonman = 0;
+        const bool closed = mesh_watertight(&m, &boundary, &nonman);
+        printf("%s: mesh, %zu vertices, %zu triangles, %s (%zu boundary, %zu non-manifold edges), "
+               "volume %.6g\n", path, m.n_vert, m.n_tri, closed ? "watertight" : "open", boundary,
+               nonman, mesh_volume_m3(&m));
+    } else {
+        printf("%s: point cloud, %zu points\n", path, m.n_vert);
+    }
+    printf("  bounds    (%g, %g, %g) .. (%g, %g, %g)\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    printf("  normals   %s, colours %s\n", normals ? "yes" : "no", m.has_rgb ? "yes" : "no");
+    mesh_free(&m);
+    return 0;
+}

@@ -1,0 +1,438 @@
+/* .argil reader and writer. Every field is encoded little-endian byte by byte; the reader checks
+ * the header CRC, the declared length against the real file size, the whole-file CRC and every
+ * section's CRC and size before it allocates or decodes anything. */
+#include "host/io/argil_file.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/io/io_util.h"
+#include "shared/crc32c.h"
+
+static const uint8_t AF_MAGIC[8] = {'A', 'R', 'G', 'I', 'L', '\r', '\n', 0x1a};
+#define AF_SEC_OVERHEAD 16u /* tag 4 + length 8 + crc 4 */
+
+void argil_doc_init(argil_doc_t *d)
+{
+    memset(d, 0, sizeof(*d));
+    d->tool.radius_m = 0.005f;
+    d->tool.strength = 0.5f;
+    d->tool.paint_rgb[0] = 200;
+    d->tool.paint_rgb[1] = 80;
+    d->tool.paint_rgb[2] = 40;
+    d->state.device_scale = 1.0f;
+}
+
+void argil_doc_free(argil_doc_t *d)
+{
+    if (d->grid.density != NULL)
+        grid_free(&d->grid);
+    free(d->rgb);
+    rbf_free(&d->rbf);
+    argil_doc_init(d);
+}
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    io_put_u32le(p, (uint32_t)v);
+    io_put_u32le(p + 4, (uint32_t)(v >> 32));
+}
+
+static uint64_t get_u64(const uint8_t *p)
+{
+    return (uint64_t)io_get_u32le(p) | (uint64_t)io_get_u32le(p + 4) << 32;
+}
+
+/* ------------------------------------------------------------------ writer */
+
+typedef struct {
+    const argil_doc_t *d;
+    size_t n; /* samples */
+} af_wctx_t;
+
+typedef struct {
+    FILE *f;
+    uint32_t file_crc, sec_crc;
+    bool bad;
+} af_out_t;
+
+static void af_put(af_out_t *o, const void *p, size_t n)
+{
+    if (o->bad || n == 0)
+        return;
+    o->file_crc = crc32c(o->file_crc, p, n);
+    o->sec_crc = crc32c(o->sec_crc, p, n);
+    if (fwrite(p, 1, n, o->f) != n)
+        o->bad = true;
+}
+
+static void af_begin(af_out_t *o, const char tag[4], uint64_t len)
+{
+    uint8_t h[12];
+    memcpy(h, tag, 4);
+    put_u64(h + 4, len);
+    o->sec_crc = 0;
+    af_put(o, h, 12);
+}
+
+static void af_end(af_out_t *o)
+{
+    uint8_t c[4];
+    io_put_u32le(c, o->sec_crc);
+    af_put(o, c, 4);
+}
+
+static void af_put_f32s(af_out_t *o, const float *v, size_t n)
+{
+    uint8_t buf[4096];
+    size_t used = 0;
+    for (size_t i = 0; i < n; i++) {
+        io_put_f32le(buf + used, v[i]);
+        used += 4;
+        if (used == sizeof(buf)) {
+            af_put(o, buf, used);
+            used = 0;
+        }
+    }
+    af_put(o, buf, used);
+}
+
+static uint64_t af_grid_bytes(size_t n)
+{
+    return 36u + 4u * (uint64_t)n;
+}
+
+static const char *af_write_body(FILE *f, const void *vctx)
+{
+    const af_wctx_t *c = vctx;
+    const argil_doc_t *d = c->d;
+    const grid_t *g = &d->grid;
+    af_out_t o = {f, 0, 0, false};
+    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0);
+    uint64_t total = ARGIL_FILE_HEADER_BYTES + 4;
+    total += AF_SEC_OVERHEAD + af_grid_bytes(c->n);
+    total += AF_SEC_OVERHEAD + 20 + AF_SEC_OVERHEAD + 16 + AF_SEC_OVERHEAD + 20;
+    if (d->rgb != NULL)
+        total += AF_SEC_OVERHEAD + 3u * (uint64_t)c->n;
+    if (d->has_rbf)
+        total += AF_SEC_OVERHEAD + 28u + 16u * (uint64_t)d->rbf.n;
+    uint8_t h[ARGIL_FILE_HEADER_BYTES] = {0};
+    memcpy(h, AF_MAGIC, 8);
+    io_put_u32le(h + 8, ARGIL_FILE_VERSION);
+    io_put_u32le(h + 12, n_sec);
+    put_u64(h + 16, total);
+    io_put_u32le(h + 28, crc32c(0, h, 28));
+    af_put(&o, h, sizeof(h));
+
+    uint8_t b[64];
+    af_begin(&o, "GRID", af_grid_bytes(c->n));
+    for (int a = 0; a < 3; a++)
+        io_put_u32le(b + 4 * a, (uint32_t)g->dims[a]);
+    const float gf[6] = {g->spacing_m, g->origin_m.x, g->origin_m.y, g->origin_m.z, g->iso,
+                         g->band_m};
+    for (int k = 0; k < 6; k++)
+        io_put_f32le(b + 12 + 4 * k, gf[k]);
+    af_put(&o, b, 36);
+    af_put_f32s(&o, g->density, c->n);
+    af_end(&o);
+
+    af_begin(&o, "MATL", 20);
+    const spring_material_t *m = &g->material;
+    const float mf[5] = {m->node_mass, m->stiffness, m->coupling, m->damping, m->plastic_rate_hz};
+    af_put_f32s(&o, mf, 5);
+    af_end(&o);
+
+    af_begin(&o, "TOOL", 16);
+    io_put_u32le(b, d->tool.tool_kind);
+    io_put_f32le(b + 4, d->tool.radius_m);
+    io_put_f32le(b + 8, d->tool.strength);
+    memcpy(b + 12, d->tool.paint_rgb, 3);
+    b[15] = 0;
+    af_put(&o, b, 16);
+    af_end(&o);
+
+    af_begin(&o, "STAT", 20);
+    const float sf[4] = {d->state.device_offset_m.x, d->state.device_offset_m.y,
+                         d->state.device_offset_m.z, d->state.device_scale};
+    for (int k = 0; k < 4; k++)
+        io_put_f32le(b + 4 * k, sf[k]);
+    io_put_u32le(b + 16, d->state.edits);
+    af_put(&o, b, 20);
+    af_end(&o);
+
+    if (d->rgb != NULL) {
+        af_begin(&o, "COLR", 3u * (uint64_t)c->n);
+        af_put(&o, d->rgb, 3 * c->n);
+        af_end(&o);
+    }
+    if (d->has_rbf) {
+        const rbf_model_t *r = &d->rbf;
+        af_begin(&o, "RBF3", 28u + 16u * (uint64_t)r->n);
+        io_put_u32le(b, r->n);
+        const float rf[6] = {r->poly[0], r->poly[1], r->poly[2], r->poly[3], r->rms_err_m,
+                             r->max_err_m};
+        for (int k = 0; k < 6; k++)
+            io_put_f32le(b + 4 + 4 * k, rf[k]);
+        af_put(&o, b, 28);
+        for (uint32_t i = 0; i < r->n; i++) {
+            const float cf[4] = {r->centre_m[3 * i], r->centre_m[3 * i + 1], r->centre_m[3 * i + 2],
+                                 r->weight[i]};
+            af_put_f32s(&o, cf, 4);
+        }
+        af_end(&o);
+    }
+    uint8_t t[4];
+    io_put_u32le(t, o.file_crc);
+    if (!o.bad && fwrite(t, 1, 4, f) != 4)
+        o.bad = true;
+    return o.bad ? "fwrite" : NULL;
+}
+
+static bool af_finite(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return false;
+    return true;
+}
+
+argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, size_t err_len)
+{
+    if (path == NULL || d == NULL || d->grid.density == NULL) {
+        io_err(err, err_len, "argil_file_write: no path or no model grid");
+        return ARGIL_ERR_ARG;
+    }
+    const grid_t *g = &d->grid;
+    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    const float gf[6] = {g->spacing_m, g->origin_m.x, g->origin_m.y, g->origin_m.z, g->iso,
+                         g->band_m};
+    if (!af_finite(gf, 6) || !af_finite(g->density, n) ||
+        (d->has_rbf && (!af_finite(d->rbf.centre_m, 3 * (size_t)d->rbf.n) ||
+                        !af_finite(d->rbf.weight, d->rbf.n) || !af_finite(d->rbf.poly, 4)))) {
+        io_err(err, err_len, "argil_file_write: %s: the model holds NaN or Inf", path);
+        return ARGIL_ERR_NONFINITE;
+    }
+    if (d->has_rbf && d->rbf.n > RBF_CENTRES_MAX) {
+        io_err(err, err_len, "argil_file_write: %s: RBF has too many centres", path);
+        return ARGIL_ERR_ARG;
+    }
+    const af_wctx_t c = {d, n};
+    return io_write_atomic(path, af_write_body, &c, "argil_file_write", err, err_len);
+}
+
+/* ------------------------------------------------------------------ reader */
+
+typedef struct {
+    const char *path;
+    char *err;
+    size_t err_len;
+} af_rctx_t;
+
+static argil_err_t af_fail(const af_rctx_t *c, size_t off, const char *rule)
+{
+    io_err(c->err, c->err_len, "%s: byte %zu: %s", c->path, off, rule);
+    return ARGIL_ERR_PARSE;
+}
+
+static void af_get_f32s(const uint8_t *p, float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        v[i] = io_get_f32le(p + 4 * i);
+}
+
+/* Decodes the GRID section payload (len bytes at p, file offset off). */
+static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
+                           argil_doc_t *d)
+{
+    if (len < 36)
+        return af_fail(c, off, "GRID section shorter than its 36-byte head");
+    int32_t dims[3];
+    uint64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        dims[a] = (int32_t)io_get_u32le(p + 4 * a);
+        if (dims[a] < 1)
+            return af_fail(c, off + 4 * (size_t)a, "GRID dimension below 1");
+        n *= (uint64_t)dims[a];
+        if (n > (uint64_t)GRID_SAMPLES_MAX)
+            return af_fail(c, off + 4 * (size_t)a, "GRID holds more than 2^30 samples");
+    }
+    if (len != af_grid_bytes((size_t)n))
+        return af_fail(c, off, "GRID section length does not match its dimensions");
+    float gf[6];
+    af_get_f32s(p + 12, gf, 6);
+    if (!af_finite(gf, 6) || !(gf[0] > 0) || !(gf[5] > 0))
+        return af_fail(c, off + 12, "GRID spacing, origin, iso or band not finite (or not > 0)");
+    if (grid_init(&d->grid, dims, gf[0], vec3(gf[1], gf[2], gf[3])) != ARGIL_OK) {
+        io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
+               (unsigned long long)n);
+        return ARGIL_ERR_NOMEM;
+    }
+    d->grid.iso = gf[4];
+    d->grid.band_m = gf[5];
+    for (size_t i = 0; i < (size_t)n; i++) {
+        const float v = io_get_f32le(p + 36 + 4 * i);
+        if (!isfinite(v) || v < 0.0f || v > 1.0f)
+            return af_fail(c, off + 36 + 4 * i, "GRID density not a finite number in [0, 1]");
+        d->grid.density[i] = d->grid.rest[i] = v;
+    }
+    return ARGIL_OK;
+}
+
+static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, argil_doc_t *d)
+{
+    if (len < ARGIL_FILE_HEADER_BYTES + 4)
+        return af_fail(c, len, "file shorter than the 32-byte header and 4-byte checksum");
+    if (memcmp(b, AF_MAGIC, 8) != 0)
+        return af_fail(c, 0, "not an .argil file (magic \"ARGIL\\r\\n\\x1a\")");
+    if (io_get_u32le(b + 28) != crc32c(0, b, 28))
+        return af_fail(c, 28, "header checksum mismatch (file corrupted)");
+    const uint32_t version = io_get_u32le(b + 8);
+    if (version == 0 || version > ARGIL_FILE_VERSION) {
+        io_err(c->err, c->err_len, "%s: byte 8: format version %u; this argil reads 1..%u", c->path,
+               version, ARGIL_FILE_VERSION);
+        return ARGIL_ERR_PARSE;
+    }
+    const uint32_t n_sec = io_get_u32le(b + 12);
+    if (n_sec < 1 || n_sec > ARGIL_FILE_SECTIONS_MAX)
+        return af_fail(c, 12, "section count not in 1..64");
+    if (get_u64(b + 16) != (uint64_t)len)
+        return af_fail(c, 16, "declared file length differs from the real size (truncated or "
+                              "extended)");
+    if (io_get_u32le(b + len - 4) != crc32c(0, b, len - 4))
+        return af_fail(c, len - 4, "file checksum mismatch (file corrupted)");
+    size_t pos = ARGIL_FILE_HEADER_BYTES;
+    bool seen_grid = false, seen_matl = false, seen_tool = false, seen_stat = false;
+    spring_material_t matl;
+    spring_material_default(&matl);
+    const uint8_t *colr = NULL;
+    uint64_t colr_len = 0;
+    size_t colr_off = 0;
+    for (uint32_t s = 0; s < n_sec; s++) {
+        const size_t end = len - 4;
+        if (end - pos < AF_SEC_OVERHEAD)
+            return af_fail(c, pos, "section head runs past the end of the file");
+        const uint64_t sl = get_u64(b + pos + 4);
+        if (sl > (uint64_t)(end - pos - AF_SEC_OVERHEAD))
+            return af_fail(c, pos + 4, "section length runs past the end of the file");
+        const uint8_t *p = b + pos + 12;
+        const size_t crc_off = pos + 12 + (size_t)sl;
+        if (io_get_u32le(b + crc_off) != crc32c(0, b + pos, 12 + (size_t)sl))
+            return af_fail(c, crc_off, "section checksum mismatch (file corrupted)");
+        const size_t off = pos + 12;
+        char tag[5] = {0};
+        memcpy(tag, b + pos, 4);
+        argil_err_t e = ARGIL_OK;
+        if (strcmp(tag, "GRID") == 0) {
+            if (seen_grid)
+                return af_fail(c, pos, "second GRID section");
+            seen_grid = true;
+            e = af_grid(c, p, sl, off, d);
+        } else if (strcmp(tag, "MATL") == 0) {
+            if (seen_matl || sl != 20)
+                return af_fail(c, pos, "MATL section repeated or not 20 bytes");
+            seen_matl = true;
+            float mf[5];
+            af_get_f32s(p, mf, 5);
+            spring_material_t m = {mf[0], mf[1], mf[2], mf[3], mf[4]};
+            if (!spring_material_valid(&m))
+                return af_fail(c, off, "MATL values out of range (mass > 0, others >= 0, finite)");
+            matl = m; /* applied once the grid exists (sections may come in any order) */
+        } else if (strcmp(tag, "TOOL") == 0) {
+            if (seen_tool || sl != 16)
+                return af_fail(c, pos, "TOOL section repeated or not 16 bytes");
+            seen_tool = true;
+            d->tool.tool_kind = io_get_u32le(p);
+            d->tool.radius_m = io_get_f32le(p + 4);
+            d->tool.strength = io_get_f32le(p + 8);
+            memcpy(d->tool.paint_rgb, p + 12, 3);
+            if (!isfinite(d->tool.radius_m) || d->tool.radius_m < 0 ||
+                !isfinite(d->tool.strength) || d->tool.strength < 0 || d->tool.strength > 1)
+                return af_fail(c, off + 4, "TOOL radius or strength out of range");
+        } else if (strcmp(tag, "STAT") == 0) {
+            if (seen_stat || sl != 20)
+                return af_fail(c, pos, "STAT section repeated or not 20 bytes");
+            seen_stat = true;
+            float sf[4];
+            af_get_f32s(p, sf, 4);
+            if (!af_finite(sf, 4) || !(sf[3] > 0))
+                return af_fail(c, off, "STAT transform not finite (or scale not > 0)");
+            d->state.device_offset_m = vec3(sf[0], sf[1], sf[2]);
+            d->state.device_scale = sf[3];
+            d->state.edits = io_get_u32le(p + 16);
+        } else if (strcmp(tag, "COLR") == 0) {
+            if (colr != NULL)
+                return af_fail(c, pos, "second COLR section");
+            colr = p;
+            colr_len = sl;
+            colr_off = off;
+        } else if (strcmp(tag, "RBF3") == 0) {
+            if (d->has_rbf || sl < 28)
+                return af_fail(c, pos, "RBF3 section repeated or shorter than 28 bytes");
+            const uint32_t n = io_get_u32le(p);
+            if (n > RBF_CENTRES_MAX || sl != 28u + 16u * (uint64_t)n)
+                return af_fail(c, off, "RBF3 centre count out of range or not matching the "
+                                       "section length");
+            if (rbf_alloc(&d->rbf, n) != ARGIL_OK) {
+                io_err(c->err, c->err_len, "%s: out of memory", c->path);
+                return ARGIL_ERR_NOMEM;
+            }
+            d->has_rbf = true;
+            float rf[6];
+            af_get_f32s(p + 4, rf, 6);
+            memcpy(d->rbf.poly, rf, sizeof(d->rbf.poly));
+            d->rbf.rms_err_m = rf[4];
+            d->rbf.max_err_m = rf[5];
+            for (uint32_t i = 0; i < n; i++) {
+                float cf[4];
+                af_get_f32s(p + 28 + 16 * (size_t)i, cf, 4);
+                memcpy(d->rbf.centre_m + 3 * (size_t)i, cf, 3 * sizeof(float));
+                d->rbf.weight[i] = cf[3];
+            }
+            if (!af_finite(rf, 6) || !af_finite(d->rbf.centre_m, 3 * (size_t)n) ||
+                !af_finite(d->rbf.weight, n))
+                return af_fail(c, off, "RBF3 holds NaN or Inf");
+        }
+        /* other tags: a later minor revision's optional data, checked and skipped */
+        if (e != ARGIL_OK)
+            return e;
+        pos = crc_off + 4;
+    }
+    if (pos != len - 4)
+        return af_fail(c, pos, "bytes between the last section and the file checksum");
+    if (!seen_grid)
+        return af_fail(c, ARGIL_FILE_HEADER_BYTES, "no GRID section (the model)");
+    d->grid.material = matl;
+    const size_t n = (size_t)d->grid.dims[0] * (size_t)d->grid.dims[1] * (size_t)d->grid.dims[2];
+    if (colr != NULL) {
+        if (colr_len != 3u * (uint64_t)n)
+            return af_fail(c, colr_off, "COLR section is not 3 bytes per GRID sample");
+        d->rgb = malloc(3 * n);
+        if (d->rgb == NULL) {
+            io_err(c->err, c->err_len, "%s: out of memory", c->path);
+            return ARGIL_ERR_NOMEM;
+        }
+        memcpy(d->rgb, colr, 3 * n);
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t argil_file_read(const char *path, argil_doc_t *d, char *err, size_t err_len)
+{
+    if (path == NULL || d == NULL) {
+        io_err(err, err_len, "argil_file_read: no path or no document");
+        return ARGIL_ERR_ARG;
+    }
+    argil_doc_init(d);
+    uint8_t *b;
+    size_t len;
+    argil_err_t e = io_slurp(path, IO_FILE_MAX_BYTES, &b, &len, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    const af_rctx_t c = {path, err, err_len};
+    e = af_parse(&c, b, len, d);
+    free(b);
+    if (e != ARGIL_OK)
+        argil_doc_free(d);
+    return e;
+}

@@ -1,0 +1,358 @@
+/* Raw and NRRD volume readers: sizes are checked against the real data length before any
+ * allocation; every sample must be finite. */
+#include "host/io/volume.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/io/io_util.h"
+
+static const struct {
+    const char *name;
+    vol_type_t t;
+} vol_names[] = {
+    {"u8", VOL_U8},       {"uchar", VOL_U8},          {"unsigned char", VOL_U8},
+    {"uint8", VOL_U8},    {"uint8_t", VOL_U8},        {"i8", VOL_I8},
+    {"signed char", VOL_I8}, {"int8", VOL_I8},        {"int8_t", VOL_I8},
+    {"u16", VOL_U16},     {"ushort", VOL_U16},        {"unsigned short", VOL_U16},
+    {"unsigned short int", VOL_U16}, {"uint16", VOL_U16}, {"uint16_t", VOL_U16},
+    {"i16", VOL_I16},     {"short", VOL_I16},         {"short int", VOL_I16},
+    {"signed short", VOL_I16}, {"signed short int", VOL_I16}, {"int16", VOL_I16},
+    {"int16_t", VOL_I16}, {"u32", VOL_U32},           {"uint", VOL_U32},
+    {"unsigned int", VOL_U32}, {"uint32", VOL_U32},   {"uint32_t", VOL_U32},
+    {"i32", VOL_I32},     {"int", VOL_I32},           {"signed int", VOL_I32},
+    {"int32", VOL_I32},   {"int32_t", VOL_I32},       {"f32", VOL_F32},
+    {"float", VOL_F32},   {"f64", VOL_F64},           {"double", VOL_F64},
+};
+
+bool vol_type_parse(const char *name, vol_type_t *out)
+{
+    for (size_t i = 0; name != NULL && i < sizeof(vol_names) / sizeof(vol_names[0]); i++)
+        if (strcmp(name, vol_names[i].name) == 0) {
+            *out = vol_names[i].t;
+            return true;
+        }
+    return false;
+}
+
+static size_t vol_size(vol_type_t t)
+{
+    static const size_t s[] = {1, 1, 2, 2, 4, 4, 4, 8};
+    return s[t];
+}
+
+void volume_free(volume_t *v)
+{
+    free(v->value);
+    memset(v, 0, sizeof(*v));
+}
+
+/* Converts n samples at data (len bytes exactly) into out->value. */
+static argil_err_t vol_decode(const char *path, const uint8_t *data, size_t len, size_t offset,
+                              const int32_t dims[3], vol_type_t t, bool big, volume_t *out,
+                              char *err, size_t err_len)
+{
+    uint64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1 || (uint64_t)dims[a] > VOLUME_SAMPLES_MAX) {
+            io_err(err, err_len, "%s: dimension %d is %d, must be 1..2^30", path, a, dims[a]);
+            return ARGIL_ERR_ARG;
+        }
+        n *= (uint64_t)dims[a];
+        if (n > VOLUME_SAMPLES_MAX) {
+            io_err(err, err_len, "%s: %d x %d x %d samples exceed the limit of 2^30", path,
+                   dims[0], dims[1], dims[2]);
+            return ARGIL_ERR_ARG;
+        }
+    }
+    const size_t sz = vol_size(t);
+    if ((uint64_t)len != n * sz) {
+        io_err(err, err_len, "%s: byte %zu: %d x %d x %d samples of %zu bytes need %llu data "
+               "bytes, the file has %zu", path, offset, dims[0], dims[1], dims[2], sz,
+               (unsigned long long)(n * sz), len);
+        return ARGIL_ERR_PARSE;
+    }
+    float *v = malloc((size_t)n * sizeof(float));
+    if (v == NULL) {
+        io_err(err, err_len, "%s: out of memory for %llu samples", path, (unsigned long long)n);
+        return ARGIL_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < (size_t)n; i++) {
+        uint8_t b[8];
+        for (size_t k = 0; k < sz; k++)
+            b[k] = data[i * sz + (big ? sz - 1 - k : k)];
+        uint64_t u = 0;
+        for (size_t k = sz; k-- > 0;)
+            u = u << 8 | b[k];
+        double d;
+        switch (t) {
+        case VOL_U8: d = (double)(uint8_t)u; break;
+        case VOL_I8: d = (double)(int8_t)u; break;
+        case VOL_U16: d = (double)(uint16_t)u; break;
+        case VOL_I16: d = (double)(int16_t)u; break;
+        case VOL_U32: d = (double)(uint32_t)u; break;
+        case VOL_I32: d = (double)(int32_t)(uint32_t)u; break;
+        case VOL_F32: {
+            const uint32_t w = (uint32_t)u;
+            float f;
+            memcpy(&f, &w, 4);
+            d = f;
+            break;
+        }
+        default: memcpy(&d, &u, 8); break;
+        }
+        if (!isfinite(d) || fabs(d) > 3e38) {
+            io_err(err, err_len, "%s: byte %zu: sample %zu is not a finite float", path,
+                   offset + i * sz, i);
+            free(v);
+            return ARGIL_ERR_PARSE;
+        }
+        v[i] = (float)d;
+    }
+    for (int a = 0; a < 3; a++) {
+        out->dims[a] = dims[a];
+        if (!(out->spacing_m[a] > 0.0f))
+            out->spacing_m[a] = 1.0f;
+    }
+    out->value = v;
+    return ARGIL_OK;
+}
+
+argil_err_t volume_read_raw(const char *path, const int32_t dims[3], vol_type_t t, bool big_endian,
+                            volume_t *out, char *err, size_t err_len)
+{
+    if (path == NULL || dims == NULL || out == NULL || (unsigned)t > VOL_F64) {
+        io_err(err, err_len, "volume_read_raw: missing argument");
+        return ARGIL_ERR_ARG;
+    }
+    memset(out, 0, sizeof(*out));
+    uint8_t *b;
+    size_t len;
+    argil_err_t e = io_slurp(path, IO_FILE_MAX_BYTES, &b, &len, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    e = vol_decode(path, b, len, 0, dims, t, big_endian, out, err, err_len);
+    free(b);
+    if (e != ARGIL_OK)
+        volume_free(out);
+    return e;
+}
+
+/* Parses up to n numbers from s (space or comma separated, optional parentheses). */
+static int nrrd_numbers(const char *s, double *v, int n)
+{
+    char tmp[IMPORT_NUM_LINE];
+    size_t l = strlen(s);
+    if (l >= sizeof(tmp))
+        return -1;
+    for (size_t i = 0; i <= l; i++)
+        tmp[i] = (s[i] == ',' || s[i] == '(' || s[i] == ')') ? ' ' : s[i];
+    char *tok[16];
+    const int nt = io_tokens(tmp, tok, 15);
+    if (nt > n)
+        return -1;
+    for (int i = 0; i < nt; i++)
+        if (!io_parse_double(tok[i], &v[i]))
+            return -1;
+    return nt;
+}
+
+argil_err_t volume_read_nrrd(const char *path, volume_t *out, char *err, size_t err_len)
+{
+    if (path == NULL || out == NULL) {
+        io_err(err, err_len, "volume_read_nrrd: missing argument");
+        return ARGIL_ERR_ARG;
+    }
+    memset(out, 0, sizeof(*out));
+    uint8_t *b;
+    size_t len;
+    argil_err_t e = io_slurp(path, IO_FILE_MAX_BYTES, &b, &len, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    io_lines_t it = {(const char *)b, len, 0, 0, 0};
+    char line[IMPORT_NUM_LINE];
+    bool have_type = false, have_dim = false, have_sizes = false, have_enc = false, big = false,
+         have_endian = false;
+    vol_type_t t = VOL_U8;
+    int32_t dims[3] = {0, 0, 0};
+    char data_file[IMPORT_NUM_LINE] = "";
+    e = ARGIL_OK;
+    for (;;) {
+        const long n = io_next_line(&it, line, sizeof(line));
+        const size_t ln = it.line_no;
+        if (n == -1) {
+            io_err(err, err_len, "%s: line %zu: header does not end with a blank line", path, ln);
+            e = ARGIL_ERR_PARSE;
+            break;
+        }
+        if (n < 0) {
+            io_err(err, err_len, "%s: line %zu: header line %s", path, ln,
+                   n == -2 ? "longer than 255 bytes" : "contains a NUL byte");
+            e = ARGIL_ERR_PARSE;
+            break;
+        }
+        if (ln == 1) {
+            if (n != 8 || memcmp(line, "NRRD000", 7) != 0 || line[7] < '1' || line[7] > '5') {
+                io_err(err, err_len, "%s: line 1: not a NRRD file (magic NRRD0001..NRRD0005)",
+                       path);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            continue;
+        }
+        if (n == 0)
+            break; /* end of header */
+        if (line[0] == '#')
+            continue;
+        char *colon = strstr(line, ": ");
+        if (colon == NULL) {
+            if (strstr(line, ":=") != NULL)
+                continue; /* key/value pair: not needed */
+            io_err(err, err_len, "%s: line %zu: expected '<field>: <value>'", path, ln);
+            e = ARGIL_ERR_PARSE;
+            break;
+        }
+        *colon = '\0';
+        const char *key = line, *val = colon + 2;
+        double v[9];
+        if (strcmp(key, "type") == 0) {
+            if (!vol_type_parse(val, &t)) {
+                io_err(err, err_len, "%s: line %zu: unknown type '%.40s'", path, ln, val);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            have_type = true;
+        } else if (strcmp(key, "dimension") == 0) {
+            if (strcmp(val, "3") != 0) {
+                io_err(err, err_len, "%s: line %zu: dimension must be 3, got '%.20s'", path, ln,
+                       val);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            have_dim = true;
+        } else if (strcmp(key, "sizes") == 0) {
+            if (nrrd_numbers(val, v, 3) != 3 || v[0] < 1 || v[1] < 1 || v[2] < 1 ||
+                v[0] > VOLUME_SAMPLES_MAX || v[1] > VOLUME_SAMPLES_MAX ||
+                v[2] > VOLUME_SAMPLES_MAX || v[0] != floor(v[0]) || v[1] != floor(v[1]) ||
+                v[2] != floor(v[2])) {
+                io_err(err, err_len, "%s: line %zu: sizes must be three whole numbers 1..2^30",
+                       path, ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            if (v[0] * v[1] * v[2] > (double)VOLUME_SAMPLES_MAX) {
+                io_err(err, err_len, "%s: line %zu: sizes give more than 2^30 samples", path, ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            for (int a = 0; a < 3; a++)
+                dims[a] = (int32_t)v[a];
+            have_sizes = true;
+        } else if (strcmp(key, "encoding") == 0) {
+            if (strcmp(val, "raw") != 0) {
+                io_err(err, err_len, "%s: line %zu: encoding '%.20s' is not supported (only raw)",
+                       path, ln, val);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            have_enc = true;
+        } else if (strcmp(key, "endian") == 0) {
+            if (strcmp(val, "little") != 0 && strcmp(val, "big") != 0) {
+                io_err(err, err_len, "%s: line %zu: endian must be little or big", path, ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            big = val[0] == 'b';
+            have_endian = true;
+        } else if (strcmp(key, "spacings") == 0) {
+            if (nrrd_numbers(val, v, 3) != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0)) {
+                io_err(err, err_len, "%s: line %zu: spacings must be three positive numbers", path,
+                       ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            for (int a = 0; a < 3; a++)
+                out->spacing_m[a] = (float)v[a];
+        } else if (strcmp(key, "space directions") == 0) {
+            if (nrrd_numbers(val, v, 9) != 9) {
+                io_err(err, err_len, "%s: line %zu: space directions must be three vectors (x,y,z)",
+                       path, ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            for (int a = 0; a < 3; a++) {
+                const double s = sqrt(v[3 * a] * v[3 * a] + v[3 * a + 1] * v[3 * a + 1] +
+                                      v[3 * a + 2] * v[3 * a + 2]);
+                if (!(s > 0) || s > 3e38) {
+                    io_err(err, err_len, "%s: line %zu: a space direction has zero length", path, ln);
+                    e = ARGIL_ERR_PARSE;
+                    break;
+                }
+                out->spacing_m[a] = (float)s;
+            }
+            if (e != ARGIL_OK)
+                break;
+        } else if (strcmp(key, "space origin") == 0) {
+            if (nrrd_numbers(val, v, 3) != 3 || fabs(v[0]) > 3e38 || fabs(v[1]) > 3e38 ||
+                fabs(v[2]) > 3e38) {
+                io_err(err, err_len, "%s: line %zu: space origin must be one vector (x,y,z)", path,
+                       ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            out->origin_m = vec3((float)v[0], (float)v[1], (float)v[2]);
+        } else if (strcmp(key, "data file") == 0 || strcmp(key, "datafile") == 0) {
+            if (strchr(val, '/') != NULL || strchr(val, '%') != NULL || strchr(val, ' ') != NULL ||
+                val[0] == '\0' || strcmp(val, "..") == 0 || strcmp(val, ".") == 0) {
+                io_err(err, err_len, "%s: line %zu: data file must be one plain file name beside "
+                       "the header", path, ln);
+                e = ARGIL_ERR_PARSE;
+                break;
+            }
+            snprintf(data_file, sizeof(data_file), "%s", val);
+        }
+        /* other fields (space, kinds, centers, content, ...) do not change the samples */
+    }
+    if (e == ARGIL_OK && (!have_type || !have_dim || !have_sizes || !have_enc)) {
+        io_err(err, err_len, "%s: line %zu: header lacks the required field '%s'", path,
+               it.line_no, !have_type ? "type" : !have_dim ? "dimension" : !have_sizes ? "sizes"
+                                                                                    : "encoding");
+        e = ARGIL_ERR_PARSE;
+    }
+    if (e == ARGIL_OK && vol_size(t) > 1 && !have_endian) {
+        io_err(err, err_len, "%s: line %zu: header lacks 'endian' for a %zu-byte type", path,
+               it.line_no, vol_size(t));
+        e = ARGIL_ERR_PARSE;
+    }
+    if (e == ARGIL_OK) {
+        if (data_file[0] != '\0') {
+            const char *slash = strrchr(path, '/');
+            const size_t dl = slash != NULL ? (size_t)(slash - path) + 1 : 0;
+            char *dp = malloc(dl + strlen(data_file) + 1);
+            if (dp == NULL) {
+                e = ARGIL_ERR_NOMEM;
+            } else {
+                memcpy(dp, path, dl);
+                strcpy(dp + dl, data_file);
+                uint8_t *db;
+                size_t dlen;
+                char inner[384] = "";
+                e = io_slurp(dp, IO_FILE_MAX_BYTES, &db, &dlen, inner, sizeof(inner));
+                if (e == ARGIL_OK) {
+                    e = vol_decode(dp, db, dlen, 0, dims, t, big, out, inner, sizeof(inner));
+                    free(db);
+                }
+                if (e != ARGIL_OK)
+                    io_err(err, err_len, "%s: data file: %s", path, inner);
+                free(dp);
+            }
+        } else {
+            e = vol_decode(path, b + it.pos, len - it.pos, it.pos, dims, t, big, out, err, err_len);
+        }
+    }
+    free(b);
+    if (e != ARGIL_OK)
+        volume_free(out);
+    return e;
+}

@@ -1,0 +1,515 @@
+/* Block-wise marching cubes: each block copies its samples (plus a one-sample halo for the
+ * central-difference normals) into scratch arrays, skips itself when every corner is on one side,
+ * and otherwise triangulates its cells with the shared case table. A vertex depends only on its
+ * global grid edge, so the same edge meshed from two blocks gives bit-identical vertices and the
+ * assembly joins them by edge id. */
+#include "host/mesh/mc_blocks.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/mesh/mc.h"
+
+#define MCB_NONE UINT32_MAX
+#define MCB_L (MC_BLOCK_CELLS + 3) /* scratch samples per axis: cells + 1 corners + 2 halo */
+#define MCB_C (MC_BLOCK_CELLS + 1) /* corners per axis */
+
+static void mcb_block_free(mc_block_mesh_t *k)
+{
+    free(k->pos);
+    free(k->normal);
+    free(k->rgb);
+    free(k->key);
+    free(k->tri);
+    memset(k, 0, sizeof(*k));
+}
+
+void mc_blocks_free(mc_blocks_t *b)
+{
+    if (b->blocks != NULL)
+        for (size_t i = 0; i < b->n_blocks; i++)
+            mcb_block_free(&b->blocks[i]);
+    free(b->blocks);
+    free(b->dirty);
+    free(b->tab);
+    free(b->val);
+    free(b->ins);
+    free(b->col);
+    free(b->cache);
+    memset(b, 0, sizeof(*b));
+}
+
+argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_m,
+                           vec3_t origin_m, float iso)
+{
+    memset(b, 0, sizeof(*b));
+    if (dims == NULL)
+        return ARGIL_ERR_ARG;
+    int64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1 || dims[a] > INT32_MAX - 2)
+            return ARGIL_ERR_ARG;
+        n *= dims[a];
+        if (n > ((int64_t)1 << 31))
+            return ARGIL_ERR_ARG;
+    }
+    if (!isfinite(spacing_m) || !(spacing_m > 0.0f) || !isfinite(iso) || !vec3_isfinite(origin_m))
+        return ARGIL_ERR_ARG;
+    b->n_blocks = 1;
+    for (int a = 0; a < 3; a++) {
+        b->dims[a] = dims[a];
+        b->nblk[a] = (dims[a] + 1 + MC_BLOCK_CELLS - 1) / MC_BLOCK_CELLS;
+        b->n_blocks *= (size_t)b->nblk[a];
+    }
+    b->spacing_m = spacing_m;
+    b->origin_m = origin_m;
+    b->iso = iso;
+    b->blocks = calloc(b->n_blocks, sizeof(*b->blocks));
+    b->dirty = malloc(b->n_blocks);
+    b->tab = malloc(sizeof(*b->tab));
+    b->val = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
+    b->ins = malloc(MCB_L * MCB_L * MCB_L);
+    b->col = malloc(3 * MCB_L * MCB_L * MCB_L);
+    b->cache = malloc(sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C);
+    if (b->blocks == NULL || b->dirty == NULL || b->tab == NULL || b->val == NULL ||
+        b->ins == NULL || b->col == NULL || b->cache == NULL) {
+        mc_blocks_free(b);
+        return ARGIL_ERR_NOMEM;
+    }
+    mc_table_build(b->tab);
+    mc_blocks_mark_all(b);
+    return ARGIL_OK;
+}
+
+void mc_blocks_mark_all(mc_blocks_t *b)
+{
+    memset(b->dirty, 1, b->n_blocks);
+}
+
+void mc_blocks_mark(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
+{
+    /* Sample s (padded s + 1) is a corner of padded cells s, s + 1 and enters the normals of
+     * vertices on edges with an end within one sample: padded cells [s - 1, s + 2]. */
+    int32_t blo[3], bhi[3];
+    for (int a = 0; a < 3; a++) {
+        int64_t l = (int64_t)lo[a] - 1, h = (int64_t)hi[a] + 2; /* padded cells [l, h) */
+        if (l < 0)
+            l = 0;
+        if (h > (int64_t)b->dims[a] + 1)
+            h = (int64_t)b->dims[a] + 1;
+        if (l >= h)
+            return;
+        blo[a] = (int32_t)(l / MC_BLOCK_CELLS);
+        bhi[a] = (int32_t)((h - 1) / MC_BLOCK_CELLS) + 1;
+    }
+    for (int32_t z = blo[2]; z < bhi[2]; z++)
+        for (int32_t y = blo[1]; y < bhi[1]; y++)
+            for (int32_t x = blo[0]; x < bhi[0]; x++)
+                b->dirty[(size_t)x + (size_t)b->nblk[0] * ((size_t)y + (size_t)b->nblk[1] * (size_t)z)] = 1;
+}
+
+/* Grows a block's arrays to hold one more vertex / triangle. */
+static argil_err_t mcb_grow_vert(mc_block_mesh_t *k, int with_rgb)
+{
+    if (k->n_vert < k->cap_vert)
+        return ARGIL_OK;
+    if (k->cap_vert >= UINT32_MAX / 2)
+        return ARGIL_ERR_FULL;
+    const size_t cap = k->cap_vert < 64 ? 64 : (size_t)k->cap_vert * 2;
+    float *p = realloc(k->pos, cap * 3 * sizeof(float));
+    if (p == NULL)
+        return ARGIL_ERR_NOMEM;
+    k->pos = p;
+    float *n = realloc(k->normal, cap * 3 * sizeof(float));
+    if (n == NULL)
+        return ARGIL_ERR_NOMEM;
+    k->normal = n;
+    uint64_t *key = realloc(k->key, cap * sizeof(uint64_t));
+    if (key == NULL)
+        return ARGIL_ERR_NOMEM;
+    k->key = key;
+    if (with_rgb) {
+        uint8_t *c = realloc(k->rgb, cap * 3);
+        if (c == NULL)
+            return ARGIL_ERR_NOMEM;
+        k->rgb = c;
+    }
+    k->cap_vert = (uint32_t)cap;
+    return ARGIL_OK;
+}
+
+static argil_err_t mcb_grow_tri(mc_block_mesh_t *k)
+{
+    if (k->n_tri < k->cap_tri)
+        return ARGIL_OK;
+    if (k->cap_tri >= UINT32_MAX / 8)
+        return ARGIL_ERR_FULL;
+    const size_t cap = k->cap_tri < 128 ? 128 : (size_t)k->cap_tri * 2;
+    uint32_t *t = realloc(k->tri, cap * 3 * sizeof(uint32_t));
+    if (t == NULL)
+        return ARGIL_ERR_NOMEM;
+    k->tri = t;
+    k->cap_tri = (uint32_t)cap;
+    return ARGIL_OK;
+}
+
+/* Per-block working view. */
+typedef struct {
+    mc_blocks_t *b;
+    mc_block_mesh_t *k;
+    int32_t c0[3], nc[3]; /* first padded cell and cell count per axis */
+    const uint8_t *rgb;
+} mcb_job_t;
+
+/* Scratch index of padded sample p (global padded coordinates). */
+static size_t mcb_l(const mcb_job_t *j, int32_t px, int32_t py, int32_t pz)
+{
+    return (size_t)(px - j->c0[0] + 1) +
+           MCB_L * ((size_t)(py - j->c0[1] + 1) + MCB_L * (size_t)(pz - j->c0[2] + 1));
+}
+
+/* Copies the block's samples and halo (padded samples c0-1 .. c0+nc+1) into scratch; false when
+ * one of them is not finite. Returns through *mixed whether corners lie on both sides. */
+static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
+{
+    mc_blocks_t *b = j->b;
+    const int32_t *d = b->dims;
+    memset(b->val, 0, sizeof(float) * MCB_L * MCB_L * MCB_L);
+    memset(b->ins, 0, MCB_L * MCB_L * MCB_L);
+    if (j->rgb != NULL)
+        memset(b->col, 0, 3 * MCB_L * MCB_L * MCB_L);
+    /* original sample o = padded - 1; scratch index l = padded - c0 + 1 */
+    const int32_t o0[3] = {j->c0[0] - 2, j->c0[1] - 2, j->c0[2] - 2};
+    const int32_t n_l[3] = {j->nc[0] + 3, j->nc[1] + 3, j->nc[2] + 3};
+    int32_t xlo = o0[0] < 0 ? 0 : o0[0];
+    int32_t xhi = o0[0] + n_l[0] > d[0] ? d[0] : o0[0] + n_l[0];
+    unsigned seen_in = 0, seen_out = 0;
+    for (int32_t lz = 0; lz < n_l[2]; lz++) {
+        const int32_t oz = o0[2] + lz;
+        if (oz < 0 || oz >= d[2])
+            continue;
+        for (int32_t ly = 0; ly < n_l[1]; ly++) {
+            const int32_t oy = o0[1] + ly;
+            if (oy < 0 || oy >= d[1] || xlo >= xhi)
+                continue;
+            const size_t src = (size_t)d[0] * ((size_t)oy + (size_t)d[1] * (size_t)oz);
+            const size_t dst = MCB_L * ((size_t)ly + MCB_L * (size_t)lz);
+            for (int32_t ox = xlo; ox < xhi; ox++) {
+                const float v = density[src + (size_t)ox];
+                if (!isfinite(v))
+                    return false;
+                b->val[dst + (size_t)(ox - o0[0])] = v;
+                b->ins[dst + (size_t)(ox - o0[0])] = v > b->iso;
+            }
+            if (j->rgb != NULL)
+                memcpy(b->col + 3 * (dst + (size_t)(xlo - o0[0])), j->rgb + 3 * (src + (size_t)xlo),
+                       3 * (size_t)(xhi - xlo));
+        }
+    }
+    /* The corners (scratch 1 .. nc+1 per axis); samples beyond the field are outside. */
+    for (int32_t lz = 1; lz <= j->nc[2] + 1; lz++)
+        for (int32_t ly = 1; ly <= j->nc[1] + 1; ly++) {
+            const uint8_t *row = b->ins + MCB_L * ((size_t)ly + MCB_L * (size_t)lz);
+            for (int32_t lx = 1; lx <= j->nc[0] + 1; lx++) {
+                seen_in |= row[lx];
+                seen_out |= (unsigned)(row[lx] ^ 1u);
+            }
+        }
+    *mixed = seen_in && seen_out;
+    return true;
+}
+
+/* Central-difference gradient (unscaled) at padded sample p, from scratch. */
+static vec3_t mcb_gradient(const mcb_job_t *j, const int32_t p[3])
+{
+    const float *v = j->b->val;
+    const size_t i = mcb_l(j, p[0], p[1], p[2]);
+    return vec3(v[i + 1] - v[i - 1], v[i + MCB_L] - v[i - MCB_L],
+                v[i + MCB_L * MCB_L] - v[i - MCB_L * MCB_L]);
+}
+
+/* Creates the vertex of the edge from padded sample p along axis a; same arithmetic as
+ * mc_extract, so the positions and normals match it bit for bit. */
+static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint32_t *id)
+{
+    mc_blocks_t *b = j->b;
+    mc_block_mesh_t *k = j->k;
+    int32_t p1[3] = {p[0], p[1], p[2]};
+    p1[a] += 1;
+    const size_t i0 = mcb_l(j, p[0], p[1], p[2]), i1 = mcb_l(j, p1[0], p1[1], p1[2]);
+    const float d0 = b->val[i0], d1 = b->val[i1];
+    float t = (b->iso - d0) / (d1 - d0);
+    if (!(t >= MC_T_MIN))
+        t = MC_T_MIN;
+    if (t > 1.0f - MC_T_MIN)
+        t = 1.0f - MC_T_MIN;
+    const int64_t s0[3] = {p[0] - 1, p[1] - 1, p[2] - 1};
+    float idx[3] = {(float)s0[0], (float)s0[1], (float)s0[2]};
+    idx[a] += t;
+    const vec3_t pos = vec3(b->origin_m.x + b->spacing_m * idx[0],
+                            b->origin_m.y + b->spacing_m * idx[1],
+                            b->origin_m.z + b->spacing_m * idx[2]);
+    const vec3_t g0 = mcb_gradient(j, p), g1 = mcb_gradient(j, p1);
+    const vec3_t g = vec3_add(g0, vec3_scale(vec3_sub(g1, g0), t));
+    const float len = vec3_norm(g);
+    vec3_t n;
+    if (len > 1e-12f && isfinite(len)) {
+        n = vec3_scale(g, -1.0f / len);
+    } else {
+        const float sgn = d0 > b->iso ? 1.0f : -1.0f;
+        n = vec3(a == 0 ? sgn : 0.0f, a == 1 ? sgn : 0.0f, a == 2 ? sgn : 0.0f);
+    }
+    argil_err_t e = mcb_grow_vert(k, j->rgb != NULL);
+    if (e != ARGIL_OK)
+        return e;
+    const uint32_t v = k->n_vert++;
+    float *pp = k->pos + 3 * (size_t)v, *nn = k->normal + 3 * (size_t)v;
+    pp[0] = pos.x;
+    pp[1] = pos.y;
+    pp[2] = pos.z;
+    nn[0] = n.x;
+    nn[1] = n.y;
+    nn[2] = n.z;
+    if (j->rgb != NULL) {
+        const uint8_t *c = b->col + 3 * (d0 > b->iso ? i0 : i1); /* the inside end's paint */
+        memcpy(k->rgb + 3 * (size_t)v, c, 3);
+    }
+    const uint64_t P0 = (uint64_t)b->dims[0] + 2, P1 = (uint64_t)b->dims[1] + 2;
+    k->key[v] = ((((uint64_t)p[2] * P1 + (uint64_t)p[1]) * P0 + (uint64_t)p[0]) * 3) + (uint64_t)a;
+    *id = v;
+    return ARGIL_OK;
+}
+
+/* Triangulates every cell of one block (scratch already loaded). */
+static argil_err_t mcb_cells(mcb_job_t *j)
+{
+    mc_blocks_t *b = j->b;
+    const uint8_t *ins = b->ins;
+    const size_t cstride_y = MCB_C, cstride_z = (size_t)MCB_C * MCB_C;
+    for (size_t i = 0; i < 3 * (size_t)MCB_C * MCB_C * MCB_C; i++)
+        b->cache[i] = MCB_NONE;
+    for (int32_t cz = 0; cz < j->nc[2]; cz++)
+        for (int32_t cy = 0; cy < j->nc[1]; cy++) {
+            const size_t r0 = MCB_L * ((size_t)cy + 1 + MCB_L * ((size_t)cz + 1)) + 1;
+            for (int32_t cx = 0; cx < j->nc[0]; cx++) {
+                const size_t i = r0 + (size_t)cx;
+                const unsigned mask =
+                    (unsigned)ins[i] | (unsigned)ins[i + 1] << 1 | (unsigned)ins[i + MCB_L] << 2 |
+                    (unsigned)ins[i + MCB_L + 1] << 3 | (unsigned)ins[i + MCB_L * MCB_L] << 4 |
+                    (unsigned)ins[i + MCB_L * MCB_L + 1] << 5 |
+                    (unsigned)ins[i + MCB_L * MCB_L + MCB_L] << 6 |
+                    (unsigned)ins[i + MCB_L * MCB_L + MCB_L + 1] << 7;
+                if (mask == 0 || mask == 255)
+                    continue;
+                const mc_case_t *c = &b->tab->cases[mask];
+                for (int t = 0; t < 3 * (int)c->n_tri; t += 3) {
+                    uint32_t v[3];
+                    for (int q = 0; q < 3; q++) {
+                        const int e = c->edge[t + q], a = e / 4;
+                        int32_t lc[3] = {cx, cy, cz}; /* block-local corner of the edge */
+                        lc[(a + 1) % 3] += e & 1;
+                        lc[(a + 2) % 3] += (e >> 1) & 1;
+                        uint32_t *slot = &b->cache[3 * ((size_t)lc[0] + cstride_y * (size_t)lc[1] +
+                                                        cstride_z * (size_t)lc[2]) +
+                                                   (size_t)a];
+                        if (*slot == MCB_NONE) {
+                            const int32_t p[3] = {j->c0[0] + lc[0], j->c0[1] + lc[1],
+                                                  j->c0[2] + lc[2]};
+                            argil_err_t err = mcb_make_vertex(j, p, a, slot);
+                            if (err != ARGIL_OK)
+                                return err;
+                        }
+                        v[q] = *slot;
+                    }
+                    argil_err_t err = mcb_grow_tri(j->k);
+                    if (err != ARGIL_OK)
+                        return err;
+                    uint32_t *tt = j->k->tri + 3 * (size_t)j->k->n_tri++;
+                    tt[0] = v[0];
+                    tt[1] = v[1];
+                    tt[2] = v[2];
+                }
+            }
+        }
+    return ARGIL_OK;
+}
+
+argil_err_t mc_blocks_update(mc_blocks_t *b, const float *density, const uint8_t *rgb)
+{
+    if (b == NULL || b->blocks == NULL || density == NULL)
+        return ARGIL_ERR_ARG;
+    if ((rgb != NULL) != (b->has_rgb != 0)) {
+        mc_blocks_mark_all(b);
+        b->has_rgb = rgb != NULL;
+    }
+    b->blocks_meshed = 0;
+    b->cells_meshed = 0;
+    size_t bi = 0;
+    for (int32_t bz = 0; bz < b->nblk[2]; bz++)
+        for (int32_t by = 0; by < b->nblk[1]; by++)
+            for (int32_t bx = 0; bx < b->nblk[0]; bx++, bi++) {
+                if (!b->dirty[bi])
+                    continue;
+                mcb_job_t j = {b, &b->blocks[bi], {0}, {0}, rgb};
+                const int32_t bc[3] = {bx, by, bz};
+                for (int a = 0; a < 3; a++) {
+                    j.c0[a] = bc[a] * MC_BLOCK_CELLS;
+                    const int32_t end = b->dims[a] + 1;
+                    j.nc[a] = end - j.c0[a] < MC_BLOCK_CELLS ? end - j.c0[a] : MC_BLOCK_CELLS;
+                }
+                j.k->n_vert = 0;
+                j.k->n_tri = 0;
+                if (rgb == NULL) {
+                    free(j.k->rgb);
+                    j.k->rgb = NULL;
+                } else if (j.k->rgb == NULL && j.k->cap_vert > 0) {
+                    j.k->rgb = malloc((size_t)j.k->cap_vert * 3);
+                    if (j.k->rgb == NULL)
+                        return ARGIL_ERR_NOMEM;
+                }
+                bool mixed = false;
+                if (!mcb_load(&j, density, &mixed))
+                    return ARGIL_ERR_NONFINITE;
+                if (mixed) {
+                    argil_err_t e = mcb_cells(&j);
+                    if (e != ARGIL_OK) {
+                        j.k->n_vert = 0;
+                        j.k->n_tri = 0;
+                        return e;
+                    }
+                    b->cells_meshed += (uint64_t)j.nc[0] * (uint64_t)j.nc[1] * (uint64_t)j.nc[2];
+                }
+                b->blocks_meshed++;
+                b->dirty[bi] = 0;
+            }
+    return ARGIL_OK;
+}
+
+/* Multiplicative hash of an edge id into a table of 2^bits slots. */
+static size_t mcb_hash(uint64_t key, int bits)
+{
+    return (size_t)((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+}
+
+argil_err_t mc_blocks_assemble(const mc_blocks_t *b, mesh_t *out)
+{
+    if (b == NULL || out == NULL || b->blocks == NULL)
+        return ARGIL_ERR_ARG;
+    mesh_clear(out);
+    size_t total_v = 0, total_t = 0, max_v = 0;
+    for (size_t i = 0; i < b->n_blocks; i++) {
+        total_v += b->blocks[i].n_vert;
+        total_t += b->blocks[i].n_tri;
+        if (b->blocks[i].n_vert > max_v)
+            max_v = b->blocks[i].n_vert;
+    }
+    if (b->has_rgb && !out->has_rgb && mesh_enable_rgb(out) != ARGIL_OK)
+        return ARGIL_ERR_NOMEM;
+    if (!b->has_rgb && out->has_rgb) {
+        free(out->rgb);
+        out->rgb = NULL;
+        out->has_rgb = 0;
+    }
+    int bits = 4;
+    while (((size_t)1 << bits) < 2 * total_v + 16)
+        bits++;
+    const size_t slots = (size_t)1 << bits;
+    uint64_t *keys = malloc(slots * sizeof(uint64_t));
+    uint32_t *vals = malloc(slots * sizeof(uint32_t));
+    uint32_t *remap = malloc((max_v + 1) * sizeof(uint32_t));
+    argil_err_t e = ARGIL_ERR_NOMEM;
+    if (keys == NULL || vals == NULL || remap == NULL)
+        goto done;
+    memset(keys, 0xff, slots * sizeof(uint64_t)); /* UINT64_MAX = empty; no edge id reaches it */
+    e = mesh_reserve(out, total_v, total_t);
+    if (e != ARGIL_OK)
+        goto done;
+    for (size_t bi = 0; bi < b->n_blocks; bi++) {
+        const mc_block_mesh_t *k = &b->blocks[bi];
+        for (uint32_t v = 0; v < k->n_vert; v++) {
+            size_t h = mcb_hash(k->key[v], bits);
+            while (keys[h] != UINT64_MAX && keys[h] != k->key[v])
+                h = (h + 1) & (slots - 1);
+            if (keys[h] == UINT64_MAX) {
+                keys[h] = k->key[v];
+                const size_t id = out->n_vert++;
+                memcpy(out->pos + 3 * id, k->pos + 3 * (size_t)v, 3 * sizeof(float));
+                memcpy(out->normal + 3 * id, k->normal + 3 * (size_t)v, 3 * sizeof(float));
+                if (b->has_rgb)
+                    memcpy(out->rgb + 3 * id, k->rgb + 3 * (size_t)v, 3);
+                vals[h] = (uint32_t)id;
+            }
+            remap[v] = vals[h];
+        }
+        for (size_t t = 0; t < 3 * (size_t)k->n_tri; t++)
+            out->tri[3 * out->n_tri + t] = remap[k->tri[t]];
+        out->n_tri += k->n_tri;
+    }
+    e = ARGIL_OK;
+done:
+    free(keys);
+    free(vals);
+    free(remap);
+    if (e != ARGIL_OK)
+        mesh_clear(out);
+    return e;
+}
+
+argil_err_t mc_extract_region(const float *density, const uint8_t *rgb, const int32_t dims[3],
+                              float spacing_m, vec3_t origin_m, float iso, const int32_t lo[3],
+                              const int32_t hi[3], mesh_t *out)
+{
+    if (out == NULL)
+        return ARGIL_ERR_ARG;
+    mesh_clear(out);
+    if (density == NULL || dims == NULL)
+        return ARGIL_ERR_ARG;
+    int32_t l[3] = {0, 0, 0}, h[3] = {dims[0], dims[1], dims[2]}, n[3];
+    for (int a = 0; a < 3; a++) {
+        if (lo != NULL)
+            l[a] = lo[a];
+        if (hi != NULL)
+            h[a] = hi[a];
+        if (l[a] < 0 || h[a] > dims[a] || l[a] >= h[a])
+            return ARGIL_ERR_ARG;
+        n[a] = h[a] - l[a];
+    }
+    const bool whole = n[0] == dims[0] && n[1] == dims[1] && n[2] == dims[2];
+    float *sub = NULL;
+    uint8_t *subc = NULL;
+    argil_err_t e = ARGIL_OK;
+    if (!whole) {
+        const size_t cnt = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+        sub = malloc(cnt * sizeof(float));
+        subc = rgb != NULL ? malloc(cnt * 3) : NULL;
+        if (sub == NULL || (rgb != NULL && subc == NULL)) {
+            free(sub);
+            free(subc);
+            return ARGIL_ERR_NOMEM;
+        }
+        size_t i = 0;
+        for (int32_t z = l[2]; z < h[2]; z++)
+            for (int32_t y = l[1]; y < h[1]; y++, i += (size_t)n[0]) {
+                const size_t src = (size_t)l[0] + (size_t)dims[0] * ((size_t)y + (size_t)dims[1] * (size_t)z);
+                memcpy(sub + i, density + src, (size_t)n[0] * sizeof(float));
+                if (subc != NULL)
+                    memcpy(subc + 3 * i, rgb + 3 * src, 3 * (size_t)n[0]);
+            }
+        origin_m = vec3(origin_m.x + spacing_m * (float)l[0], origin_m.y + spacing_m * (float)l[1],
+                        origin_m.z + spacing_m * (float)l[2]);
+    }
+    mc_blocks_t b;
+    e = mc_blocks_init(&b, n, spacing_m, origin_m, iso);
+    if (e == ARGIL_OK) {
+        e = mc_blocks_update(&b, whole ? density : sub, whole ? rgb : subc);
+        if (e == ARGIL_OK)
+            e = mc_blocks_assemble(&b, out);
+        mc_blocks_free(&b);
+    }
+    free(sub);
+    free(subc);
+    if (e != ARGIL_OK)
+        mesh_clear(out);
+    return e;
+}

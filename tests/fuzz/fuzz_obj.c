@@ -1,0 +1,52 @@
+/* libFuzzer target for the obj reader: the input bytes become a file it parses; an error must
+ * name the file, and an accepted result must be consistent. */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <math.h>
+#include <stdbool.h>
+
+#include "host/io/mesh_import.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    char path[] = "/tmp/argil_fuzz_obj_XXXXXX";
+    const int fd = mkstemp(path);
+    if (fd < 0)
+        return 0;
+    size_t done = 0;
+    while (done < size) {
+        const ssize_t n = write(fd, data + done, size - done);
+        if (n <= 0)
+            break;
+        done += (size_t)n;
+    }
+    close(fd);
+    if (done == size) {
+        char err[512];
+        err[0] = '\0';
+        mesh_t m;
+        mesh_init(&m);
+        bool nrm = false;
+        const argil_err_t e = obj_read(path, &m, &nrm, err, sizeof(err));
+        if (e == ARGIL_OK) {
+            for (size_t i = 0; i < 3 * m.n_tri; i++)
+                if (m.tri[i] >= m.n_vert)
+                    abort();
+            for (size_t i = 0; i < 3 * m.n_vert; i++)
+                if (!isfinite(m.pos[i]))
+                    abort();
+        } else if (err[0] == 0 || strstr(err, path) == NULL || strchr(err, 10) != NULL) {
+            abort(); /* every error is one line naming the file */
+        }
+        (void)nrm;
+        mesh_free(&m);
+    }
+    unlink(path);
+    return 0;
+}

@@ -1,0 +1,435 @@
+/* The .argil session file: round trip of every part, atomic replacement, any flipped bit or cut
+ * refused, and one crafted file per rule the reader enforces (each error names file + byte). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "host/io/argil_file.h"
+#include "host/io/io_util.h"
+#include "shared/crc32c.h"
+
+static char g_dir[64];
+
+static int setup_dir(void **state)
+{
+    (void)state;
+    strcpy(g_dir, "/tmp/argil_test_argil_XXXXXX");
+    return mkdtemp(g_dir) != NULL ? 0 : -1;
+}
+
+static int teardown_dir(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", g_dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static uint8_t *slurp(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    fseek(fp, 0, SEEK_END);
+    const long n = ftell(fp);
+    rewind(fp);
+    uint8_t *b = malloc((size_t)n + 1);
+    assert_non_null(b);
+    assert_int_equal(fread(b, 1, (size_t)n, fp), (size_t)n);
+    fclose(fp);
+    *len = (size_t)n;
+    return b;
+}
+
+static void spit(const char *path, const void *data, size_t len)
+{
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(data, 1, len, fp), len);
+    assert_int_equal(fclose(fp), 0);
+}
+
+static void make_doc(argil_doc_t *d, bool extras)
+{
+    argil_doc_init(d);
+    const int32_t dims[3] = {6, 5, 4};
+    assert_int_equal(grid_init(&d->grid, dims, 0.002f, vec3(-0.005f, -0.004f, -0.003f)), ARGIL_OK);
+    grid_fill_sphere(&d->grid, vec3(0, 0, 0), 0.004f);
+    d->grid.iso = 0.4f;
+    d->grid.material.stiffness = 123.0f;
+    d->tool.tool_kind = 3;
+    d->tool.radius_m = 0.007f;
+    d->tool.paint_rgb[1] = 99;
+    d->state.device_scale = 2.5f;
+    d->state.device_offset_m = vec3(0.1f, 0.2f, 0.3f);
+    d->state.edits = 42;
+    if (extras) {
+        d->rgb = malloc(3 * 120);
+        assert_non_null(d->rgb);
+        for (int i = 0; i < 360; i++)
+            d->rgb[i] = (uint8_t)i;
+        assert_int_equal(rbf_alloc(&d->rbf, 3), ARGIL_OK);
+        d->has_rbf = true;
+        for (int i = 0; i < 9; i++)
+            d->rbf.centre_m[i] = (float)i * 0.001f;
+        d->rbf.weight[2] = -5.0f;
+        d->rbf.poly[3] = 0.25f;
+        d->rbf.rms_err_m = 1e-4f;
+    }
+}
+
+static void test_round_trip(void **state)
+{
+    (void)state;
+    char p[128], err[256];
+    snprintf(p, sizeof(p), "%s/a.argil", g_dir);
+    for (int extras = 0; extras < 2; extras++) {
+        argil_doc_t d, r;
+        make_doc(&d, extras);
+        assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+        assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+        assert_memory_equal(r.grid.dims, d.grid.dims, sizeof(d.grid.dims));
+        assert_memory_equal(r.grid.density, d.grid.density, 120 * sizeof(float));
+        assert_memory_equal(r.grid.rest, d.grid.density, 120 * sizeof(float));
+        assert_float_equal(r.grid.iso, 0.4f, 0);
+        assert_float_equal(r.grid.spacing_m, 0.002f, 0);
+        assert_float_equal(r.grid.origin_m.y, -0.004f, 0);
+        assert_float_equal(r.grid.band_m, d.grid.band_m, 0);
+        assert_float_equal(r.grid.material.stiffness, 123.0f, 0);
+        assert_int_equal(r.tool.tool_kind, 3);
+        assert_float_equal(r.tool.radius_m, 0.007f, 0);
+        assert_int_equal(r.tool.paint_rgb[1], 99);
+        assert_float_equal(r.state.device_scale, 2.5f, 0);
+        assert_float_equal(r.state.device_offset_m.z, 0.3f, 0);
+        assert_int_equal(r.state.edits, 42);
+        assert_int_equal(r.has_rbf, extras);
+        if (extras) {
+            assert_memory_equal(r.rgb, d.rgb, 360);
+            assert_int_equal(r.rbf.n, 3);
+            assert_float_equal(r.rbf.weight[2], -5.0f, 0);
+            assert_float_equal(r.rbf.centre_m[8], 0.008f, 0);
+            assert_float_equal(r.rbf.poly[3], 0.25f, 0);
+            assert_float_equal(r.rbf.rms_err_m, 1e-4f, 0);
+        } else {
+            assert_null(r.rgb);
+        }
+        argil_doc_free(&r);
+        argil_doc_free(&d);
+    }
+}
+
+/* A crash mid-save leaves path.tmp behind, never a damaged path; a failed save keeps the old. */
+static void test_atomic(void **state)
+{
+    (void)state;
+    char p[128], tmp[160], err[256];
+    snprintf(p, sizeof(p), "%s/keep.argil", g_dir);
+    snprintf(tmp, sizeof(tmp), "%s.tmp", p);
+    argil_doc_t d, r;
+    make_doc(&d, true);
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    size_t len0;
+    uint8_t *before = slurp(p, &len0);
+    /* a half-written temp file from a crash: the saved file still reads */
+    spit(tmp, before, len0 / 2);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    argil_doc_free(&r);
+    /* a save that fails (NaN in the model) leaves the file byte for byte as it was */
+    d.grid.density[7] = NAN;
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_NONFINITE);
+    assert_non_null(strstr(err, "NaN or Inf"));
+    /* a save whose temp file cannot be created (it is a directory) fails with IO */
+    d.grid.density[7] = 0.5f;
+    unlink(tmp);
+    assert_int_equal(mkdir(tmp, 0700), 0);
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "fopen"));
+    rmdir(tmp);
+    size_t len1;
+    uint8_t *after = slurp(p, &len1);
+    assert_int_equal(len0, len1);
+    assert_memory_equal(before, after, len0);
+    /* and a successful save replaces it whole, leaving no temp file */
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(access(tmp, F_OK), -1);
+    free(before);
+    free(after);
+    argil_doc_free(&d);
+    /* writing the seed for the fuzzer's corpus is not this test's business; an empty doc: */
+    argil_doc_init(&d);
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_ARG);
+}
+
+/* Every single-bit flip and every truncation of a saved file is refused with a clear error. */
+static void test_any_corruption_refused(void **state)
+{
+    (void)state;
+    char p[128], q[160], err[256];
+    snprintf(p, sizeof(p), "%s/c.argil", g_dir);
+    snprintf(q, sizeof(q), "%s/bad.argil", g_dir);
+    argil_doc_t d, r;
+    make_doc(&d, true);
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    argil_doc_free(&d);
+    size_t len;
+    uint8_t *b = slurp(p, &len);
+    for (size_t i = 0; i < len; i += 3) {
+        b[i] ^= (uint8_t)(1u << (i % 8));
+        spit(q, b, len);
+        const argil_err_t e = argil_file_read(q, &r, err, sizeof(err));
+        if (e != ARGIL_ERR_PARSE || strstr(err, q) == NULL || strstr(err, "byte ") == NULL)
+            fail_msg("flip at byte %zu: %d '%s'", i, e, err);
+        assert_null(r.grid.density);
+        b[i] ^= (uint8_t)(1u << (i % 8));
+    }
+    for (size_t cut = 0; cut < len; cut += 17) {
+        spit(q, b, cut);
+        assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
+    }
+    free(b);
+}
+
+/* Builds a file from sections with correct checksums (so the deeper rules are reached). */
+typedef struct {
+    uint8_t b[4096];
+    size_t len;
+    uint32_t n_sec;
+} build_t;
+
+static void b_begin(build_t *f)
+{
+    memset(f, 0, sizeof(*f));
+    f->len = 32;
+}
+
+static void b_sec(build_t *f, const char *tag, const void *payload, size_t n)
+{
+    uint8_t *s = f->b + f->len;
+    memcpy(s, tag, 4);
+    io_put_u32le(s + 4, (uint32_t)n);
+    io_put_u32le(s + 8, 0);
+    memcpy(s + 12, payload, n);
+    io_put_u32le(s + 12 + n, crc32c(0, s, 12 + n));
+    f->len += 16 + n;
+    f->n_sec++;
+}
+
+static void b_end(build_t *f, const char *path, uint32_t version)
+{
+    static const uint8_t magic[8] = {'A', 'R', 'G', 'I', 'L', '\r', '\n', 0x1a};
+    memcpy(f->b, magic, 8);
+    io_put_u32le(f->b + 8, version);
+    io_put_u32le(f->b + 12, f->n_sec);
+    io_put_u32le(f->b + 16, (uint32_t)(f->len + 4));
+    io_put_u32le(f->b + 20, 0);
+    io_put_u32le(f->b + 24, 0);
+    io_put_u32le(f->b + 28, crc32c(0, f->b, 28));
+    io_put_u32le(f->b + f->len, crc32c(0, f->b, f->len));
+    spit(path, f->b, f->len + 4);
+}
+
+/* A 1x1x2 GRID payload with the given density and spacing. */
+static size_t grid_payload(uint8_t *p, int32_t nx, float spacing, float density)
+{
+    io_put_u32le(p, (uint32_t)nx);
+    io_put_u32le(p + 4, 1);
+    io_put_u32le(p + 8, 2);
+    const float f[6] = {spacing, 0, 0, 0, 0.5f, 0.004f};
+    for (int k = 0; k < 6; k++)
+        io_put_f32le(p + 12 + 4 * k, f[k]);
+    const size_t n = nx > 0 ? 2u * (size_t)nx : 0;
+    for (size_t i = 0; i < n && i < 64; i++)
+        io_put_f32le(p + 36 + 4 * i, density);
+    return 36 + 4 * (n < 64 ? n : 64);
+}
+
+static void expect_rule(const char *path, const char *where, const char *rule)
+{
+    argil_doc_t r;
+    char err[512] = "";
+    const argil_err_t e = argil_file_read(path, &r, err, sizeof(err));
+    if (e != ARGIL_ERR_PARSE || strstr(err, path) == NULL || strstr(err, where) == NULL ||
+        strstr(err, rule) == NULL)
+        fail_msg("got %d '%s', want '%s' and '%s'", e, err, where, rule);
+    assert_null(r.grid.density);
+}
+
+static void test_each_rule(void **state)
+{
+    (void)state;
+    char p[128];
+    snprintf(p, sizeof(p), "%s/r.argil", g_dir);
+    build_t f;
+    uint8_t g[512], x[64] = {0};
+    const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
+
+    spit(p, "ARGIL", 5);
+    expect_rule(p, "byte 5", "shorter than the 32-byte header");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    b_end(&f, p, 1);
+    argil_doc_t ok;
+    char err[256];
+    assert_int_equal(argil_file_read(p, &ok, err, sizeof(err)), ARGIL_OK); /* builder is right */
+    assert_float_equal(ok.grid.density[1], 0.5f, 0);
+    argil_doc_free(&ok);
+    f.b[0] = 'X';
+    spit(p, f.b, f.len + 4);
+    expect_rule(p, "byte 0", "not an .argil file");
+    b_end(&f, p, 1);
+    f.b[20] = 1;
+    spit(p, f.b, f.len + 4);
+    expect_rule(p, "byte 28", "header checksum mismatch");
+    b_end(&f, p, 2);
+    expect_rule(p, "byte 8", "format version 2; this argil reads 1..1");
+    f.n_sec = 0;
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 12", "section count not in 1..64");
+    f.n_sec = 1;
+    b_end(&f, p, 1);
+    f.b[f.len + 4] = 0; /* one byte more than declared */
+    spit(p, f.b, f.len + 5);
+    expect_rule(p, "byte 16", "declared file length differs");
+    b_end(&f, p, 1);
+    f.b[40] ^= 1; /* inside the GRID payload: the file checksum catches it first */
+    spit(p, f.b, f.len + 4);
+    char at[32];
+    snprintf(at, sizeof(at), "byte %zu", f.len);
+    expect_rule(p, at, "file checksum mismatch");
+    /* deeper rules need consistent outer checksums: */
+    f.b[40] ^= 1;
+    f.n_sec = 2;
+    b_end(&f, p, 1);
+    snprintf(at, sizeof(at), "byte %zu", f.len);
+    expect_rule(p, at, "section head runs past the end");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    io_put_u32le(f.b + 36, 100000); /* length beyond the file, crc not even reached */
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 36", "section length runs past the end");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    f.b[32 + 12 + 20] ^= 4;
+    b_end(&f, p, 1);
+    snprintf(at, sizeof(at), "byte %zu", 32 + 12 + gl);
+    expect_rule(p, at, "section checksum mismatch");
+    const struct {
+        const char *tag;
+        const void *payload;
+        size_t n;
+        const char *where, *rule;
+    } cases[] = {
+        {"GRID", g, 20, "byte 44", "shorter than its 36-byte head"},
+        {"MATL", x, 19, "byte 32", "MATL section repeated or not 20 bytes"},
+        {"MATL", x, 20, "byte 44", "MATL values out of range"},
+        {"TOOL", x, 15, "byte 32", "TOOL section repeated or not 16 bytes"},
+        {"STAT", x, 20, "byte 44", "STAT transform not finite (or scale not > 0)"},
+        {"STAT", x, 21, "byte 32", "STAT section repeated or not 20 bytes"},
+        {"RBF3", x, 27, "byte 32", "RBF3 section repeated or shorter than 28"},
+        {"RBF3", x, 44, "byte 44", "RBF3 centre count out of range"},
+        {"XTRA", x, 8, "byte 32", "no GRID section"},
+    };
+    for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+        b_begin(&f);
+        b_sec(&f, cases[k].tag, cases[k].payload, cases[k].n);
+        b_end(&f, p, 1);
+        expect_rule(p, cases[k].where, cases[k].rule);
+    }
+    /* values inside sections */
+    uint8_t t[64] = {0};
+    io_put_f32le(t + 4, -1.0f);
+    b_begin(&f);
+    b_sec(&f, "TOOL", t, 16);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 48", "TOOL radius or strength out of range");
+    memset(t, 0, sizeof(t));
+    io_put_u32le(t, 1);
+    io_put_f32le(t + 8, NAN);
+    b_begin(&f);
+    b_sec(&f, "RBF3", t, 44);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 44", "RBF3 holds NaN or Inf");
+    uint8_t g2[512];
+    size_t g2l = grid_payload(g2, 0, 0.001f, 0.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g2, g2l);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 44", "GRID dimension below 1");
+    g2l = grid_payload(g2, 1, 0.001f, 0.5f);
+    io_put_u32le(g2 + 4, 1u << 20);
+    io_put_u32le(g2 + 8, 1u << 20);
+    b_begin(&f);
+    b_sec(&f, "GRID", g2, g2l);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 52", "more than 2^30 samples");
+    g2l = grid_payload(g2, 2, 0.001f, 0.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g2, g2l - 4);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 44", "GRID section length does not match its dimensions");
+    g2l = grid_payload(g2, 1, -0.001f, 0.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g2, g2l);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 56", "GRID spacing, origin, iso or band");
+    g2l = grid_payload(g2, 1, 0.001f, 1.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g2, g2l);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 80", "GRID density not a finite number in [0, 1]");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    b_sec(&f, "GRID", g, gl);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 92", "second GRID section");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    b_sec(&f, "COLR", x, 5);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 104", "COLR section is not 3 bytes per GRID sample");
+    b_begin(&f);
+    b_sec(&f, "COLR", x, 6);
+    b_sec(&f, "COLR", x, 6);
+    b_sec(&f, "GRID", g, gl);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 54", "second COLR section");
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    f.len += 4; /* 4 stray bytes before the file checksum */
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 92", "bytes between the last section and the file checksum");
+    /* an unknown section with a good checksum is skipped; order does not matter */
+    uint8_t m[20];
+    const float mf[5] = {2.0f, 1.0f, 1.0f, 1.0f, 0.0f};
+    for (int k = 0; k < 5; k++)
+        io_put_f32le(m + 4 * k, mf[k]);
+    b_begin(&f);
+    b_sec(&f, "MATL", m, 20);
+    b_sec(&f, "XTRA", x, 8);
+    b_sec(&f, "GRID", g, gl);
+    b_end(&f, p, 1);
+    assert_int_equal(argil_file_read(p, &ok, err, sizeof(err)), ARGIL_OK);
+    assert_float_equal(ok.grid.material.node_mass, 2.0f, 0);
+    argil_doc_free(&ok);
+    spit(p, "", 0);
+    expect_rule(p, "byte 0", "shorter than the 32-byte header");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_atomic),
+        cmocka_unit_test(test_any_corruption_refused),
+        cmocka_unit_test(test_each_rule),
+    };
+    return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}
