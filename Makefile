@@ -32,6 +32,16 @@ SIM_SRC := $(wildcard sim/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(SIM_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
+# argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
+# HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
+BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
+                 firmware/hal/gpio_gpiod.c firmware/hal/link_framer.c firmware/hal/link_udp.c \
+                 firmware/hal/link_ffs.c
+BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
+BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
+BOARD_LDLIBS := -lgpiod -lpthread -lm
+# Sources a fuzz target may need beyond LIB_SRC (the board's config parser; no libgpiod).
+FUZZ_EXTRA_SRC := firmware/board/board_config.c firmware/hal/gpio_port.c
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
 SIL_TESTS := $(patsubst tests/sil/%.c,%,$(wildcard tests/sil/test_*.c))
@@ -41,10 +51,10 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-fuzz check-freestanding tests-build
+.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-fuzz deps-cross check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
-all: $(REL)/argil check-freestanding
+all: $(REL)/argil $(REL)/argil-board check-freestanding
 
 deps:
 	@sh toolchain/install-deps.sh
@@ -57,6 +67,9 @@ deps-test:
 
 deps-fuzz:
 	@sh toolchain/install-deps.sh fuzz
+
+deps-cross:
+	@sh toolchain/install-deps.sh cross
 
 # Pattern rules: release and sanitizer objects.
 $(REL)/%.o: %.c
@@ -75,6 +88,20 @@ $(SAN)/libargil.a: $(LIB_SRC:%.c=$(SAN)/%.o)
 	@rm -f $@
 	ar rcs $@ $^
 
+$(REL)/libboard.a: $(BOARD_LIB_SRC:%.c=$(REL)/%.o)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(SAN)/libboard.a: $(BOARD_LIB_SRC:%.c=$(SAN)/%.o)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(REL)/argil-board: $(REL)/firmware/board/main.o $(REL)/libboard.a
+	$(CC) $(REL_CFLAGS) $^ -o $@ $(BOARD_LDLIBS)
+
+$(SAN)/argil-board: $(SAN)/firmware/board/main.o $(SAN)/libboard.a
+	$(CC) $(TEST_CFLAGS) $^ -o $@ $(BOARD_LDLIBS)
+
 $(REL)/argil: $(REL)/host/app/main.o $(REL)/libargil.a
 	$(CC) $(REL_CFLAGS) $^ -o $@ $(LDLIBS)
 
@@ -85,6 +112,15 @@ $(SAN)/tests/%: tests/unit/%.c $(SAN)/libargil.a
 	@mkdir -p $(dir $@)
 	$(CC) $(TEST_CFLAGS) $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
 
+# A UDP host for tests/sys/test_board_daemon.sh (the host's protocol peer over a real socket).
+$(REL)/board_udp_client: tests/sys/board_udp_client.c $(REL)/libargil.a
+	$(CC) $(REL_CFLAGS) $^ -o $@ $(LDLIBS)
+
+# Tests of the daemon and the Linux HAL link against the board library (no hal_sim.c).
+$(SAN)/tests/test_board_%: tests/unit/test_board_%.c $(SAN)/libboard.a
+	@mkdir -p $(dir $@)
+	$(CC) $(TEST_CFLAGS) $< $(SAN)/libboard.a -o $@ -lcmocka $(BOARD_LDLIBS)
+
 $(SAN)/sil/%: tests/sil/%.c $(SAN)/libargil.a
 	@mkdir -p $(dir $@)
 	$(CC) $(TEST_CFLAGS) $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
@@ -94,10 +130,11 @@ $(SAN)/sil/%: tests/sil/%.c $(SAN)/libargil.a
 check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 	@sh toolchain/check-freestanding.sh $^
 
-tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil
+tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil \
+             $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client
 
-test: deps-test
-	@$(MAKE) --no-print-directory tests-build check-freestanding
+test: deps-test deps-cross
+	@$(MAKE) --no-print-directory tests-build cross-build check-freestanding
 	@sh tests/run_all.sh $(SAN) $(REL)
 
 run: deps-build
@@ -106,9 +143,9 @@ run: deps-build
 
 # libFuzzer targets: clang, the same library sources compiled with the fuzzer's sanitizers.
 FUZZ_CFLAGS := $(CSTD) $(INC) -g -O1 -fsanitize=fuzzer,address,undefined
-$(FZ)/%: tests/fuzz/%.c $(LIB_SRC)
+$(FZ)/%: tests/fuzz/%.c $(LIB_SRC) $(FUZZ_EXTRA_SRC)
 	@mkdir -p $(dir $@)
-	clang $(FUZZ_CFLAGS) $< $(LIB_SRC) -o $@ $(LDLIBS)
+	clang $(FUZZ_CFLAGS) $< $(LIB_SRC) $(FUZZ_EXTRA_SRC) -o $@ $(LDLIBS)
 
 fuzz: deps-fuzz
 	@$(MAKE) --no-print-directory $(FUZZ_TARGETS:%=$(FZ)/%)
@@ -125,9 +162,74 @@ fuzz: deps-fuzz
 bench: all
 	@sh tests/bench.sh $(REL)
 
-cross:
-	@echo "make cross: the aarch64 board daemon and the Cortex-M image come with the board issue;"
-	@echo "            today 'make all' already proves the core links without heap or stdio."
+# ---- cross targets (docs/board.md) ----
+# aarch64 Linux board: argil-board, the core's unit tests and one SIL scenario, run under
+# qemu-aarch64 by tests/sys/test_cross.sh. Cortex-M: the core + shared/ as a bare-metal image
+# that runs a fixed tick sequence (firmware/cortexm/) and reports through semihosting; built
+# for Cortex-M4 (runs on qemu mps2-an386) and Cortex-M7 (mps2-an500). -ffp-contract=off keeps
+# the MCU's fused multiply-adds from changing results against the host reference.
+A64 := $(BUILD)/aarch64
+A64_CC := aarch64-linux-gnu-gcc
+A64_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
+A64_UNIT := $(filter $(UNIT_TESTS),test_safety test_safety_transitions test_drives test_canopen test_spsc_ring test_rt_stats test_window test_arm_kin)
+A64_SIL := $(filter $(SIL_TESTS),test_board_sim)
+CM := $(BUILD)/cortexm
+CM_CC := arm-none-eabi-gcc
+CM_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
+CM_M7 := -mcpu=cortex-m7 -mthumb -mfpu=fpv5-sp-d16 -mfloat-abi=hard
+CM_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g -ffunction-sections -fdata-sections -ffp-contract=off
+CM_CORE_SRC := $(SHARED_SRC) $(filter-out firmware/core/board_hal.c,$(CORE_SRC))
+CM_APP_SRC := firmware/cortexm/startup.c firmware/cortexm/tick_script.c firmware/cortexm/tick_main.c
+# A reference to any of these from the core or shared/ becomes an undefined symbol: no link.
+CM_FORBID := malloc free calloc realloc printf puts fopen
+CM_REDEFINE := $(foreach f,$(CM_FORBID),--redefine-sym $(f)=argil_core_must_not_call_$(f))
+
+$(A64)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(A64_CC) $(A64_CFLAGS) $(if $(filter $<,$(RT_SRC)),$(RT_FLAGS)) -MMD -MP -c $< -o $@
+
+$(A64)/argil-board: $(A64)/firmware/board/main.o $(BOARD_LIB_SRC:%.c=$(A64)/%.o)
+	$(A64_CC) $(A64_CFLAGS) $^ -o $@ $(BOARD_LDLIBS)
+
+$(A64)/tests/%: tests/unit/%.c $(LIB_SRC:%.c=$(A64)/%.o)
+	@mkdir -p $(dir $@)
+	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(LDLIBS)
+
+$(A64)/sil/%: tests/sil/%.c $(LIB_SRC:%.c=$(A64)/%.o)
+	@mkdir -p $(dir $@)
+	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(LDLIBS)
+
+$(CM)/m4/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CM_CC) $(CM_M4) $(CM_CFLAGS) $(if $(filter $<,$(RT_SRC)),$(RT_FLAGS)) -MMD -MP -c $< -o $@
+
+$(CM)/m7/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CM_CC) $(CM_M7) $(CM_CFLAGS) $(if $(filter $<,$(RT_SRC)),$(RT_FLAGS)) -MMD -MP -c $< -o $@
+
+$(CM)/%/core.o: $(CM_CORE_SRC:%.c=$(CM)/m4/%.o) $(CM_CORE_SRC:%.c=$(CM)/m7/%.o)
+	arm-none-eabi-ld -r -o $@.tmp $(CM_CORE_SRC:%.c=$(CM)/$*/%.o)
+	arm-none-eabi-objcopy $(CM_REDEFINE) $@.tmp $@
+	@rm -f $@.tmp
+
+$(CM)/argil-%.elf: $(CM)/%/core.o $(CM_APP_SRC:%.c=$(CM)/m4/%.o) $(CM_APP_SRC:%.c=$(CM)/m7/%.o) firmware/cortexm/mps2.ld
+	$(CM_CC) $(if $(filter m4,$*),$(CM_M4),$(CM_M7)) --specs=rdimon.specs -T firmware/cortexm/mps2.ld \
+	    -Wl,--gc-sections $(CM_APP_SRC:%.c=$(CM)/$*/%.o) $(CM)/$*/core.o -lm -o $@
+
+# The host reference of the same tick sequence, with the same float settings.
+$(CM)/tick_ref: $(CM_APP_SRC:firmware/cortexm/startup.c=) $(CM_CORE_SRC)
+	@mkdir -p $(dir $@)
+	$(CC) $(REL_CFLAGS) -ffp-contract=off $(filter-out firmware/cortexm/startup.c,$(CM_APP_SRC)) $(CM_CORE_SRC) -o $@ $(LDLIBS)
+
+.PRECIOUS: $(A64)/%.o $(CM)/m4/%.o $(CM)/m7/%.o $(CM)/%/core.o
+
+cross-build: $(A64)/argil-board $(A64_UNIT:%=$(A64)/tests/%) $(A64_SIL:%=$(A64)/sil/%) \
+             $(CM)/argil-m4.elf $(CM)/argil-m7.elf $(CM)/tick_ref
+
+cross: deps-cross
+	@$(MAKE) --no-print-directory cross-build
+	@file $(A64)/argil-board | sed 's/, BuildID.*//'
+	@arm-none-eabi-size $(CM)/argil-m4.elf $(CM)/argil-m7.elf
 
 hil:
 	@echo "make hil: the VM rig with real vcan/gpio-sim/FunctionFS comes with the HIL issue."

@@ -6,26 +6,31 @@
 #   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
-BUILD_PKGS="make gcc libc6-dev"          # the build
+BUILD_PKGS="make gcc libc6-dev libgpiod-dev" # the build (libgpiod 1.6: argil-board's GPIO lines)
 TEST_PKGS="libcmocka-dev assimp-utils"   # unit-test runner; a third-party mesh reader for tests
 FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
+# make cross (and the cross tier of make test): aarch64 board daemon + its tests under
+# qemu-user, the Cortex-M image under qemu-system-arm. The :arm64 libraries need Debian's
+# arm64 architecture enabled (done below, once).
+CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64"
 
 check_only=0
 groups=""
 for a in "$@"; do
     case "$a" in
         --check) check_only=1 ;;
-        build|test|fuzz) groups="$groups $a" ;;
-        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz)" >&2; exit 2 ;;
+        build|test|fuzz|cross) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross)" >&2; exit 2 ;;
     esac
 done
-[ -n "$groups" ] || groups="build test fuzz"
+[ -n "$groups" ] || groups="build test fuzz cross"
 PACKAGES=""
 for g in $groups; do
     case "$g" in
         build) PACKAGES="$PACKAGES $BUILD_PKGS" ;;
         test) PACKAGES="$PACKAGES $BUILD_PKGS $TEST_PKGS" ;;
         fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $FUZZ_PKGS" ;;
+        cross) PACKAGES="$PACKAGES $BUILD_PKGS $CROSS_PKGS" ;;
     esac
 done
 
@@ -55,6 +60,16 @@ else
     SUDO=""
 fi
 export DEBIAN_FRONTEND=noninteractive
+need_update=0
+case "$missing" in
+    *:arm64*)
+        if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+            echo "toolchain: enabling Debian's arm64 architecture for the cross libraries"
+            $SUDO dpkg --add-architecture arm64
+            need_update=1
+        fi ;;
+esac
+[ "$need_update" = 1 ] && $SUDO apt-get update -q
 # A fresh machine has empty package lists; refresh them once if an install fails.
 if ! $SUDO apt-get install -y -q --no-install-recommends $missing; then
     echo "toolchain: refreshing package lists (apt-get update)"

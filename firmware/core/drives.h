@@ -1,5 +1,6 @@
-/* CiA 402 master for the arm's drives: NMT start, power state machine, SYNC + RPDO every tick,
- * TPDO and heartbeat supervision. Node id of joint j is j + 1. */
+/* CiA 402 master for the arm's drives: NMT start/stop, power state machine, SYNC + RPDO every
+ * tick, TPDO, heartbeat consumer, EMCY decoding, and the bus state from SocketCAN error frames
+ * (error-passive, bus-off, restart) with a bounded recovery time. Node id of joint j is j + 1. */
 #ifndef ARGIL_DRIVES_H
 #define ARGIL_DRIVES_H
 
@@ -9,8 +10,29 @@
 #include "shared/argil_limits.h"
 #include "shared/canopen.h"
 
+/* SocketCAN error frames pass through can_batch_t unchanged: id carries the error flag and
+ * class bits, data[1] the controller status. Values are Linux's <linux/can/error.h> ones
+ * (checked against the kernel header in firmware/hal/can_socket.c). */
+#define DRIVES_CAN_ERR_FLAG 0x20000000u      /* CAN_ERR_FLAG: this is an error frame */
+#define DRIVES_CAN_ERR_CRTL 0x00000004u      /* CAN_ERR_CRTL: controller problem, see data[1] */
+#define DRIVES_CAN_ERR_BUSOFF 0x00000040u    /* CAN_ERR_BUSOFF */
+#define DRIVES_CAN_ERR_RESTARTED 0x00000100u /* CAN_ERR_RESTARTED: controller restarted */
+#define DRIVES_CAN_CRTL_RX_PASSIVE 0x10u     /* CAN_ERR_CRTL_RX_PASSIVE */
+#define DRIVES_CAN_CRTL_TX_PASSIVE 0x20u     /* CAN_ERR_CRTL_TX_PASSIVE */
+#define DRIVES_CAN_CRTL_ACTIVE 0x40u         /* CAN_ERR_CRTL_ACTIVE: back to error-active */
+
+typedef enum {
+    CAN_BUS_ACTIVE = 0,     /* error-active: normal */
+    CAN_BUS_PASSIVE = 1,    /* error-passive: frames still flow, the bus is sick */
+    CAN_BUS_OFF = 2         /* the controller left the bus: nothing flows */
+} can_bus_state_t;
+
 typedef struct {
-    uint32_t heartbeat_timeout_us;   /* consumer time per drive (default 100 ms + margin) */
+    uint32_t heartbeat_timeout_us;   /* consumer time per drive; drives produce every 100 ms,
+                                        so the default is 150 ms (one late heartbeat tolerated) */
+    uint32_t bus_passive_fault_us;   /* error-passive this long is a fault (default 100 ms) */
+    uint32_t bus_recovery_us;        /* bus-off not restarted within this is unrecoverable
+                                        (default 500 ms); the owner then gives up */
 } drives_cfg_t;
 
 typedef struct {
@@ -18,11 +40,14 @@ typedef struct {
     bool seen;                       /* any heartbeat since init */
     uint32_t heartbeat_age_us;
     cia402_state_t power;            /* from the latest statusword */
+    uint16_t statusword;
     int32_t position_counts;
     int16_t torque_permille;
     bool position_valid;             /* a TPDO arrived since init */
     bool emcy;                       /* an EMCY arrived and has not been cleared by a re-arm */
-    uint16_t emcy_code;
+    uint16_t emcy_code;              /* the latest non-zero error code */
+    uint8_t emcy_register;           /* its error register (object 0x1001) */
+    uint32_t emcy_count;             /* non-zero EMCYs since init */
     bool start_sent;
 } drive_link_t;
 
@@ -31,20 +56,31 @@ typedef struct {
     uint16_t controlword[ARGIL_DRIVES];
     uint32_t frames_rx;
     uint32_t frames_unknown;
+    can_bus_state_t bus;
+    uint32_t bus_state_us;           /* time spent in the current bus state */
+    uint32_t bus_off_events;
+    uint32_t bus_passive_events;
+    uint32_t bus_restarts;
+    uint32_t error_frames;
 } drives_t;
 
 void drives_cfg_default(drives_cfg_t *cfg);
 void drives_init(drives_t *dr);
 
-/* Takes in the frames the drives sent since the last tick. */
+/* Takes in the frames the drives sent since the last tick, and SocketCAN error frames. */
 void drives_receive(drives_t *dr, const can_batch_t *rx);
 
-/* Ages the heartbeats by dt_us and appends this tick's frames (NMT when needed, RPDO per
- * drive with the controlword for want_enabled and the torque, then SYNC) to tx. Torque is
- * forced to zero for any drive not in OPERATION_ENABLED or when want_enabled is false. */
+/* Ages the heartbeats and the bus state by dt_us and appends this tick's frames (NMT when
+ * needed, RPDO per drive with the controlword for want_enabled and the torque, then SYNC) to
+ * tx. Torque is forced to zero for any drive not in OPERATION_ENABLED or when want_enabled is
+ * false; an enabled drive that must stop gets quick stop. Nothing is queued while bus-off. */
 void drives_process(drives_t *dr, const drives_cfg_t *cfg, bool want_enabled,
                     const int16_t torque_permille[ARGIL_DRIVES], uint32_t dt_us,
                     can_batch_t *tx);
+
+/* Appends the frames that leave the drives safe on shutdown: zero torque with disable voltage
+ * to every operational drive, then NMT stop to each node. */
+void drives_shutdown(drives_t *dr, can_batch_t *tx);
 
 /* Clears latched EMCY flags (the host re-armed). */
 void drives_clear_emcy(drives_t *dr);
@@ -53,5 +89,15 @@ bool drives_all_enabled(const drives_t *dr);
 bool drives_heartbeat_lost(const drives_t *dr, const drives_cfg_t *cfg);
 bool drives_any_emcy(const drives_t *dr);
 bool drives_positions_valid(const drives_t *dr);
+
+/* True when the bus is a fault for the safety machine: bus-off, or error-passive for longer
+ * than cfg->bus_passive_fault_us. */
+bool drives_bus_error(const drives_t *dr, const drives_cfg_t *cfg);
+/* True when bus-off has lasted longer than cfg->bus_recovery_us. */
+bool drives_bus_unrecoverable(const drives_t *dr, const drives_cfg_t *cfg);
+
+/* The CiA 301 class of an EMCY error code, in a few English words ("current", "voltage"…). */
+const char *drives_emcy_class(uint16_t code);
+const char *drives_bus_state_name(can_bus_state_t s);
 
 #endif

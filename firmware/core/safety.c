@@ -46,6 +46,8 @@ static fault_code_t input_fault(const safety_inputs_t *in, const safety_t *s,
         return FAULT_DEADLINE;
     if (in->force_limit_exceeded)
         return FAULT_FORCE_LIMIT;
+    if (in->velocity_limit_exceeded)
+        return FAULT_VELOCITY_LIMIT;
     return FAULT_NONE;
 }
 
@@ -158,6 +160,7 @@ const char *safety_fault_name(fault_code_t f)
     case FAULT_FORCE_LIMIT: return "force limit exceeded";
     case FAULT_BUS: return "CAN bus error";
     case FAULT_ESTOP: return "e-stop";
+    case FAULT_VELOCITY_LIMIT: return "velocity limit exceeded";
     }
     return "?";
 }

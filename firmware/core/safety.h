@@ -25,7 +25,8 @@ typedef enum {
     FAULT_NONFINITE = 6,       /* NaN/Inf in a position, window or gain */
     FAULT_FORCE_LIMIT = 7,     /* the controller itself asked for more than the limit */
     FAULT_BUS = 8,             /* CAN bus-off or frames could not be sent */
-    FAULT_ESTOP = 9
+    FAULT_ESTOP = 9,
+    FAULT_VELOCITY_LIMIT = 10  /* the tool moved faster than the configured limit */
 } fault_code_t;
 
 typedef struct {
@@ -47,7 +48,8 @@ typedef struct {
     bool nonfinite;                /* the tick saw NaN/Inf in its inputs or its force */
     bool force_limit_exceeded;
     bool deadline_overrun;         /* the previous tick overran its period */
-    bool bus_error;
+    bool bus_error;                /* CAN bus-off, or error-passive too long */
+    bool velocity_limit_exceeded;  /* tool speed above board_cfg_t.max_velocity_m_s */
 } safety_inputs_t;
 
 typedef struct {

@@ -1,0 +1,364 @@
+/* argil-board settings: one table, parsed from INI text or the command line. */
+#include "board_config.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const board_setting_t board_settings[] = {
+    {"can", "bus", "bus", "socketcan|sim",
+     "drive bus: the SocketCAN interface, or the simulated arm (no hardware)"},
+    {"can", "interface", "can", "IF", "SocketCAN interface of the drives (can0)"},
+    {"can", "heartbeat_timeout_ms", "drive-heartbeat-ms", "MS",
+     "heartbeat consumer time per drive; drives produce every 100 ms (150)"},
+    {"can", "bus_recovery_ms", "bus-recovery-ms", "MS",
+     "bus-off must be restarted (restart-ms) within this, else exit for a restart (500)"},
+    {"gpio", "chip", "gpio-chip", "CHIP", "GPIO chip: name, path, label or number (gpiochip0)"},
+    {"gpio", "estop", "line-estop", "NAME", "e-stop input, active low (ESTOP_N)"},
+    {"gpio", "drive_fault", "line-drive-fault", "NAME", "drive fault input, active low (DRIVE_FAULT_N)"},
+    {"gpio", "stylus_btn1", "line-btn1", "NAME", "stylus button 1 input (STYLUS_BTN1)"},
+    {"gpio", "stylus_btn2", "line-btn2", "NAME", "stylus button 2 input (STYLUS_BTN2)"},
+    {"gpio", "drive_enable", "line-drive-enable", "NAME", "drive enable output (DRIVE_ENABLE)"},
+    {"gpio", "status_led", "line-led", "NAME", "status LED output, a pattern per state (STATUS_LED)"},
+    {"gpio", "wdog_kick", "line-wdog", "NAME",
+     "external watchdog output, toggled every healthy tick (WDOG_KICK)"},
+    {"link", "host", "link", "udp:ADDR:PORT|ffs:DIR",
+     "host link: UDP address to listen on, or a FunctionFS mount (udp:0.0.0.0:7700)"},
+    {"link", "heartbeat_timeout_ms", "host-timeout-ms", "MS",
+     "host heartbeat silence that stops sculpting and fades the force (50)"},
+    {"link", "fade_ms", "host-fade-ms", "MS", "force fade to zero after the host is lost (20)"},
+    {"loop", "rate_hz", "rate-hz", "HZ", "loop rate: 1000, 2000 or 4000 (1000)"},
+    {"loop", "rt_priority", "rt-priority", "PRIO",
+     "SCHED_FIFO priority of the fast loop, 1-99; 0 = no real-time scheduling (80)"},
+    {"loop", "cpu", "cpu", "N", "CPU to pin the fast loop to; -1 = any (-1)"},
+    {"loop", "overrun_streak", "overrun-streak", "N",
+     "ticks in a row over their period that are a fault; 0 = never (3)"},
+    {"loop", "stats_period_s", "stats-period-s", "S",
+     "log deadline statistics every S seconds; 0 = only on exit (10)"},
+    {"loop", "duration_s", "duration-s", "S", "stop cleanly after S seconds; 0 = run until signalled (0)"},
+    {"limits", "max_force_n", "max-force-n", "N", "hard limit on the force to the hand (3.3)"},
+    {"limits", "max_velocity_m_s", "max-velocity-m-s", "M/S",
+     "tool speed that is a fault; 0 = no limit (1.5)"},
+    {"transform", "scale", "model-scale", "K",
+     "device-to-model scale until the host sends its tool transform (1)"},
+    {"transform", "offset_m", "model-offset-m", "X,Y,Z",
+     "device-to-model offset in metres, same rule (0,0,0)"},
+};
+const size_t board_settings_count = sizeof(board_settings) / sizeof(board_settings[0]);
+
+static void copy_str(char *dst, size_t cap, const char *src)
+{
+    const size_t n = strlen(src) < cap - 1u ? strlen(src) : cap - 1u;
+    memcpy(dst, src, n);
+    dst[n] = '\0';
+}
+
+void board_config_default(board_daemon_cfg_t *c)
+{
+    memset(c, 0, sizeof(*c));
+    c->bus = BOARD_BUS_SOCKETCAN;
+    copy_str(c->can_if, sizeof(c->can_if), "can0");
+    c->drive_heartbeat_ms = 150;
+    c->bus_recovery_ms = 500;
+    gpio_names_default(&c->gpio);
+    c->link = BOARD_LINK_UDP;
+    copy_str(c->link_target, sizeof(c->link_target), "0.0.0.0:7700");
+    c->host_timeout_ms = 50;
+    c->host_fade_ms = 20;
+    c->rate_hz = 1000;
+    c->rt_priority = 80;
+    c->cpu = -1;
+    c->overrun_streak = 3;
+    c->stats_period_s = 10;
+    c->duration_s = 0.0f;
+    c->max_force_n = 3.3f;
+    c->max_velocity_m_s = 1.5f;
+    c->model_scale = 1.0f;
+}
+
+static argil_err_t parse_long(const char *v, long lo, long hi, long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const long x = strtol(v, &end, 10);
+    if (errno != 0 || end == v || *end != '\0' || x < lo || x > hi)
+        return ARGIL_ERR_PARSE;
+    *out = x;
+    return ARGIL_OK;
+}
+
+static argil_err_t parse_float(const char *v, float lo, float hi, float *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const float x = strtof(v, &end);
+    if (errno != 0 || end == v || *end != '\0' || !isfinite(x) || x < lo || x > hi)
+        return ARGIL_ERR_PARSE;
+    *out = x;
+    return ARGIL_OK;
+}
+
+static argil_err_t set_name(char *dst, size_t cap, const char *v)
+{
+    if (v[0] == '\0' || strlen(v) >= cap)
+        return ARGIL_ERR_PARSE;
+    for (const char *p = v; *p; p++)
+        if (*p == ' ' || *p == '\t' || (unsigned char)*p < 0x20)
+            return ARGIL_ERR_PARSE;
+    copy_str(dst, cap, v);
+    return ARGIL_OK;
+}
+
+#define BAD(...) (snprintf(why, why_len, __VA_ARGS__), ARGIL_ERR_PARSE)
+
+argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
+                             const char *v, char *why, size_t why_len)
+{
+    long x = 0;
+    float f = 0.0f;
+    const char *lines[] = {"estop", "drive_fault", "stylus_btn1", "stylus_btn2",
+                           "drive_enable", "status_led", "wdog_kick"};
+#define IS(s, k) (strcmp(section, s) == 0 && strcmp(key, k) == 0)
+    if (IS("can", "bus")) {
+        if (strcmp(v, "socketcan") == 0)
+            c->bus = BOARD_BUS_SOCKETCAN;
+        else if (strcmp(v, "sim") == 0)
+            c->bus = BOARD_BUS_SIM;
+        else
+            return BAD("can.bus '%s': expected socketcan or sim", v);
+        return ARGIL_OK;
+    }
+    if (IS("can", "interface")) {
+        if (set_name(c->can_if, 16, v) != ARGIL_OK)
+            return BAD("can.interface '%s': expected an interface name of 1-15 characters", v);
+        return ARGIL_OK;
+    }
+    if (IS("can", "heartbeat_timeout_ms")) {
+        if (parse_long(v, 10, 10000, &x) != ARGIL_OK)
+            return BAD("can.heartbeat_timeout_ms '%s': expected 10-10000", v);
+        c->drive_heartbeat_ms = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("can", "bus_recovery_ms")) {
+        if (parse_long(v, 10, 60000, &x) != ARGIL_OK)
+            return BAD("can.bus_recovery_ms '%s': expected 10-60000", v);
+        c->bus_recovery_ms = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("gpio", "chip")) {
+        if (set_name(c->gpio.chip, GPIO_NAME_LEN, v) != ARGIL_OK)
+            return BAD("gpio.chip '%s': expected a chip name of 1-%u characters", v,
+                       GPIO_NAME_LEN - 1u);
+        return ARGIL_OK;
+    }
+    if (strcmp(section, "gpio") == 0) {
+        for (uint32_t i = 0; i < 7; i++) {
+            if (strcmp(key, lines[i]) != 0)
+                continue;
+            char *dst = i < GPIO_IN_COUNT ? c->gpio.in[i] : c->gpio.out[i - GPIO_IN_COUNT];
+            if (set_name(dst, GPIO_NAME_LEN, v) != ARGIL_OK)
+                return BAD("gpio.%s '%s': expected a line name of 1-%u characters", key, v,
+                           GPIO_NAME_LEN - 1u);
+            return ARGIL_OK;
+        }
+    }
+    if (IS("link", "host")) {
+        if (strncmp(v, "udp:", 4) == 0 && v[4] != '\0' && strlen(v + 4) < BOARD_CFG_STR) {
+            c->link = BOARD_LINK_UDP;
+            copy_str(c->link_target, sizeof(c->link_target), v + 4);
+            return ARGIL_OK;
+        }
+        if (strncmp(v, "ffs:", 4) == 0 && v[4] != '\0' && strlen(v + 4) < BOARD_CFG_STR) {
+            c->link = BOARD_LINK_FFS;
+            copy_str(c->link_target, sizeof(c->link_target), v + 4);
+            return ARGIL_OK;
+        }
+        return BAD("link.host '%s': expected udp:ADDR:PORT or ffs:DIR", v);
+    }
+    if (IS("link", "heartbeat_timeout_ms")) {
+        if (parse_long(v, 5, 10000, &x) != ARGIL_OK)
+            return BAD("link.heartbeat_timeout_ms '%s': expected 5-10000", v);
+        c->host_timeout_ms = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("link", "fade_ms")) {
+        if (parse_long(v, 0, 1000, &x) != ARGIL_OK)
+            return BAD("link.fade_ms '%s': expected 0-1000", v);
+        c->host_fade_ms = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "rate_hz")) {
+        if (parse_long(v, 100, 10000, &x) != ARGIL_OK || 1000000L % x != 0)
+            return BAD("loop.rate_hz '%s': expected 100-10000 Hz dividing 1 s into whole "
+                       "microseconds (1000, 2000, 4000)", v);
+        c->rate_hz = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "rt_priority")) {
+        if (parse_long(v, 0, 99, &x) != ARGIL_OK)
+            return BAD("loop.rt_priority '%s': expected 0-99", v);
+        c->rt_priority = (int32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "cpu")) {
+        if (parse_long(v, -1, 1023, &x) != ARGIL_OK)
+            return BAD("loop.cpu '%s': expected -1 (any) or a CPU number 0-1023", v);
+        c->cpu = (int32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "overrun_streak")) {
+        if (parse_long(v, 0, 1000, &x) != ARGIL_OK)
+            return BAD("loop.overrun_streak '%s': expected 0-1000", v);
+        c->overrun_streak = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "stats_period_s")) {
+        if (parse_long(v, 0, 86400, &x) != ARGIL_OK)
+            return BAD("loop.stats_period_s '%s': expected 0-86400", v);
+        c->stats_period_s = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("loop", "duration_s")) {
+        if (parse_float(v, 0.0f, 1e6f, &f) != ARGIL_OK)
+            return BAD("loop.duration_s '%s': expected 0-1000000 seconds", v);
+        c->duration_s = f;
+        return ARGIL_OK;
+    }
+    if (IS("limits", "max_force_n")) {
+        if (parse_float(v, 0.01f, 20.0f, &f) != ARGIL_OK)
+            return BAD("limits.max_force_n '%s': expected 0.01-20 N", v);
+        c->max_force_n = f;
+        return ARGIL_OK;
+    }
+    if (IS("limits", "max_velocity_m_s")) {
+        if (parse_float(v, 0.0f, 20.0f, &f) != ARGIL_OK)
+            return BAD("limits.max_velocity_m_s '%s': expected 0-20 m/s (0 = no limit)", v);
+        c->max_velocity_m_s = f;
+        return ARGIL_OK;
+    }
+    if (IS("transform", "scale")) {
+        if (parse_float(v, 1e-3f, 1e3f, &f) != ARGIL_OK)
+            return BAD("transform.scale '%s': expected 0.001-1000", v);
+        c->model_scale = f;
+        return ARGIL_OK;
+    }
+    if (IS("transform", "offset_m")) {
+        float o[3];
+        char buf[96];
+        if (strlen(v) >= sizeof(buf))
+            return BAD("transform.offset_m: too long");
+        copy_str(buf, sizeof(buf), v);
+        char *p = buf;
+        for (int i = 0; i < 3; i++) {
+            char *comma = strchr(p, ',');
+            if ((i < 2) != (comma != NULL))
+                return BAD("transform.offset_m '%s': expected X,Y,Z in metres", v);
+            if (comma)
+                *comma = '\0';
+            if (parse_float(p, -100.0f, 100.0f, &o[i]) != ARGIL_OK)
+                return BAD("transform.offset_m '%s': expected X,Y,Z in metres, each within "
+                           "+-100", v);
+            p = comma ? comma + 1 : p;
+        }
+        memcpy(c->model_offset_m, o, sizeof(o));
+        return ARGIL_OK;
+    }
+#undef IS
+    snprintf(why, why_len, "unknown setting '%s.%s'", section, key);
+    return ARGIL_ERR_ARG;
+}
+
+static const char *trim(char *s)
+{
+    while (*s == ' ' || *s == '\t')
+        s++;
+    size_t n = strlen(s);
+    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r'))
+        s[--n] = '\0';
+    return s;
+}
+
+argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
+                                   uint32_t *line, char *why, size_t why_len)
+{
+    char section[32] = "";
+    char buf[256];
+    size_t at = 0;
+    *line = 0;
+    while (at < len) {
+        (*line)++;
+        size_t end = at;
+        while (end < len && text[end] != '\n')
+            end++;
+        const size_t n = end - at;
+        if (n >= sizeof(buf)) {
+            snprintf(why, why_len, "line longer than %zu characters", sizeof(buf) - 1u);
+            return ARGIL_ERR_PARSE;
+        }
+        memcpy(buf, text + at, n);
+        buf[n] = '\0';
+        at = end < len ? end + 1 : end;
+        if (memchr(buf, '\0', n) != NULL) {
+            snprintf(why, why_len, "NUL byte in the file");
+            return ARGIL_ERR_PARSE;
+        }
+        char *s = (char *)trim(buf);
+        if (*s == '\0' || *s == ';' || *s == '#')
+            continue;
+        if (*s == '[') {
+            char *close = strchr(s, ']');
+            if (close == NULL || trim(close + 1)[0] != '\0') {
+                snprintf(why, why_len, "expected [section]");
+                return ARGIL_ERR_PARSE;
+            }
+            *close = '\0';
+            const char *name = trim(s + 1);
+            if (name[0] == '\0' || strlen(name) >= sizeof(section)) {
+                snprintf(why, why_len, "empty or overlong section name");
+                return ARGIL_ERR_PARSE;
+            }
+            copy_str(section, sizeof(section), name);
+            continue;
+        }
+        char *eq = strchr(s, '=');
+        if (eq == NULL) {
+            snprintf(why, why_len, "expected key = value or [section]");
+            return ARGIL_ERR_PARSE;
+        }
+        *eq = '\0';
+        const char *key = trim(s);
+        char *value = eq + 1;
+        /* An inline comment starts at ';' or '#' after whitespace. */
+        for (char *p = value; *p; p++)
+            if ((*p == ';' || *p == '#') && (p == value || p[-1] == ' ' || p[-1] == '\t')) {
+                *p = '\0';
+                break;
+            }
+        const char *val = trim(value);
+        if (section[0] == '\0') {
+            snprintf(why, why_len, "'%s' is outside any [section]", key);
+            return ARGIL_ERR_PARSE;
+        }
+        const argil_err_t rc = board_config_set(c, section, key, val, why, why_len);
+        if (rc != ARGIL_OK)
+            return rc;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len)
+{
+    if (c->host_fade_ms > c->host_timeout_ms * 10u) {
+        snprintf(why, why_len, "link.fade_ms (%u) must not exceed ten host timeouts (%u ms)",
+                 c->host_fade_ms, c->host_timeout_ms * 10u);
+        return ARGIL_ERR_ARG;
+    }
+    if (c->drive_heartbeat_ms * 1000u < 1000000u / c->rate_hz) {
+        snprintf(why, why_len, "can.heartbeat_timeout_ms (%u) is shorter than one tick",
+                 c->drive_heartbeat_ms);
+        return ARGIL_ERR_ARG;
+    }
+    return ARGIL_OK;
+}

@@ -1,0 +1,68 @@
+/* argil-board's configuration: defaults, an INI file and command-line overrides, all through
+ * one table of settings (section.key), so the file, the CLI and --help say the same thing.
+ * Library code: returns which rule the input broke; never prints, never exits. */
+#ifndef ARGIL_BOARD_CONFIG_H
+#define ARGIL_BOARD_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "firmware/hal/gpio_port.h"
+#include "shared/argil_err.h"
+
+#define BOARD_CFG_STR 128u
+
+typedef enum { BOARD_BUS_SOCKETCAN = 0, BOARD_BUS_SIM = 1 } board_bus_t;
+typedef enum { BOARD_LINK_UDP = 0, BOARD_LINK_FFS = 1 } board_link_t;
+
+typedef struct {
+    board_bus_t bus;
+    char can_if[32];
+    uint32_t drive_heartbeat_ms;     /* heartbeat consumer time per drive */
+    uint32_t bus_recovery_ms;        /* bus-off must recover within this, else exit */
+    gpio_names_t gpio;
+    board_link_t link;
+    char link_target[BOARD_CFG_STR]; /* "ADDR:PORT" or the FunctionFS mount directory */
+    uint32_t host_timeout_ms;
+    uint32_t host_fade_ms;
+    uint32_t rate_hz;                /* 1000, 2000 or 4000 (100 … 10000 accepted) */
+    int32_t rt_priority;             /* SCHED_FIFO 1..99; 0 = stay SCHED_OTHER */
+    int32_t cpu;                     /* CPU to pin the fast loop to; -1 = any */
+    uint32_t overrun_streak;         /* consecutive overruns that are a fault; 0 = never */
+    float max_force_n;
+    float max_velocity_m_s;
+    float model_scale;               /* device → model until the host's TOOL frame sets one */
+    float model_offset_m[3];
+    uint32_t stats_period_s;         /* deadline statistics to the log; 0 = only on exit */
+    float duration_s;                /* run this long then stop cleanly; 0 = until signalled */
+} board_daemon_cfg_t;
+
+/* One setting: where it lives in the INI file, its CLI flag and what --help says. */
+typedef struct {
+    const char *section;
+    const char *key;
+    const char *flag;                /* long option without "--" */
+    const char *arg;                 /* argument name for --help */
+    const char *help;
+} board_setting_t;
+
+extern const board_setting_t board_settings[];
+extern const size_t board_settings_count;
+
+void board_config_default(board_daemon_cfg_t *c);
+
+/* Sets section.key from text. ARGIL_ERR_ARG for an unknown setting, ARGIL_ERR_PARSE for a
+ * value that is malformed or out of range; why gets one line saying which. */
+argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
+                             const char *value, char *why, size_t why_len);
+
+/* Applies INI text: [section] headers, key = value, ';' or '#' comments, blank lines.
+ * On error *line is the 1-based line and why says what is wrong. */
+argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
+                                   uint32_t *line, char *why, size_t why_len);
+
+/* Checks the settings together (rate, priority, limits); one line into why. */
+argil_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len);
+
+#endif

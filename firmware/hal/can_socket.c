@@ -1,0 +1,127 @@
+/* SocketCAN raw socket: struct can_frame <-> can_frame_t, never blocking. */
+#include "can_socket.h"
+
+#include <errno.h>
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "firmware/core/drives.h"
+
+/* The core decodes error frames with its own copies of the kernel's constants. */
+_Static_assert(DRIVES_CAN_ERR_FLAG == CAN_ERR_FLAG, "CAN_ERR_FLAG");
+_Static_assert(DRIVES_CAN_ERR_CRTL == CAN_ERR_CRTL, "CAN_ERR_CRTL");
+_Static_assert(DRIVES_CAN_ERR_BUSOFF == CAN_ERR_BUSOFF, "CAN_ERR_BUSOFF");
+_Static_assert(DRIVES_CAN_ERR_RESTARTED == CAN_ERR_RESTARTED, "CAN_ERR_RESTARTED");
+_Static_assert(DRIVES_CAN_CRTL_RX_PASSIVE == CAN_ERR_CRTL_RX_PASSIVE, "RX_PASSIVE");
+_Static_assert(DRIVES_CAN_CRTL_TX_PASSIVE == CAN_ERR_CRTL_TX_PASSIVE, "TX_PASSIVE");
+_Static_assert(DRIVES_CAN_CRTL_ACTIVE == CAN_ERR_CRTL_ACTIVE, "CRTL_ACTIVE");
+
+argil_err_t can_socket_open(const char *ifname, int *fd, char *err, size_t err_len)
+{
+    *fd = -1;
+    if (ifname == NULL || ifname[0] == '\0' || strlen(ifname) >= IFNAMSIZ) {
+        snprintf(err, err_len, "CAN interface name '%s' is empty or longer than %d characters",
+                 ifname ? ifname : "", IFNAMSIZ - 1);
+        return ARGIL_ERR_ARG;
+    }
+    const int s = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (s < 0) {
+        snprintf(err, err_len, "CAN interface '%s': cannot create a SocketCAN socket (%s)%s",
+                 ifname, strerror(errno),
+                 errno == EAFNOSUPPORT ? "; this kernel has no CAN support (modprobe can-raw)" : "");
+        return ARGIL_ERR_IO;
+    }
+    struct ifreq ifr;
+    memset(&ifr, 0, sizeof(ifr));
+    memcpy(ifr.ifr_name, ifname, strlen(ifname));
+    if (ioctl(s, SIOCGIFINDEX, &ifr) < 0) {
+        snprintf(err, err_len, "CAN interface '%s' not found (%s)", ifname, strerror(errno));
+        close(s);
+        return ARGIL_ERR_IO;
+    }
+    const can_err_mask_t mask = CAN_ERR_BUSOFF | CAN_ERR_CRTL | CAN_ERR_RESTARTED;
+    if (setsockopt(s, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &mask, sizeof(mask)) < 0) {
+        snprintf(err, err_len, "CAN interface '%s': cannot enable error frames (%s)", ifname,
+                 strerror(errno));
+        close(s);
+        return ARGIL_ERR_IO;
+    }
+    struct sockaddr_can addr;
+    memset(&addr, 0, sizeof(addr));
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = ifr.ifr_ifindex;
+    if (bind(s, (struct sockaddr *)&addr, sizeof(addr)) < 0) {
+        snprintf(err, err_len, "CAN interface '%s': bind failed (%s)", ifname, strerror(errno));
+        close(s);
+        return ARGIL_ERR_IO;
+    }
+    *fd = s;
+    return ARGIL_OK;
+}
+
+argil_err_t can_socket_receive(int fd, can_batch_t *rx, can_socket_stats_t *st)
+{
+    rx->n = 0;
+    for (uint32_t i = 0; i < CAN_BATCH_MAX; i++) {
+        struct can_frame cf;
+        const ssize_t n = recv(fd, &cf, sizeof(cf), MSG_DONTWAIT);
+        if (n < 0) {
+            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+                return ARGIL_OK;
+            st->last_errno = errno;
+            return ARGIL_ERR_IO;
+        }
+        if (n != (ssize_t)sizeof(cf) || cf.can_dlc > 8 || (cf.can_id & CAN_RTR_FLAG)) {
+            st->rx_dropped++;
+            continue;
+        }
+        can_frame_t f;
+        memset(&f, 0, sizeof(f));
+        if (cf.can_id & CAN_ERR_FLAG) {
+            f.id = cf.can_id & (CAN_ERR_FLAG | CAN_ERR_MASK);
+            st->rx_error_frames++;
+        } else if (cf.can_id & CAN_EFF_FLAG) {
+            st->rx_dropped++; /* CANopen uses 11-bit identifiers only */
+            continue;
+        } else {
+            f.id = cf.can_id & CAN_SFF_MASK;
+        }
+        f.len = cf.can_dlc;
+        memcpy(f.data, cf.data, f.len);
+        (void)can_batch_push(rx, &f);
+        st->rx_frames++;
+    }
+    /* More is waiting than a tick takes: it stays queued for the next tick. */
+    return ARGIL_OK;
+}
+
+argil_err_t can_socket_send(int fd, const can_batch_t *tx, can_socket_stats_t *st)
+{
+    const uint8_t n = tx->n <= CAN_BATCH_MAX ? tx->n : CAN_BATCH_MAX;
+    for (uint8_t i = 0; i < n; i++) {
+        struct can_frame cf;
+        memset(&cf, 0, sizeof(cf));
+        cf.can_id = tx->f[i].id & CAN_SFF_MASK;
+        cf.can_dlc = tx->f[i].len <= 8 ? tx->f[i].len : 8;
+        memcpy(cf.data, tx->f[i].data, cf.can_dlc);
+        const ssize_t w = send(fd, &cf, sizeof(cf), MSG_DONTWAIT);
+        if (w != (ssize_t)sizeof(cf)) {
+            st->last_errno = w < 0 ? errno : EIO;
+            if (w < 0 && (errno == ENOBUFS || errno == EAGAIN || errno == EWOULDBLOCK)) {
+                st->tx_busy++;
+                return ARGIL_ERR_FULL;
+            }
+            st->tx_errors++;
+            return ARGIL_ERR_IO;
+        }
+        st->tx_frames++;
+    }
+    return ARGIL_OK;
+}

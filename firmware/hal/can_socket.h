@@ -1,0 +1,36 @@
+/* SocketCAN raw socket for the drives' bus: open by interface name, non-blocking receive of
+ * data and error frames into a can_batch_t, send a batch. Linux only (hosted). */
+#ifndef ARGIL_CAN_SOCKET_H
+#define ARGIL_CAN_SOCKET_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/canopen.h"
+
+typedef struct {
+    uint32_t rx_frames;
+    uint32_t rx_error_frames;
+    uint32_t rx_dropped;          /* frames beyond CAN_BATCH_MAX in one tick, or malformed */
+    uint32_t tx_frames;
+    uint32_t tx_busy;             /* sends refused: the queue is full (ENOBUFS/EAGAIN) */
+    uint32_t tx_errors;           /* sends refused for other reasons (ENETDOWN…) */
+    int last_errno;
+} can_socket_stats_t;
+
+/* Opens a raw CAN socket bound to ifname, non-blocking, with error frames for bus-off,
+ * controller state and restarts enabled. On failure writes one line into err (no newline)
+ * naming the interface and the cause, and returns ARGIL_ERR_IO (or ARGIL_ERR_ARG for a bad
+ * name). */
+argil_err_t can_socket_open(const char *ifname, int *fd, char *err, size_t err_len);
+
+/* Reads every frame waiting on fd (up to CAN_BATCH_MAX) into rx without blocking. Error
+ * frames keep their CAN_ERR_FLAG id (firmware/core/drives.h decodes them). */
+argil_err_t can_socket_receive(int fd, can_batch_t *rx, can_socket_stats_t *st);
+
+/* Writes every frame of tx without blocking; ARGIL_ERR_FULL when the kernel queue is full,
+ * ARGIL_ERR_IO for another failure (the rest of the batch is not sent). */
+argil_err_t can_socket_send(int fd, const can_batch_t *tx, can_socket_stats_t *st);
+
+#endif

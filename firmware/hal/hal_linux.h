@@ -1,0 +1,54 @@
+/* The Linux board backend of the HAL: SocketCAN for the drives, libgpiod lines, and the host
+ * link handed over through two lock-free SPSC rings that the link thread serves (the fast loop
+ * never makes a link system call). A "sim" bus replaces CAN and GPIO with the in-process
+ * simulated arm (sim/), so the real daemon runs and is tested on a machine with neither. */
+#ifndef ARGIL_HAL_LINUX_H
+#define ARGIL_HAL_LINUX_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "can_socket.h"
+#include "firmware/core/spsc_ring.h"
+#include "gpio_port.h"
+#include "hal.h"
+#include "sim/sim_device.h"
+
+#define HAL_LINUX_RX_RING_BYTES (1u << 17)   /* host → board frames waiting for the tick */
+#define HAL_LINUX_TX_RING_BYTES (1u << 19)   /* board → host, about 50 ticks of output */
+
+typedef enum { HAL_BUS_SOCKETCAN = 0, HAL_BUS_SIM = 1 } hal_bus_t;
+
+struct hal {
+    hal_bus_t bus;
+    int can_fd;
+    can_socket_stats_t can;
+    gpio_port_t gpio;
+    /* sim bus */
+    sim_device_t *sim;
+    can_batch_t sim_from_board;    /* frames the board sent, delivered at the next step */
+    uint32_t sim_gpio_out;
+    uint32_t tick_us;
+    /* host link */
+    spsc_ring_t link_rx;           /* producer: link thread; consumer: fast loop */
+    spsc_ring_t link_tx;           /* producer: fast loop; consumer: link thread */
+    uint8_t link_rx_mem[HAL_LINUX_RX_RING_BYTES];
+    uint8_t link_tx_mem[HAL_LINUX_TX_RING_BYTES];
+    uint32_t link_rx_too_big;      /* records larger than the tick's buffer (dropped) */
+};
+
+/* Opens the SocketCAN interface and the GPIO lines. One line into err on failure. */
+argil_err_t hal_linux_open(hal_t *h, const char *can_if, const gpio_names_t *names,
+                           char *err, size_t err_len);
+
+/* Uses the simulated arm (sim_params_default) for CAN and GPIO; the lines still go through
+ * gpio_port with the default names, so a wrong line name fails as on a real chip. */
+argil_err_t hal_linux_open_sim(hal_t *h, const gpio_names_t *names, uint32_t tick_us,
+                               char *err, size_t err_len);
+
+void hal_linux_close(hal_t *h);
+
+/* Sends the frames in tx straight away (shutdown: quick stop / NMT stop). */
+argil_err_t hal_linux_can_flush(hal_t *h, const can_batch_t *tx);
+
+#endif

@@ -1,0 +1,90 @@
+/* The host link's transports for the board daemon's link thread: UDP (one frame per datagram,
+ * replies go to whoever sent the last valid frame, so a restarted host is picked up at once)
+ * and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
+ * the same frames back to back). A framer cuts a byte stream into whole protocol frames.
+ * Linux only (hosted); nothing here runs in the fast loop. */
+#ifndef ARGIL_LINK_IO_H
+#define ARGIL_LINK_IO_H
+
+#include <netinet/in.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shared/argil_err.h"
+#include "shared/proto.h"
+
+#define LINK_USB_VID 0x1209u   /* pid.codes test VID */
+#define LINK_USB_PID 0x0001u   /* pid.codes test PID */
+
+/* ---- framing ---- */
+
+/* Size of the frame whose header starts buf (header length field + header + CRC), or 0 when
+ * fewer than PROTO_HEADER_SIZE bytes are given, the magic is wrong or it would exceed
+ * PROTO_FRAME_MAX. */
+size_t link_frame_size(const uint8_t *buf, size_t len);
+
+typedef struct {
+    uint8_t buf[2u * PROTO_FRAME_MAX];
+    size_t len;
+    uint32_t skipped_bytes;     /* bytes dropped while looking for a frame start */
+} link_framer_t;
+
+void link_framer_init(link_framer_t *fr);
+/* Appends bytes (at most sizeof(buf) - len are taken; returns how many). */
+size_t link_framer_feed(link_framer_t *fr, const uint8_t *data, size_t len);
+/* Moves the next whole frame to out (cap ≥ PROTO_FRAME_MAX); returns its size or 0. */
+size_t link_framer_next(link_framer_t *fr, uint8_t *out, size_t cap);
+
+/* ---- UDP ---- */
+
+typedef struct {
+    int fd;
+    struct sockaddr_in peer;
+    bool have_peer;
+    uint32_t peer_changes;       /* a (re)connecting host: the first frame from a new address */
+    uint32_t rx_datagrams;
+    uint32_t rx_refused;         /* not starting with a frame header */
+    uint32_t tx_datagrams;
+    uint32_t tx_errors;
+} link_udp_t;
+
+/* Parses "ADDR:PORT" (IPv4 dotted quad, port 1..65535). */
+argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
+
+/* Binds a non-blocking UDP socket to spec ("ADDR:PORT"); one line into err on failure. */
+argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len);
+
+/* Receives one datagram into buf if one waits; returns its length, 0 when none. A datagram
+ * that does not start with a frame header is refused (0, counted). */
+size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap);
+
+/* Sends each whole frame of buf[0..len) as its own datagram to the current peer.
+ * ARGIL_ERR_STATE when no host has spoken yet, ARGIL_ERR_IO on a send failure. */
+argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len);
+
+void link_udp_close(link_udp_t *u);
+
+/* ---- USB FunctionFS ---- */
+
+typedef struct {
+    int ep0;
+    int ep_out;                  /* host → board (bulk OUT, ep1 file) */
+    int ep_in;                   /* board → host (bulk IN, ep2 file) */
+    bool enabled;                /* the host configured the gadget (FUNCTIONFS_ENABLE) */
+    uint32_t enables;
+    uint32_t disables;
+} link_ffs_t;
+
+/* Writes the FunctionFS v2 descriptor blob (full- and high-speed: one vendor-class
+ * interface, bulk OUT 0x01 and bulk IN 0x82) into buf; returns its size, 0 if cap is short. */
+size_t link_ffs_descriptors(uint8_t *buf, size_t cap);
+/* Writes the strings blob (English: the interface name) into buf; returns its size. */
+size_t link_ffs_strings(uint8_t *buf, size_t cap);
+
+/* Opens dir/ep0, writes descriptors and strings, opens dir/ep1 and dir/ep2. One line into err
+ * on failure ("FunctionFS 'DIR' is not mounted…"). */
+argil_err_t link_ffs_open(link_ffs_t *f, const char *dir, char *err, size_t err_len);
+void link_ffs_close(link_ffs_t *f);
+
+#endif

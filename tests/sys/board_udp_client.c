@@ -1,0 +1,193 @@
+/* A host for tests/sys/test_board_daemon.sh: talks to a running argil-board over real UDP on
+ * 127.0.0.1 with the host's protocol peer, and checks what a person would notice:
+ *   1. HELLO → the board answers, takes the window, arms and goes ACTIVE;
+ *   2. the host falls silent → within heartbeat timeout + fade the force is zero, sculpting
+ *      stops and the board is in FAULT (host lost);
+ *   3. a new host (new socket) says HELLO → window re-sent, re-arm → ACTIVE again, no restart.
+ * Usage: board_udp_client PORT. Prints one line per phase; exit 0 when all hold. */
+#define _GNU_SOURCE
+#include <arpa/inet.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "firmware/core/safety.h"
+#include "host/app/peer.h"
+#include "host/model/grid.h"
+
+typedef struct {
+    int fd;
+    struct sockaddr_in board;
+    peer_t peer;
+    grid_t grid;
+    msg_telemetry_t tm;
+    uint32_t tm_count;
+    uint32_t hello_from_board;
+} host_t;
+
+static bool udp_send(void *ctx, const uint8_t *f, size_t len)
+{
+    host_t *h = ctx;
+    return sendto(h->fd, f, len, 0, (struct sockaddr *)&h->board, sizeof(h->board)) == (ssize_t)len;
+}
+
+static void on_tm(void *ctx, const msg_telemetry_t *t)
+{
+    host_t *h = ctx;
+    h->tm = *t;
+    h->tm_count++;
+}
+
+static uint64_t now_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
+}
+
+static void send_simple(host_t *h, uint8_t type, uint8_t command)
+{
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = type;
+    if (type == MSG_HELLO) {
+        m.u.hello.role = PROTO_ROLE_HOST;
+        memcpy(m.u.hello.name, "udp-test-host", 13);
+    } else {
+        m.u.heartbeat.command = command;
+        m.u.heartbeat.window_version = h->peer.have_current ? h->peer.current.version : 0u;
+    }
+    uint8_t buf[PROTO_FRAME_MAX];
+    size_t len = 0;
+    if (proto_encode(&m, 0, buf, sizeof(buf), &len) == PROTO_OK)
+        (void)udp_send(h, buf, len);
+}
+
+static void host_open(host_t *h, int port)
+{
+    memset(h, 0, sizeof(*h));
+    h->fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+    h->board.sin_family = AF_INET;
+    h->board.sin_port = htons((uint16_t)port);
+    inet_pton(AF_INET, "127.0.0.1", &h->board.sin_addr);
+    const int32_t dims[3] = {72, 72, 72};
+    const float half = 0.5f * 71 * 0.00125f;
+    if (grid_init(&h->grid, dims, 0.00125f, vec3(-half, -half, 0.174f - half)) != ARGIL_OK)
+        exit(2);
+    grid_fill_sphere(&h->grid, vec3(0, 0, 0.174f - 0.040f), 0.030f);
+    peer_cfg_t pc;
+    peer_cfg_default(&pc);
+    pc.window_edge = 16;
+    if (peer_init(&h->peer, &pc, &h->grid, udp_send, on_tm, h) != ARGIL_OK)
+        exit(2);
+    msg_tool_t t;
+    memset(&t, 0, sizeof(t));
+    t.kind = TOOL_TOUCH;
+    t.radius_m = 0.004f;
+    t.axis[2] = 1.0f; /* unit axis (a point tool ignores it; the decoder checks it) */
+    t.alpha = 12000.0f;
+    t.contact_stiffness_n_per_m = 800.0f;
+    t.max_force_n = 3.3f;
+    t.model_scale = 1.0f;
+    peer_set_tool(&h->peer, &t);
+    peer_request_arm(&h->peer);
+}
+
+static void host_close(host_t *h)
+{
+    peer_free(&h->peer);
+    grid_free(&h->grid);
+    close(h->fd);
+}
+
+/* One millisecond of host: receive, tick the peer (if talking), sleep to the next ms. */
+static void host_ms(host_t *h, bool talking, uint64_t *next)
+{
+    static uint8_t buf[65536];
+    ssize_t n;
+    while ((n = recv(h->fd, buf, sizeof(buf), 0)) > 0) {
+        if (n >= 6 && buf[5] == MSG_HELLO)
+            h->hello_from_board++;
+        peer_receive(&h->peer, buf, (size_t)n);
+    }
+    if (talking)
+        peer_tick(&h->peer, 1000);
+    *next += 1000;
+    struct timespec ts = {(time_t)(*next / 1000000u), (long)(*next % 1000000u) * 1000};
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+}
+
+/* Talks until the board is ACTIVE; returns ms taken or -1. rearm: send ARM ourselves once the
+ * window is current (after a fault the peer, like a person, does not re-arm on its own). */
+static int until_active(host_t *h, int max_ms, bool rearm)
+{
+    uint64_t next = now_us();
+    for (int ms = 0; ms < max_ms; ms++) {
+        if (!h->peer.board_seen && ms % 50 == 0)
+            send_simple(h, MSG_HELLO, 0);
+        if (rearm && h->peer.have_current && h->tm_count > 0 && h->tm.state == SAFETY_FAULT &&
+            ms % 20 == 0)
+            send_simple(h, MSG_HEARTBEAT, PROTO_CMD_ARM);
+        host_ms(h, true, &next);
+        if (h->tm_count > 0 && h->tm.state == SAFETY_ACTIVE)
+            return ms + 1;
+    }
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2)
+        return 2;
+    const int port = atoi(argv[1]);
+    static host_t h;
+    host_open(&h, port);
+    const int t1 = until_active(&h, 4000, false);
+    printf("phase 1: ACTIVE after %d ms (board HELLOs %u, telemetry frames %u)\n", t1,
+           h.hello_from_board, h.tm_count);
+    if (t1 < 0) {
+        printf("FAIL: board state %u, never ACTIVE\n", h.tm.state);
+        return 1;
+    }
+    /* 2: silence. Keep listening; find when the force is zero and the state FAULT. */
+    uint64_t next = now_us();
+    const uint64_t t0 = next;
+    int fault_ms = -1, zero_ms = -1;
+    float peak_after_fault = 0.0f;
+    for (int ms = 0; ms < 300; ms++) {
+        host_ms(&h, false, &next);
+        const float f = sqrtf(h.tm.force_n[0] * h.tm.force_n[0] + h.tm.force_n[1] * h.tm.force_n[1] +
+                              h.tm.force_n[2] * h.tm.force_n[2]);
+        if (fault_ms < 0 && h.tm.state == SAFETY_FAULT)
+            fault_ms = (int)((now_us() - t0) / 1000u);
+        if (fault_ms >= 0 && zero_ms < 0 && f == 0.0f && (h.tm.flags & 2u) == 0)
+            zero_ms = (int)((now_us() - t0) / 1000u);
+        if (fault_ms >= 0 && ms > fault_ms + 25 && f > peak_after_fault)
+            peak_after_fault = f;
+    }
+    printf("phase 2: host silent: FAULT (host lost) after %d ms, force zero and sculpting off "
+           "after %d ms, peak force 25 ms after the fault %.3f N\n", fault_ms, zero_ms,
+           (double)peak_after_fault);
+    /* 50 ms timeout + 20 ms fade; 60 ms of slack for a shared, non-RT test machine. */
+    if (fault_ms < 40 || fault_ms > 130 || zero_ms < 0 || zero_ms > 150 || peak_after_fault != 0.0f) {
+        printf("FAIL: host-loss timing\n");
+        return 1;
+    }
+    host_close(&h);
+    /* 3: a new host. */
+    host_open(&h, port);
+    const int t3 = until_active(&h, 4000, true);
+    printf("phase 3: reconnected host: board HELLO %s, windows sent %u, ACTIVE again after %d ms\n",
+           h.hello_from_board ? "received" : "missing", h.peer.stats.windows_sent, t3);
+    if (t3 < 0 || h.hello_from_board == 0 || h.peer.stats.windows_sent == 0) {
+        printf("FAIL: no resynchronisation (state %u)\n", h.tm.state);
+        return 1;
+    }
+    host_close(&h);
+    printf("ok\n");
+    return 0;
+}

@@ -1,0 +1,62 @@
+#!/bin/sh
+# argil-board as a new user meets it, and the real daemon over real UDP: --help names every
+# option; a bad option, a bad value, a missing CAN interface, an unknown GPIO line or an
+# unmounted FunctionFS each give one clear line and a non-zero exit, never a hang; then a host
+# on 127.0.0.1 arms it, loses it (force fades, FAULT) and reconnects without a restart.
+set -eu
+bin="$REL/argil-board"
+tmp=$(mktemp -d)
+pid=
+trap '[ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$bin" --help >"$tmp/help" || fail "--help exits non-zero"
+for opt in bus can drive-heartbeat-ms bus-recovery-ms gpio-chip line-estop line-drive-fault \
+           line-btn1 line-btn2 line-drive-enable line-led line-wdog link host-timeout-ms \
+           host-fade-ms rate-hz rt-priority cpu overrun-streak stats-period-s duration-s \
+           max-force-n max-velocity-m-s model-scale model-offset-m config set; do
+    grep -q -- "--$opt" "$tmp/help" || fail "--help does not explain --$opt"
+done
+
+# One line on stderr, the expected status, within 5 s.
+expect_error() {
+    want=$1; pattern=$2; shift 2
+    st=0
+    timeout 5 "$bin" "$@" >"$tmp/out" 2>"$tmp/err" || st=$?
+    [ "$st" = 124 ] && fail "'$*' hung"
+    [ "$st" = "$want" ] || fail "'$*' exit $st, want $want: $(cat "$tmp/err")"
+    [ "$(wc -l <"$tmp/err")" = 1 ] || fail "'$*' printed $(wc -l <"$tmp/err") lines: $(cat "$tmp/err")"
+    grep -q -- "$pattern" "$tmp/err" || fail "'$*' said: $(cat "$tmp/err")"
+    echo "ok: $* -> $(cat "$tmp/err")"
+}
+expect_error 2 "unknown option '--frobnicate'" --frobnicate 1
+expect_error 2 "rate_hz '3000'" --rate-hz 3000
+expect_error 2 "needs a value" --can
+expect_error 2 "expected udp:ADDR:PORT or ffs:DIR" --link tcp:1.2.3.4:5
+expect_error 2 "config file '$tmp/nope.ini'" --config "$tmp/nope.ini"
+printf '[loop]\nrate_hz = 2000\nbogus = 1\n' >"$tmp/bad.ini"
+expect_error 2 "bad.ini:3: unknown setting 'loop.bogus'" --config "$tmp/bad.ini"
+expect_error 3 "CAN interface 'can7'" --can can7 --rt-priority 0
+expect_error 3 "GPIO line 'NO_SUCH_LINE' not found" --bus sim --line-estop NO_SUCH_LINE --rt-priority 0
+expect_error 3 "ffs:$tmp/ffs" --bus sim --link "ffs:$tmp/ffs" --rt-priority 0
+
+# The real daemon (simulated arm behind it) and a host over UDP. 2000 Hz must work too.
+port=$((20000 + $$ % 20000))
+for rate in 1000 2000; do
+    "$bin" --bus sim --link "udp:127.0.0.1:$port" --rate-hz "$rate" --duration-s 6 \
+        --stats-period-s 0 --overrun-streak 0 >"$tmp/daemon.out" 2>"$tmp/daemon.err" &
+    pid=$!
+    sleep 0.3
+    "$REL/board_udp_client" "$port" >"$tmp/client.out" 2>&1 || {
+        cat "$tmp/client.out"; kill "$pid"; cat "$tmp/daemon.err"; fail "UDP session at $rate Hz"; }
+    cat "$tmp/client.out"
+    kill -TERM "$pid"
+    st=0; wait "$pid" || st=$?
+    pid=
+    [ "$st" = 0 ] || fail "daemon exit $st after SIGTERM: $(cat "$tmp/daemon.err")"
+    grep -q "exit: .* ticks at $rate Hz" "$tmp/daemon.err" || fail "no exit statistics"
+    grep -q "wake latency histogram" "$tmp/daemon.err" || fail "no latency histogram"
+    grep "exit:" "$tmp/daemon.err"
+    port=$((port + 1))
+done
+echo "argil-board: CLI errors are one clear line; UDP arm, host loss and reconnection work"

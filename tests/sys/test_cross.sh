@@ -1,0 +1,78 @@
+#!/bin/sh
+# The cross tier (make cross): the core's unit tests and one SIL scenario built for aarch64 run
+# under qemu-aarch64, the aarch64 argil-board answers --help and runs a second on the simulated
+# arm, and the Cortex-M image boots on qemu-system-arm (mps2-an386, Cortex-M4; the M7 build on
+# mps2-an500) and produces the host build's tick results for the same inputs:
+#   state, fault, CAN frame count, GPIO levels, link bytes: identical;
+#   commanded torque: within 1 per mille; rendered force: within 2 mN per axis
+# (newlib's and glibc's sinf/cosf differ in the last bit; fused multiply-add is off).
+set -eu
+root=$(dirname "$REL")
+a64="$root/aarch64"
+cm="$root/cortexm"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+QEMU_A64="qemu-aarch64 -L /usr/aarch64-linux-gnu -E LD_LIBRARY_PATH=/usr/lib/aarch64-linux-gnu"
+
+n=0
+for t in "$a64"/tests/test_* "$a64"/sil/test_*; do
+    [ -x "$t" ] || continue
+    timeout -s KILL 300 $QEMU_A64 "$t" >"$tmp/out" 2>&1 || { tail -n 20 "$tmp/out"; fail "aarch64 $(basename "$t")"; }
+    echo "aarch64 $(basename "$t"): $(grep -E '^\[  PASSED  \]' "$tmp/out")"
+    n=$((n + 1))
+done
+[ "$n" -ge 2 ] || fail "no aarch64 tests were built"
+
+timeout -s KILL 60 $QEMU_A64 "$a64/argil-board" --help >"$tmp/help" || fail "aarch64 argil-board --help"
+grep -q -- '--rate-hz' "$tmp/help" || fail "aarch64 --help incomplete"
+st=0
+timeout -s KILL 60 $QEMU_A64 "$a64/argil-board" --bus sim --link udp:127.0.0.1:0 >/dev/null 2>"$tmp/err" || st=$?
+[ "$st" = 2 ] || fail "aarch64 argil-board: bad port gave status $st"
+# Not yet: running the aarch64 daemon's loop under qemu-user (it stalls after start-up there;
+# see docs/board.md, "Open items"). The x86 daemon's loop is tested in test_board_daemon.sh.
+
+"$cm/tick_ref" >"$tmp/ref.txt" || fail "host tick reference"
+compare() {
+    awk -v name="$1" '
+        FNR == NR { ref[FNR] = $0; nref = FNR; next }
+        {
+            split(ref[FNR], r, " ")
+            if (NF != split(ref[FNR], r, " ")) { print name ": line " FNR " differs in shape"; bad = 1; exit }
+            if ($1 == "done:") { if ($0 != ref[FNR]) { print name ": summary differs"; bad = 1 } next }
+            for (i = 1; i <= 5; i++) if ($i != r[i]) { print name ": tick " $1 " field " i " " $i " vs " r[i]; bad = 1; exit }
+            if ($12 != r[12]) { print name ": tick " $1 " link bytes differ"; bad = 1; exit }
+            for (i = 6; i <= 8; i++) { d = $i - r[i]; if (d < 0) d = -d; if (d > 1) { print name ": tick " $1 " torque " d; bad = 1; exit } if (d > mt) mt = d }
+            for (i = 9; i <= 11; i++) { d = $i - r[i]; if (d < 0) d = -d; if (d > 0.002) { print name ": tick " $1 " force " d " N"; bad = 1; exit } if (d > mf) mf = d }
+            if ($0 != ref[FNR]) diff++
+            n++
+        }
+        END {
+            if (n + 1 != nref) { print name ": " n + 1 " lines, reference " nref; bad = 1 }
+            printf "%s: %d ticks, states/frames/GPIO identical, %d lines not bit-identical, max |dtorque| %d per mille, max |dF| %.2g N\n", name, n, diff, mt, mf
+            exit bad
+        }' "$tmp/ref.txt" "$2"
+}
+for board in m4:mps2-an386 m7:mps2-an500; do
+    cpu=${board%%:*}; machine=${board#*:}
+    start=$(date +%s.%N)
+    timeout -s KILL 60 qemu-system-arm -M "$machine" -nographic -semihosting -kernel "$cm/argil-$cpu.elf" \
+        >"$tmp/$cpu.txt" 2>"$tmp/$cpu.err" || { tail -n 5 "$tmp/$cpu.txt" "$tmp/$cpu.err"; fail "$cpu image on $machine"; }
+    end=$(date +%s.%N)
+    compare "cortex-$cpu on $machine ($(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f s", b - a }'))" "$tmp/$cpu.txt" || fail "cortex-$cpu results"
+done
+tail -n 1 "$tmp/ref.txt"
+
+# The MCU link refuses the heap and printf in the core.
+printf '#include <stdlib.h>\nvoid *core_bad(void);\nvoid *core_bad(void) { return malloc(8); }\n' >"$tmp/bad.c"
+arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -c "$tmp/bad.c" -o "$tmp/bad.o"
+arm-none-eabi-ld -r -o "$tmp/core.o" "$tmp/bad.o" "$cm/m4/core.o"
+arm-none-eabi-objcopy --redefine-sym malloc=argil_core_must_not_call_malloc "$tmp/core.o" "$tmp/core2.o"
+if arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard --specs=rdimon.specs \
+    -T firmware/cortexm/mps2.ld -Wl,--gc-sections -Wl,--undefined=core_bad \
+    "$cm/m4/firmware/cortexm/startup.o" "$cm/m4/firmware/cortexm/tick_script.o" \
+    "$cm/m4/firmware/cortexm/tick_main.o" "$tmp/core2.o" -lm -o "$tmp/bad.elf" 2>"$tmp/link.err"; then
+    fail "the Cortex-M link accepted malloc in the core"
+fi
+grep -q argil_core_must_not_call_malloc "$tmp/link.err" || fail "no clear link error: $(cat "$tmp/link.err")"
+echo "cortex-m: a core that calls malloc does not link ($(grep -o "undefined reference to .argil_core_must_not_call_malloc." "$tmp/link.err" | head -1))"

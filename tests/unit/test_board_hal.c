@@ -1,0 +1,381 @@
+/* The daemon's Linux side against fakes: SocketCAN frames through a SOCK_SEQPACKET socketpair
+ * (the same one-frame-per-read semantics as a raw CAN socket), the GPIO mapping against a fake
+ * chip, the UDP link on 127.0.0.1, the stream framer, FunctionFS descriptors, the SPSC ring,
+ * and the configuration parser's every refusal. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <arpa/inet.h>
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "firmware/board/board_config.h"
+#include "firmware/core/drives.h"
+#include "firmware/core/spsc_ring.h"
+#include "firmware/hal/can_socket.h"
+#include "firmware/hal/gpio_port.h"
+#include "firmware/hal/link_io.h"
+#include "shared/gpio_lines.h"
+
+static void test_can_socket_frames_and_error_frames(void **st)
+{
+    (void)st;
+    int sv[2];
+    assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+    struct can_frame cf;
+    memset(&cf, 0, sizeof(cf));
+    cf.can_id = 0x182;
+    cf.can_dlc = 8;
+    cf.data[0] = 0x37;
+    assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+    memset(&cf, 0, sizeof(cf));
+    cf.can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;
+    cf.can_dlc = CAN_ERR_DLC;
+    assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+    memset(&cf, 0, sizeof(cf));
+    cf.can_id = CAN_EFF_FLAG | 0x1234567; /* 29-bit: not CANopen, dropped */
+    assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+    can_batch_t rx;
+    can_socket_stats_t stats = {0};
+    assert_int_equal(can_socket_receive(sv[0], &rx, &stats), ARGIL_OK);
+    assert_int_equal(rx.n, 2);
+    assert_int_equal(rx.f[0].id, 0x182);
+    assert_int_equal(rx.f[0].data[0], 0x37);
+    assert_int_equal(rx.f[1].id, DRIVES_CAN_ERR_FLAG | DRIVES_CAN_ERR_BUSOFF);
+    assert_int_equal(stats.rx_error_frames, 1);
+    assert_int_equal(stats.rx_dropped, 1);
+    /* The core sees bus-off from it in the same tick. */
+    drives_t dr;
+    drives_cfg_t cfg;
+    drives_cfg_default(&cfg);
+    drives_init(&dr);
+    drives_receive(&dr, &rx);
+    assert_true(drives_bus_error(&dr, &cfg));
+    /* Nothing waiting: returns at once with no frames (never blocks). */
+    assert_int_equal(can_socket_receive(sv[0], &rx, &stats), ARGIL_OK);
+    assert_int_equal(rx.n, 0);
+    /* Send: each frame arrives whole with 11-bit id and its length. */
+    can_batch_t tx = {0};
+    can_frame_t f;
+    canopen_rpdo_encode(&f, 2, CIA402_CW_ENABLE_OP, -250);
+    (void)can_batch_push(&tx, &f);
+    canopen_sync_encode(&f);
+    (void)can_batch_push(&tx, &f);
+    assert_int_equal(can_socket_send(sv[0], &tx, &stats), ARGIL_OK);
+    assert_int_equal(read(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+    assert_int_equal(cf.can_id, 0x202);
+    assert_int_equal(cf.can_dlc, 4);
+    assert_int_equal(cf.data[0], 0x0F);
+    assert_int_equal(read(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+    assert_int_equal(cf.can_id, 0x080);
+    assert_int_equal(cf.can_dlc, 0);
+    close(sv[0]);
+    close(sv[1]);
+}
+
+static void test_can_open_errors_are_one_line(void **st)
+{
+    (void)st;
+    int fd;
+    char err[200];
+    assert_int_equal(can_socket_open("", &fd, err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(can_socket_open("a_name_far_too_long", &fd, err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(can_socket_open("nocan9", &fd, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "'nocan9'"));
+    assert_null(strchr(err, '\n'));
+    assert_int_equal(fd, -1);
+}
+
+/* ---- a fake GPIO chip ---- */
+typedef struct {
+    const char *names[8];
+    int level[8];
+    bool requested[8];
+    bool is_out[8];
+    int refuse;                /* index whose request fails, -1 none */
+    int opened;
+} fake_chip_t;
+
+static void *f_open(void *ctx, const char *chip)
+{
+    fake_chip_t *c = ctx;
+    if (strcmp(chip, "fake0") != 0)
+        return NULL;
+    c->opened++;
+    return c;
+}
+static void f_close(void *ctx, void *chip) { (void)chip; ((fake_chip_t *)ctx)->opened--; }
+static void *f_find(void *ctx, void *chip, const char *name)
+{
+    (void)chip;
+    fake_chip_t *c = ctx;
+    for (intptr_t i = 0; i < 8 && c->names[i]; i++)
+        if (strcmp(c->names[i], name) == 0)
+            return (void *)(i + 1);
+    return NULL;
+}
+static int f_req_in(void *ctx, void *line, const char *who)
+{
+    (void)who;
+    fake_chip_t *c = ctx;
+    const intptr_t i = (intptr_t)line - 1;
+    if (i == c->refuse)
+        return -1;
+    c->requested[i] = true;
+    return 0;
+}
+static int f_req_out(void *ctx, void *line, const char *who, int level)
+{
+    fake_chip_t *c = ctx;
+    const int rc = f_req_in(ctx, line, who);
+    if (rc == 0) {
+        c->is_out[(intptr_t)line - 1] = true;
+        c->level[(intptr_t)line - 1] = level;
+    }
+    return rc;
+}
+static int f_get(void *ctx, void *line) { return ((fake_chip_t *)ctx)->level[(intptr_t)line - 1]; }
+static int f_set(void *ctx, void *line, int level)
+{
+    ((fake_chip_t *)ctx)->level[(intptr_t)line - 1] = level;
+    return 0;
+}
+static void f_release(void *ctx, void *line) { ((fake_chip_t *)ctx)->requested[(intptr_t)line - 1] = false; }
+static const gpio_ops_t fake_ops = {f_open, f_close, f_find, f_req_in, f_req_out, f_get, f_set, f_release};
+
+static fake_chip_t fake_chip(void)
+{
+    fake_chip_t c;
+    memset(&c, 0, sizeof(c));
+    const char *n[7] = {"ESTOP_N", "DRIVE_FAULT_N", "STYLUS_BTN1", "STYLUS_BTN2",
+                        "DRIVE_ENABLE", "STATUS_LED", "WDOG_KICK"};
+    memcpy(c.names, n, sizeof(n));
+    c.refuse = -1;
+    return c;
+}
+
+static void test_gpio_mapping_by_name(void **st)
+{
+    (void)st;
+    fake_chip_t c = fake_chip();
+    gpio_names_t names;
+    gpio_names_default(&names);
+    memcpy(names.chip, "fake0", 6);
+    gpio_port_t p;
+    char err[200];
+    assert_int_equal(gpio_port_open(&p, &fake_ops, &c, &names, err, sizeof(err)), ARGIL_OK);
+    for (int i = 4; i < 7; i++)
+        assert_true(c.is_out[i] && c.level[i] == 0); /* outputs start low: drives disabled */
+    c.level[0] = 1; /* e-stop released */
+    c.level[1] = 1; /* no drive fault */
+    c.level[3] = 1; /* button 2 pressed */
+    assert_int_equal(gpio_port_read(&p), GPIO_IN_ESTOP_N | GPIO_IN_DRIVE_FAULT_N | GPIO_IN_STYLUS_BTN2);
+    c.level[0] = 0; /* e-stop pressed: the bit drops, the core sees it this tick */
+    assert_int_equal(gpio_port_read(&p) & GPIO_IN_ESTOP_N, 0);
+    gpio_port_write(&p, GPIO_OUT_DRIVE_ENABLE | GPIO_OUT_WDOG_KICK);
+    assert_int_equal(c.level[4], 1);
+    assert_int_equal(c.level[5], 0);
+    assert_int_equal(c.level[6], 1);
+    gpio_port_write(&p, GPIO_OUT_DRIVE_ENABLE);
+    assert_int_equal(c.level[6], 0); /* the watchdog line toggles */
+    gpio_port_close(&p);
+    assert_int_equal(c.level[4], 0); /* closing drops DRIVE_ENABLE */
+    for (int i = 0; i < 7; i++)
+        assert_false(c.requested[i]);
+    assert_int_equal(c.opened, 0);
+}
+
+static void test_gpio_errors_name_the_line(void **st)
+{
+    (void)st;
+    fake_chip_t c = fake_chip();
+    gpio_names_t names;
+    gpio_names_default(&names);
+    gpio_port_t p;
+    char err[200];
+    assert_int_equal(gpio_port_open(&p, &fake_ops, &c, &names, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "GPIO chip 'gpiochip0' not found"));
+    memcpy(names.chip, "fake0", 6);
+    memcpy(names.out[1], "LED_TYPO", 9);
+    assert_int_equal(gpio_port_open(&p, &fake_ops, &c, &names, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "GPIO line 'LED_TYPO' not found"));
+    for (int i = 0; i < 7; i++)
+        assert_false(c.requested[i]); /* nothing stays requested */
+    assert_int_equal(c.opened, 0);
+    gpio_names_default(&names);
+    memcpy(names.chip, "fake0", 6);
+    c.refuse = 2;
+    assert_int_equal(gpio_port_open(&p, &fake_ops, &c, &names, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "'STYLUS_BTN1'"));
+    assert_non_null(strstr(err, "cannot be requested as input"));
+}
+
+static void test_udp_link_loopback(void **st)
+{
+    (void)st;
+    link_udp_t u;
+    char err[200];
+    assert_int_equal(link_udp_open(&u, "127.0.0.1:0", err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(link_udp_open(&u, "localhost:7700", err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(link_udp_open(&u, "127.0.0.1:47311", err, sizeof(err)), ARGIL_OK);
+    uint8_t frame[PROTO_FRAME_MAX], buf[2 * PROTO_FRAME_MAX];
+    assert_int_equal(link_udp_send(&u, frame, 10), ARGIL_ERR_STATE); /* no host yet */
+    const int h = socket(AF_INET, SOCK_DGRAM, 0);
+    struct sockaddr_in to;
+    assert_int_equal(link_udp_parse("127.0.0.1:47311", &to), ARGIL_OK);
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = MSG_HELLO;
+    m.u.hello.role = PROTO_ROLE_HOST;
+    size_t len = 0;
+    assert_int_equal(proto_encode(&m, 7, frame, sizeof(frame), &len), PROTO_OK);
+    assert_int_equal(sendto(h, "junk", 4, 0, (struct sockaddr *)&to, sizeof(to)), 4);
+    assert_int_equal(sendto(h, frame, len, 0, (struct sockaddr *)&to, sizeof(to)), (ssize_t)len);
+    usleep(20000);
+    assert_int_equal(link_udp_receive(&u, buf, sizeof(buf)), 0);   /* junk refused */
+    assert_int_equal(link_udp_receive(&u, buf, sizeof(buf)), len);
+    assert_int_equal(u.rx_refused, 1);
+    assert_true(u.have_peer);
+    /* Two frames back to back go out as two datagrams to that host. */
+    memcpy(buf, frame, len);
+    memcpy(buf + len, frame, len);
+    assert_int_equal(link_udp_send(&u, buf, 2 * len), ARGIL_OK);
+    usleep(20000);
+    assert_int_equal(recv(h, buf, sizeof(buf), MSG_DONTWAIT), (ssize_t)len);
+    assert_int_equal(recv(h, buf, sizeof(buf), MSG_DONTWAIT), (ssize_t)len);
+    assert_int_equal(u.tx_datagrams, 2);
+    close(h);
+    link_udp_close(&u);
+}
+
+static void test_framer_splits_a_stream(void **st)
+{
+    (void)st;
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = MSG_HEARTBEAT;
+    uint8_t a[64], out[PROTO_FRAME_MAX];
+    size_t len = 0;
+    assert_int_equal(proto_encode(&m, 1, a, sizeof(a), &len), PROTO_OK);
+    link_framer_t fr;
+    link_framer_init(&fr);
+    const uint8_t junk[3] = {1, 2, 3};
+    link_framer_feed(&fr, junk, 3);
+    link_framer_feed(&fr, a, 5);                /* a torn frame: wait */
+    assert_int_equal(link_framer_next(&fr, out, sizeof(out)), 0);
+    link_framer_feed(&fr, a + 5, len - 5);
+    link_framer_feed(&fr, a, len);
+    assert_int_equal(link_framer_next(&fr, out, sizeof(out)), len);
+    assert_memory_equal(out, a, len);
+    assert_int_equal(link_framer_next(&fr, out, sizeof(out)), len);
+    assert_int_equal(link_framer_next(&fr, out, sizeof(out)), 0);
+    assert_int_equal(fr.skipped_bytes, 3);
+}
+
+static void test_ffs_descriptors(void **st)
+{
+    (void)st;
+    uint8_t b[128];
+    const size_t n = link_ffs_descriptors(b, sizeof(b));
+    assert_int_equal(n, 66);                     /* header 12 + counts 8 + 2 × 23 */
+    assert_int_equal(b[0], 3);                   /* FUNCTIONFS_DESCRIPTORS_MAGIC_V2 */
+    assert_int_equal(b[4], 66);
+    assert_int_equal(b[20 + 5], 0xFF);           /* vendor-class interface */
+    assert_int_equal(b[20 + 9 + 2], 0x01);       /* bulk OUT */
+    assert_int_equal(b[20 + 16 + 2], 0x82);      /* bulk IN */
+    assert_int_equal(b[20 + 9 + 4] | (b[20 + 9 + 5] << 8), 64);   /* full speed */
+    assert_int_equal(b[43 + 9 + 4] | (b[43 + 9 + 5] << 8), 512);  /* high speed */
+    assert_int_equal(link_ffs_descriptors(b, 10), 0);
+    link_ffs_t f;
+    char err[300];
+    assert_int_equal(link_ffs_open(&f, "/nonexistent/ffs-argil", err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "is FunctionFS mounted"));
+}
+
+static void test_spsc_ring_wraps_and_refuses(void **st)
+{
+    (void)st;
+    static uint8_t mem[64];
+    spsc_ring_t r;
+    assert_int_equal(spsc_init(&r, mem, 48), ARGIL_ERR_ARG);
+    assert_int_equal(spsc_init(&r, mem, 64), ARGIL_OK);
+    uint8_t in[40], out[40];
+    size_t n;
+    for (int i = 0; i < 40; i++)
+        in[i] = (uint8_t)i;
+    for (int round = 0; round < 10; round++) { /* crosses the end of storage many times */
+        assert_int_equal(spsc_push(&r, in, 25), ARGIL_OK);
+        assert_int_equal(spsc_push(&r, in, 25), ARGIL_OK);
+        assert_int_equal(spsc_push(&r, in, 25), ARGIL_ERR_FULL);
+        assert_int_equal(spsc_pop(&r, out, 10, &n), ARGIL_ERR_FULL); /* too small: stays */
+        assert_int_equal(spsc_pop(&r, out, sizeof(out), &n), ARGIL_OK);
+        assert_int_equal(n, 25);
+        assert_memory_equal(out, in, 25);
+        assert_true(spsc_skip(&r));
+        assert_int_equal(spsc_pop(&r, out, sizeof(out), &n), ARGIL_ERR_EMPTY);
+    }
+    assert_int_equal(r.dropped, 10);
+}
+
+static void test_config_ini_and_refusals(void **st)
+{
+    (void)st;
+    board_daemon_cfg_t c;
+    board_config_default(&c);
+    char why[200];
+    uint32_t line = 0;
+    const char *ok = "; comment\n[can]\ninterface = can1\n[gpio]\nestop = EMERG ; inline\n"
+                     "[link]\nhost = ffs:/dev/ffs-argil\n[loop]\nrate_hz=4000\ncpu = 1\n"
+                     "[transform]\noffset_m = 0.01,-0.02,0.5\n";
+    assert_int_equal(board_config_parse_ini(&c, ok, strlen(ok), &line, why, sizeof(why)), ARGIL_OK);
+    assert_string_equal(c.can_if, "can1");
+    assert_string_equal(c.gpio.in[0], "EMERG");
+    assert_int_equal(c.link, BOARD_LINK_FFS);
+    assert_string_equal(c.link_target, "/dev/ffs-argil");
+    assert_int_equal(c.rate_hz, 4000);
+    assert_float_equal(c.model_offset_m[1], -0.02f, 1e-7f);
+    static const struct { const char *text; uint32_t line; const char *says; } bad[] = {
+        {"x = 1\n", 1, "outside any [section]"},
+        {"[loop\n", 1, "expected [section]"},
+        {"[loop]\nrate_hz\n", 2, "expected key = value"},
+        {"[loop]\nrate_hz = 3000\n", 2, "rate_hz '3000'"},
+        {"[loop]\nrt_priority = 100\n", 2, "expected 0-99"},
+        {"[loop]\nbogus = 1\n", 2, "unknown setting 'loop.bogus'"},
+        {"[can]\nbus = vcan\n", 2, "expected socketcan or sim"},
+        {"[limits]\nmax_force_n = nan\n", 2, "max_force_n"},
+        {"[transform]\noffset_m = 1,2\n", 2, "expected X,Y,Z"},
+        {"[link]\nhost = tcp:1\n", 2, "udp:ADDR:PORT or ffs:DIR"},
+        {"[gpio]\nestop = two words\n", 2, "gpio.estop"},
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        board_config_default(&c);
+        why[0] = '\0';
+        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
+                                                    why, sizeof(why)), ARGIL_OK);
+        assert_int_equal(line, bad[i].line);
+        if (strstr(why, bad[i].says) == NULL)
+            fail_msg("case %zu: '%s' does not say '%s'", i, why, bad[i].says);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_can_socket_frames_and_error_frames),
+        cmocka_unit_test(test_can_open_errors_are_one_line),
+        cmocka_unit_test(test_gpio_mapping_by_name),
+        cmocka_unit_test(test_gpio_errors_name_the_line),
+        cmocka_unit_test(test_udp_link_loopback),
+        cmocka_unit_test(test_framer_splits_a_stream),
+        cmocka_unit_test(test_ffs_descriptors),
+        cmocka_unit_test(test_spsc_ring_wraps_and_refuses),
+        cmocka_unit_test(test_config_ini_and_refusals),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
