@@ -22,6 +22,7 @@ bool spring_material_valid(const spring_material_t *m)
 
 float springs_stable_dt_s(const spring_material_t *m)
 {
+    /* With per-node stiffness, pass the largest node stiffness in m->stiffness. */
     /* Semi-implicit Euler on m x'' + c x' + k x: stable for dt < 2/(c/m + sqrt(k/m)) roughly;
      * the six neighbour springs add up to 12*coupling of effective stiffness. Half that, to
      * keep a margin. */
@@ -53,32 +54,35 @@ float springs_step(spring_field_t *f, const spring_material_t *m, const int32_t 
     const float plastic = m->plastic_rate_hz * dt_s > 1.0f ? 1.0f : m->plastic_rate_hz * dt_s;
     float max_acc = 0.0f;
 
-    /* Velocities first (all forces from the old densities), then positions. */
+    /* Velocities first (all forces from the old densities), then positions. Interior nodes
+     * (all six neighbours present) take a branch-free path; the rest count their neighbours. */
     for (int32_t z = b0[2]; z < b1[2]; z++) {
         for (int32_t y = b0[1]; y < b1[1]; y++) {
+            const bool row_inner = y > 0 && y + 1 < ny && z > 0 && z + 1 < nz;
             for (int32_t x = b0[0]; x < b1[0]; x++) {
                 const int32_t i = x + y * sy + z * sz;
-                const float d = f->density[i];
-                float nb = 0.0f;
-                int cnt = 0;
-                if (x > 0) { nb += f->density[i - 1]; cnt++; }
-                if (x + 1 < nx) { nb += f->density[i + 1]; cnt++; }
-                if (y > 0) { nb += f->density[i - sy]; cnt++; }
-                if (y + 1 < ny) { nb += f->density[i + sy]; cnt++; }
-                if (z > 0) { nb += f->density[i - sz]; cnt++; }
-                if (z + 1 < nz) { nb += f->density[i + sz]; cnt++; }
-                /* Neighbour springs pull towards the neighbours' mean deviation from rest, so a
-                 * field at rest stays at rest: only differences from the rest shape are smoothed. */
-                float rest_nb = 0.0f;
-                if (x > 0) rest_nb += f->rest[i - 1];
-                if (x + 1 < nx) rest_nb += f->rest[i + 1];
-                if (y > 0) rest_nb += f->rest[i - sy];
-                if (y + 1 < ny) rest_nb += f->rest[i + sy];
-                if (z > 0) rest_nb += f->rest[i - sz];
-                if (z + 1 < nz) rest_nb += f->rest[i + sz];
-                const float dev = d - f->rest[i];
-                const float nb_dev = (nb - rest_nb) - (float)cnt * dev;
-                const float force = f->force[i] - m->stiffness * dev + m->coupling * nb_dev -
+                const float dev = f->density[i] - f->rest[i];
+                float nb_dev;
+                if (row_inner && x > 0 && x + 1 < nx) {
+                    /* Σ over neighbours of (their deviation − ours): 4D springs, density part. */
+                    nb_dev = (f->density[i - 1] - f->rest[i - 1]) + (f->density[i + 1] - f->rest[i + 1]) +
+                             (f->density[i - sy] - f->rest[i - sy]) +
+                             (f->density[i + sy] - f->rest[i + sy]) +
+                             (f->density[i - sz] - f->rest[i - sz]) +
+                             (f->density[i + sz] - f->rest[i + sz]) - 6.0f * dev;
+                } else {
+                    nb_dev = 0.0f;
+                    if (x > 0) nb_dev += f->density[i - 1] - f->rest[i - 1] - dev;
+                    if (x + 1 < nx) nb_dev += f->density[i + 1] - f->rest[i + 1] - dev;
+                    if (y > 0) nb_dev += f->density[i - sy] - f->rest[i - sy] - dev;
+                    if (y + 1 < ny) nb_dev += f->density[i + sy] - f->rest[i + sy] - dev;
+                    if (z > 0) nb_dev += f->density[i - sz] - f->rest[i - sz] - dev;
+                    if (z + 1 < nz) nb_dev += f->density[i + sz] - f->rest[i + sz] - dev;
+                }
+                /* Neighbour springs act on deviations from the rest shape, so a field at rest
+                 * stays at rest: only differences from the rest shape are smoothed. */
+                const float k = f->stiffness ? f->stiffness[i] : m->stiffness;
+                const float force = f->force[i] - k * dev + m->coupling * nb_dev -
                                     m->damping * f->velocity[i];
                 const float acc = force * inv_m;
                 f->velocity[i] += acc * dt_s;

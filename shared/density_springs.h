@@ -22,6 +22,7 @@ typedef struct {
     float *rest;
     float *velocity;          /* density rate, 1/s */
     float *force;             /* external force per node; springs_step consumes and zeroes it */
+    const float *stiffness;   /* per-node stiffness to rest, or NULL for the material's */
 } spring_field_t;
 
 /* The default clay: heavily damped, plastic. */

@@ -45,3 +45,37 @@ if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/nu
 else
     echo "  valgrind not installed: skipped"
 fi
+
+echo "== haptic rendering (tests/bench/bench_haptics.c on the simulated arm)"
+hb="$tmp/bench_haptics"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_haptics.c "$rel/libargil.a" -lm -o "$hb"
+echo "  Z-width: a relaxed hand (100 N/m grip) drives 10 mm into a wall at 100 mm/s; stable ="
+echo "  still ACTIVE and < 0.05 mm peak-to-peak 0.5-1.0 s after the impact"
+"$hb" zwidth
+if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/null 2>&1; then
+    echo "  tick cost while sculpting (push tool, 2 s stroke), board_tick inclusive:"
+    for shape in point curve area; do
+        for edge in 16 32; do
+            valgrind --tool=callgrind --toggle-collect=board_tick --callgrind-out-file="$tmp/hcg" \
+                "$hb" tick "$shape" "$edge" >"$tmp/hout" 2>/dev/null
+            ir=$(callgrind_annotate "$tmp/hcg" 2>/dev/null | sed -n 's/^ *\([0-9,]*\) .*PROGRAM TOTALS.*/\1/p' | tr -d ,)
+            ticks=$(sed -n 's/.* \([0-9]*\) ticks.*/\1/p' "$tmp/hout")
+            printf '    %-5s %2d^3: %s instructions / %s ticks = %s per tick (mean)\n' "$shape" "$edge" "$ir" \
+                "$ticks" "$(awk -v a="$ir" -v b="$ticks" 'BEGIN { printf "%d", a / b }')"
+        done
+    done
+fi
+
+echo "== meshing and fitting (tests/bench/bench_mesh.c, one core)"
+if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_mesh.c "$rel/libargil.a" -o "$tmp/bench_mesh" -lm; then
+    "$tmp/bench_mesh"
+else
+    echo "  bench_mesh did not build: skipped"
+fi
+
+echo "== host model (host/model): Hua & Qin Tables 1-2 and Ferley et al.'s table, 3 runs"
+cc -O2 -I. tests/bench/bench_model.c "$rel/libargil.a" -lm -o "$tmp/bench_model"
+for i in 1 2 3; do "$tmp/bench_model" >"$tmp/model.$i"; done
+# each run already prints medians of 9-15 repetitions per row; all three runs are shown
+for i in 1 2 3; do echo "  -- run $i"; cat "$tmp/model.$i"; done
+echo "  (goals: Table 1 128^3 / 40^3 row <= 2 ms; Table 2 15^3 / 20^3 row <= 0.5 ms; 32^3 / 64^3 implicit step <= 16 ms)"

@@ -13,8 +13,18 @@ void board_cfg_default(board_cfg_t *cfg)
     cfg->max_force_n = 3.3f;
     cfg->impulse_period_us = 5000u;
     cfg->heartbeat_period_us = 10000u;
-    cfg->crossfade_ticks = 8u;
-    cfg->velocity_filter = 0.2f;
+    cfg->swap_smoothing = 0.95f;
+    cfg->contact_damping_n_s_per_m = 0.5f;
+    cfg->contact_damping_s = 0.0025f;
+    cfg->io_delay_ticks = 2u;
+    cfg->slew_n_per_s = 1000.0f;
+    cfg->passivity = true;
+    cfg->pc_max_damping_n_s_per_m = 10.0f;
+    cfg->pc_deadband_j = 0.2e-3f;
+    cfg->joint_margin_rad = 0.1f;
+    cfg->joint_limit_stiffness_nm_per_rad = 0.5f;
+    cfg->accel_limit = 1e5f;
+    cfg->velocity_filter = 0.5f;
     safety_cfg_default(&cfg->safety);
     drives_cfg_default(&cfg->drives);
     arm_desc_default(&cfg->arm);
@@ -26,7 +36,12 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     if (cfg->tick_us < 100u || cfg->tick_us > 10000u || !(cfg->max_force_n > 0.0f) ||
         !isfinite(cfg->max_force_n) || cfg->impulse_period_us == 0 ||
         cfg->heartbeat_period_us == 0 || !(cfg->velocity_filter > 0.0f) ||
-        cfg->velocity_filter > 1.0f)
+        cfg->velocity_filter > 1.0f || !(cfg->swap_smoothing >= 0.0f) ||
+        !(cfg->swap_smoothing < 1.0f) || !(cfg->contact_damping_n_s_per_m >= 0.0f) || !(cfg->contact_damping_s >= 0.0f) ||
+        cfg->io_delay_ticks < 1u || cfg->io_delay_ticks > PASSIVITY_DELAY_MAX ||
+        !(cfg->slew_n_per_s > 0.0f) || !(cfg->pc_max_damping_n_s_per_m >= 0.0f) || !(cfg->pc_deadband_j >= 0.0f) ||
+        !(cfg->joint_margin_rad >= 0.0f) || !(cfg->joint_limit_stiffness_nm_per_rad >= 0.0f) ||
+        !(cfg->accel_limit > 0.0f) || !isfinite(cfg->slew_n_per_s) || !isfinite(cfg->accel_limit))
         return ARGIL_ERR_ARG;
     b->cfg = *cfg;
     safety_init(&b->safety);
@@ -46,13 +61,21 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     b->fault_reported = false;
     b->wdog_level = false;
     b->host_window_version = 0;
+    b->host_impulse_ack = 0;
     b->have_tip = false;
     b->tip_device_m = vec3(0, 0, 0);
     b->pos_m = vec3(0, 0, 0);
     b->vel_m_s = vec3(0, 0, 0);
     b->force_n = vec3(0, 0, 0);
-    b->fade_from_n = vec3(0, 0, 0);
-    b->fade_left = 0;
+    b->swap_offset_n = vec3(0, 0, 0);
+    b->swapped = false;
+    passivity_init(&b->passivity, cfg->io_delay_ticks);
+    b->spring_max_accel = 0.0f;
+    b->log_head = 0;
+    b->log_count = 0;
+    b->settle_left = 0;
+    b->work_m = vec3(0, 0, 0);
+    b->work_radius_m = 0.0f;
     b->contact = false;
     b->sculpting = false;
     memset(&b->stats, 0, sizeof(b->stats));
@@ -100,6 +123,11 @@ static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
         if (e != PROTO_OK) {
             b->stats.link_errors++;
             b->stats.last_link_error = e;
+            /* A window or tool with NaN, Inf or an out-of-range value: the host is broken, and
+             * the safe state is a fault, not a guess. */
+            if (e == PROTO_ERR_VALUE && len - at > 5u &&
+                (in->link_rx[at + 5u] == MSG_WINDOW || in->link_rx[at + 5u] == MSG_TOOL))
+                ev->nonfinite = true;
             if (e == PROTO_ERR_TRUNCATED)
                 break; /* frames arrive whole; the rest of this buffer is a torn frame */
             at++;
@@ -115,6 +143,7 @@ static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
         case MSG_HEARTBEAT:
             ev->heartbeat = true;
             b->host_window_version = m->u.heartbeat.window_version;
+            b->host_impulse_ack = m->u.heartbeat.impulse_seq;
             if (m->u.heartbeat.command == PROTO_CMD_ARM)
                 ev->arm = true;
             else if (m->u.heartbeat.command == PROTO_CMD_DISARM)
@@ -165,6 +194,46 @@ static bool sense_tool(board_t *b)
     return vec3_isfinite(b->pos_m) && vec3_isfinite(b->vel_m_s);
 }
 
+/* Model-space position of window node i. */
+static vec3_t node_position(const window_buf_t *w, uint32_t i)
+{
+    const int32_t nx = w->dims[0], ny = w->dims[1];
+    const int32_t k = (int32_t)i;
+    return window_node_pos(w, k % nx, (k / nx) % ny, k / (nx * ny));
+}
+
+/* Remembers a sent impulse until a window from the host includes it. */
+static void log_impulse(board_t *b, uint32_t seq, vec3_t pos_m, float impulse_ns)
+{
+    const uint32_t slot = b->log_head;
+    if (b->log_count == BOARD_IMPULSE_LOG && (int32_t)(b->log_seq[slot] - b->host_impulse_ack) > 0)
+        b->stats.impulse_log_overflow++;
+    b->log_seq[slot] = seq;
+    b->log_pos_m[slot] = pos_m;
+    b->log_impulse_ns[slot] = impulse_ns;
+    b->log_head = (slot + 1u) % BOARD_IMPULSE_LOG;
+    if (b->log_count < BOARD_IMPULSE_LOG)
+        b->log_count++;
+}
+
+/* Re-applies to a freshly swapped-in window the impulses its host had not yet applied when it
+ * extracted it, as the velocity kicks the host will give them (Δv = J / m). */
+static void reapply_impulses(board_t *b, window_buf_t *w)
+{
+    const float inv_h = 1.0f / w->spacing_m;
+    for (uint32_t k = 0; k < b->log_count; k++) {
+        if ((int32_t)(b->log_seq[k] - w->impulse_seq) <= 0)
+            continue;
+        const vec3_t d = vec3_sub(b->log_pos_m[k], w->origin_m);
+        const int32_t i = window_index(w, (int32_t)lrintf(d.x * inv_h), (int32_t)lrintf(d.y * inv_h),
+                                       (int32_t)lrintf(d.z * inv_h));
+        if (i < 0)
+            continue;
+        w->velocity[i] += b->log_impulse_ns[k] / w->material.node_mass;
+        b->stats.impulses_reapplied++;
+    }
+}
+
 /* Sends the accumulated impulses of the active window, at most BOARD_IMPULSE_FRAMES_MAX frames. */
 static void flush_impulses(board_t *b, board_out_t *out)
 {
@@ -197,8 +266,11 @@ static void flush_impulses(board_t *b, board_out_t *out)
             break;
         }
         b->impulse_seq++;
-        for (uint16_t k = 0; k < m->u.impulse.count; k++)
-            b->impulse_ns[m->u.impulse.entries[k].node] = 0.0f;
+        for (uint16_t k = 0; k < m->u.impulse.count; k++) {
+            const uint32_t node = m->u.impulse.entries[k].node;
+            log_impulse(b, b->impulse_seq, node_position(w, node), b->impulse_ns[node]);
+            b->impulse_ns[node] = 0.0f;
+        }
     }
     for (; i < n && !left; i++)
         if (b->impulse_ns[i] != 0.0f)
@@ -217,6 +289,46 @@ static bool status_led(const board_t *b)
     case SAFETY_ESTOP: return (ms / 100u) % 2u == 0;
     default: return false;
     }
+}
+
+/* From the mapped force to the one the hand gets: contact damping, the passivity controller,
+ * the window-swap smoothing, the force limit, the slew limit and the safety scale. */
+static vec3_t shape_force(board_t *b, const haptics_out_t *h, float scale, float dt_s)
+{
+    vec3_t f = h->force_n;
+    if (h->contact) {
+        /* Contact damping grows with the wall's stiffness: b = b0 + K·τ, enough to offset
+         * the loop's sample-and-hold and bus delay (Colgate: b > K·(T/2 + delay)). */
+        const float damping = b->cfg.contact_damping_n_s_per_m +
+                              b->tool.contact_stiffness_n_per_m * b->cfg.contact_damping_s;
+        f = vec3_sub(f, vec3_scale(b->vel_m_s, damping));
+    }
+    const window_buf_t *w = window_active(&b->window);
+    const uint32_t env = (w ? w->version : 0u) * TOOL_KIND_COUNT + (b->tool_valid ? b->tool.kind : 0u);
+    const vec3_t device_m = b->tip_device_m;
+    f = vec3_add(f, passivity_process(&b->passivity, device_m, b->vel_m_s, h->potential_j, env,
+                                      dt_s, b->cfg.passivity && scale > 0.0f,
+                                      b->cfg.pc_deadband_j, b->cfg.pc_max_damping_n_s_per_m));
+    /* A window swap's force step is brought in by Guo et al.'s exponential weighted average:
+     * the difference from the force felt before the swap decays by α each tick. */
+    if (b->swapped) {
+        b->swap_offset_n = vec3_add(b->swap_offset_n, vec3_sub(b->force_n, f));
+        b->swapped = false;
+    }
+    f = vec3_add(f, b->swap_offset_n);
+    b->swap_offset_n = vec3_scale(b->swap_offset_n, b->cfg.swap_smoothing);
+    const float limit = b->tool_valid && b->tool.max_force_n < b->cfg.max_force_n
+                            ? b->tool.max_force_n
+                            : b->cfg.max_force_n;
+    f = vec3_clamp_len(f, limit);
+    /* Slew limit: the force changes by at most slew · dt per tick. */
+    const vec3_t step = vec3_clamp_len(vec3_sub(f, b->force_n), b->cfg.slew_n_per_s * dt_s);
+    f = vec3_add(b->force_n, step);
+    f = vec3_clamp_len(vec3_scale(f, scale), limit);
+    if (!vec3_isfinite(f))
+        f = vec3(0, 0, 0);
+    passivity_applied(&b->passivity, f);
+    return f;
 }
 
 void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
@@ -247,9 +359,11 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     if (window_pending(&b->window) && !b->impulse_pending) {
         /* impulse_ns is all zero here: every entry went out before the swap. */
         window_swap(&b->window);
+        reapply_impulses(b, window_active_mut(&b->window));
+        if (b->settle_left > 0)
+            b->settle_left = BOARD_SETTLE_TICKS;
         haptics_reset_path(&b->haptics);
-        b->fade_from_n = b->force_n;
-        b->fade_left = b->cfg.crossfade_ticks;
+        b->swapped = true;
         b->stats.windows_swapped++;
     }
 
@@ -259,25 +373,60 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     /* 3-4. Force mapping and the local window step. */
     window_buf_t *w = window_active_mut(&b->window);
     const bool btn1 = (in->gpio_in & GPIO_IN_STYLUS_BTN1) != 0;
-    haptics_out_t h = {vec3(0, 0, 0), false, false};
+    haptics_out_t h = {vec3(0, 0, 0), 0.0f, false, false, false, vec3(0, 0, 0), 0.0f};
     if (w && b->tool_valid && b->have_tip && !nonfinite) {
         haptics_process(&b->haptics, &b->tool, w, b->pos_m, b->vel_m_s, btn1,
                         safety_may_sculpt(&b->safety), dt_s, b->impulse_ns, &h);
-        if (h.sculpting)
+        if (h.sculpting) {
             b->impulse_pending = true;
-        /* Step the springs only in a box around the tool — the nodes it can reach and one
-         * cell beyond — the board's own physical window (Hua & Qin §6.3). */
-        const float reach = b->tool.radius_m + w->spacing_m;
+            b->settle_left = BOARD_SETTLE_TICKS;
+        }
+        /* Step the springs only in a box around where the tool works the clay — the nodes
+         * its forces reach and one cell beyond — the board's own physical window (Hua & Qin
+         * §6.3). */
+        if (h.sculpting) {
+            b->work_m = h.work_m;
+            b->work_radius_m = h.work_radius_m;
+        }
+        const float reach = b->work_radius_m + w->spacing_m;
         int32_t lo[3], hi[3];
-        const float p[3] = {b->pos_m.x - w->origin_m.x, b->pos_m.y - w->origin_m.y,
-                            b->pos_m.z - w->origin_m.z};
+        const float p[3] = {b->work_m.x - w->origin_m.x, b->work_m.y - w->origin_m.y,
+                            b->work_m.z - w->origin_m.z};
         for (int a = 0; a < 3; a++) {
             lo[a] = (int32_t)floorf((p[a] - reach) / w->spacing_m);
             hi[a] = (int32_t)ceilf((p[a] + reach) / w->spacing_m) + 1;
         }
+        /* The window's springs move only while the tool works the clay and shortly after (or
+         * after re-applied impulses); a window at rest is left alone — the host is
+         * authoritative and sends the settled shape. */
         spring_field_t f = {{w->dims[0], w->dims[1], w->dims[2]},
-                            w->density, w->rest, w->velocity, w->force};
-        (void)springs_step(&f, &w->material, lo, hi, dt_s);
+                            w->density, w->rest, w->velocity, w->force, w->node_stiffness};
+        /* Adaptive step (Hua & Qin §7): halve while the step is beyond the explicit stability
+         * bound or the last step's acceleration exceeded the limit; at most 3 halvings. */
+        spring_material_t worst = w->material;
+        worst.stiffness = w->max_stiffness;
+        uint32_t sub = b->settle_left > 0 ? 1u : 0u;
+        if (b->settle_left > 0)
+            b->settle_left--;
+        while (sub > 0 && sub < BOARD_SUBSTEPS_MAX &&
+               (dt_s / (float)sub > springs_stable_dt_s(&worst) ||
+                b->spring_max_accel * (dt_s / (float)sub) > b->cfg.accel_limit * 1e-3f))
+            sub *= 2u;
+        if (sub > b->stats.max_substeps)
+            b->stats.max_substeps = sub;
+        b->spring_max_accel = 0.0f;
+        for (uint32_t k = 0; k < sub; k++) {
+            /* External forces act over the whole tick: springs_step consumes them in the
+             * first sub-step, so scale them to keep the impulse. */
+            if (k == 0 && sub > 1u)
+                for (int32_t z = lo[2] < 0 ? 0 : lo[2]; z < hi[2] && z < w->dims[2]; z++)
+                    for (int32_t y = lo[1] < 0 ? 0 : lo[1]; y < hi[1] && y < w->dims[1]; y++)
+                        for (int32_t x = lo[0] < 0 ? 0 : lo[0]; x < hi[0] && x < w->dims[0]; x++)
+                            w->force[window_index(w, x, y, z)] *= (float)sub;
+            const float acc = springs_step(&f, &w->material, lo, hi, dt_s / (float)sub);
+            if (acc > b->spring_max_accel)
+                b->spring_max_accel = acc;
+        }
     } else {
         haptics_reset_path(&b->haptics);
     }
@@ -298,20 +447,12 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     si.nonfinite = nonfinite;
     si.force_limit_exceeded = false;
     si.deadline_overrun = overrun;
-    si.bus_error = false;
+    si.bus_error = drives_bus_error(&b->drives, &b->cfg.drives);
+    si.velocity_limit_exceeded =
+        b->cfg.max_velocity_m_s > 0.0f && vec3_norm(b->vel_m_s) > b->cfg.max_velocity_m_s;
     const float scale = safety_process(&b->safety, &b->cfg.safety, &si, dt_us);
 
-    vec3_t f = nonfinite ? vec3(0, 0, 0) : vec3_clamp_len(h.force_n, b->cfg.max_force_n);
-    if (b->fade_left > 0) {
-        /* Cross-fade from the force felt before the swap. */
-        const float t = (float)(b->cfg.crossfade_ticks - b->fade_left + 1u) /
-                        (float)(b->cfg.crossfade_ticks + 1u);
-        f = vec3_add(vec3_scale(b->fade_from_n, 1.0f - t), vec3_scale(f, t));
-        b->fade_left--;
-    }
-    f = vec3_scale(f, scale);
-    if (!vec3_isfinite(f))
-        f = vec3(0, 0, 0);
+    const vec3_t f = nonfinite ? vec3(0, 0, 0) : shape_force(b, &h, scale, dt_s);
     b->force_n = f;
     b->contact = h.contact;
     b->sculpting = h.sculpting && scale > 0.0f;
@@ -321,12 +462,23 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
 
     /* 6. Actuate: tau = Jᵀ F, motor torque in per-mille of rated. */
     int16_t permille[ARGIL_DRIVES] = {0};
-    if (b->have_tip && fn > 0.0f) {
+    if (b->have_tip && !nonfinite && scale > 0.0f) {
         float q[ARGIL_DRIVES], jac[3][ARGIL_DRIVES], tau[ARGIL_DRIVES];
         for (int j = 0; j < ARGIL_DRIVES; j++)
             q[j] = arm_counts_to_rad(&b->cfg.arm, j, b->drives.d[j].position_counts);
         arm_jacobian(&b->cfg.arm, q, jac);
         arm_jt_force(jac, f, tau);
+        /* Soft workspace limits: within the margin of a joint limit, a joint-space spring
+         * pushes back before the hard stop. */
+        const float m = b->cfg.joint_margin_rad, k = b->cfg.joint_limit_stiffness_nm_per_rad;
+        for (int j = 0; j < ARGIL_DRIVES; j++) {
+            const float over_hi = q[j] - (b->cfg.arm.q_max_rad[j] - m);
+            const float over_lo = (b->cfg.arm.q_min_rad[j] + m) - q[j];
+            if (over_hi > 0.0f)
+                tau[j] -= k * over_hi * scale;
+            else if (over_lo > 0.0f)
+                tau[j] += k * over_lo * scale;
+        }
         for (int j = 0; j < ARGIL_DRIVES; j++) {
             float pm = tau[j] / b->cfg.arm.gear_ratio[j] / b->cfg.arm.rated_torque_nm[j] * 1000.0f;
             if (!isfinite(pm))

@@ -11,6 +11,7 @@
 
 #include "drives.h"
 #include "haptics.h"
+#include "passivity.h"
 #include "safety.h"
 #include "shared/arm_kin.h"
 #include "shared/canopen.h"
@@ -19,14 +20,29 @@
 
 #define BOARD_LINK_TX_MAX 8192u        /* bytes of frames one tick may send */
 #define BOARD_IMPULSE_FRAMES_MAX 4u    /* IMPULSE frames per flush; the rest waits a tick */
+#define BOARD_IMPULSE_LOG 4096u        /* sent impulses remembered until the host's window has them */
+#define BOARD_SUBSTEPS_MAX 8u          /* adaptive step halving: at most 3 halvings */
+#define BOARD_SETTLE_TICKS 100u        /* the window's springs run this long after the last push */
 
 typedef struct {
     uint32_t tick_us;                  /* loop period (1000 at 1 kHz) */
     float max_force_n;                 /* hard limit on the force to the hand (3.3 N) */
     uint32_t impulse_period_us;        /* how often impulses go to the host (5 ms) */
     uint32_t heartbeat_period_us;      /* board heartbeat (10 ms) */
-    uint32_t crossfade_ticks;          /* force cross-fade after a window swap */
+    float swap_smoothing;              /* Guo et al.'s α: share of a window swap's force step kept
+                                        * each tick (exponential weighted average), 0 … <1 */
+    float contact_damping_n_s_per_m;   /* velocity damping while in contact, b0 */
+    float contact_damping_s;           /* … plus this many seconds × the contact stiffness */
+    uint32_t io_delay_ticks;           /* ticks from a force to the motion it acts on (2: CiA 402) */
+    float slew_n_per_s;                /* largest change of the force per second */
+    bool passivity;                    /* passivity observer + controller (Hannaford & Ryu) */
+    float pc_max_damping_n_s_per_m;    /* the passivity controller's largest damping */
+    float pc_deadband_j;               /* generated energy tolerated before it damps */
+    float joint_margin_rad;            /* soft workspace limit starts this far from a joint limit */
+    float joint_limit_stiffness_nm_per_rad;
+    float accel_limit;                 /* density-spring |acceleration| (1/s²) that halves the step */
     float velocity_filter;             /* 0…1: weight of the newest velocity sample */
+    float max_velocity_m_s;            /* tool speed (device space) that is a fault; 0 = none */
     safety_cfg_t safety;
     drives_cfg_t drives;
     arm_desc_t arm;
@@ -56,6 +72,9 @@ typedef struct {
     uint32_t link_errors;              /* frames the decoder refused */
     uint32_t link_tx_dropped;          /* frames that did not fit in a tick's output */
     uint32_t windows_swapped;
+    uint32_t impulses_reapplied;       /* unacknowledged impulses carried into a new window */
+    uint32_t impulse_log_overflow;     /* sent impulses forgotten before the host acknowledged them */
+    uint32_t max_substeps;             /* most spring sub-steps one tick needed */
     float peak_force_n;
     proto_err_t last_link_error;
 } board_stats_t;
@@ -79,13 +98,24 @@ typedef struct {
     bool fault_reported;
     bool wdog_level;
     uint32_t host_window_version;      /* newest version the host says it sent */
+    uint32_t host_impulse_ack;         /* newest impulse batch the host says it applied */
     bool have_tip;
     vec3_t tip_device_m;
     vec3_t pos_m;                      /* tool, model space */
     vec3_t vel_m_s;
     vec3_t force_n;                    /* rendered this tick, model space */
-    vec3_t fade_from_n;                /* force at the last window swap */
-    uint32_t fade_left;
+    vec3_t swap_offset_n;              /* force step of the last window swap, decaying */
+    bool swapped;                      /* a window was swapped in this tick */
+    passivity_t passivity;
+    float spring_max_accel;            /* last step's largest |acceleration| */
+    uint32_t settle_left;              /* ticks the window's springs still run */
+    vec3_t work_m;                     /* where the tool last worked the clay */
+    float work_radius_m;
+    uint32_t log_head;                 /* next slot of the impulse log */
+    uint32_t log_count;
+    uint32_t log_seq[BOARD_IMPULSE_LOG];
+    vec3_t log_pos_m[BOARD_IMPULSE_LOG];   /* model-space node position */
+    float log_impulse_ns[BOARD_IMPULSE_LOG];
     bool contact;
     bool sculpting;
     board_stats_t stats;

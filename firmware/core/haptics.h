@@ -1,6 +1,9 @@
-/* Force mapping on the local window (Hua & Qin §5.2): what the hand feels and how the tool's
- * motion turns into forces on the window's density springs. Model space throughout; the
- * device-to-model transform is a uniform scale, so force directions carry over unchanged. */
+/* Force mapping on the local window: what the hand feels and how the tool's motion becomes
+ * forces on the window's density springs. Sources: Hua & Qin §5.2 and §6.1 (eq. 7, the β
+ * filter, point/curve/area tools, iso-surface rendering, probing), Guo et al. (gradient +
+ * virtual contact point, friction by limiting its motion), McDonnell et al. §7.1 (rope).
+ * Model space throughout; the device-to-model transform is a uniform scale, so force
+ * directions carry over unchanged. */
 #ifndef ARGIL_HAPTICS_H
 #define ARGIL_HAPTICS_H
 
@@ -10,29 +13,48 @@
 #include "shared/vec3.h"
 #include "window.h"
 
+#define HAPTICS_CURVE_SAMPLES_MAX 17   /* paths along a curve tool */
+#define HAPTICS_AREA_SAMPLES_MAX 9     /* paths per side of an area tool */
+#define HAPTICS_MARCH_STEPS 64         /* half-cell steps searching the surface along the normal */
+#define HAPTICS_BISECT_STEPS 8         /* then bisections: 1/512 of a cell */
+
 typedef struct {
     bool prev_valid;
     vec3_t prev_pos_m;
-    bool grabbing;             /* button held with a sculpting tool */
+    bool in_contact;
+    vec3_t vcp_m;              /* virtual contact point: where the tool centre rests on the surface */
+    bool grabbing;             /* button held with pull or rope */
     vec3_t grab_pos_m;         /* reference point where the button went down */
     float grab_density;
 } haptics_t;
 
 typedef struct {
-    vec3_t force_n;            /* on the hand, before safety limits */
+    vec3_t force_n;            /* on the hand, before the board's limits */
+    float potential_j;         /* energy stored in the virtual spring being rendered */
     bool contact;
-    bool sculpting;
+    bool sculpting;            /* forces went to the density springs this tick */
+    bool yielding;             /* push: the contact force reached the yield force */
+    vec3_t work_m;             /* where the sculpting forces went (centre of the nodes touched) */
+    float work_radius_m;       /* … and how far from there */
 } haptics_out_t;
 
 void haptics_init(haptics_t *h);
 
-/* Forgets the tool's path (after a window swap or a fault), so no stroke spans the gap. */
+/* Forgets the tool's path and contact (after a window swap or a fault), so no stroke spans
+ * the gap. */
 void haptics_reset_path(haptics_t *h);
 
-/* One tick: contact force from the window's trilinear gradient, and, while the button is held
- * and sculpt_allowed, the sculpting force f = -α ∫C s dc along this tick's path (Hua & Qin
- * eq. 7) spread over the nodes near the tool by a Gaussian filter β. The node impulses are
- * added to impulse_ns (one per window sample) and the node forces to win->force. */
+/* Signed distance (m, positive inside) from p to the iso-surface along the field's gradient
+ * line, searched up to reach_m (beyond it: ±reach), and the outward normal; false when p is
+ * outside the window or the field is flat at p. */
+bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, float reach_m,
+                              float *dist_m, vec3_t *normal);
+
+/* β(d) for a node at distance d from a path, support radius r (0 beyond r). */
+float haptics_beta(beta_filter_t filter, float dist_m, float radius_m);
+
+/* One tick of the tool against the window. While the button is held and sculpt_allowed,
+ * sculpting forces go to win->force and their impulses (N·s) to impulse_ns (one per node). */
 void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, vec3_t pos_m,
                      vec3_t vel_m_s, bool button, bool sculpt_allowed, float dt_s,
                      float *impulse_ns, haptics_out_t *out);

@@ -6,7 +6,8 @@
 
 static void asm_target_back(window_t *w)
 {
-    window_asm_init(&w->assembler, w->buf[w->active ^ 1u].density, ARGIL_WINDOW_SAMPLES_MAX);
+    window_buf_t *back = &w->buf[w->active ^ 1u];
+    window_asm_init(&w->assembler, back->field, PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX);
 }
 
 void window_init(window_t *w)
@@ -14,8 +15,12 @@ void window_init(window_t *w)
     w->active = 0;
     w->pending = false;
     w->chunks_refused = 0;
-    w->buf[0].valid = false;
-    w->buf[1].valid = false;
+    for (int k = 0; k < 2; k++) {
+        w->buf[k].valid = false;
+        w->buf[k].density = w->buf[k].field;
+        w->buf[k].node_stiffness = 0;
+        w->buf[k].max_stiffness = 0.0f;
+    }
     asm_target_back(w);
 }
 
@@ -55,8 +60,9 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     const msg_window_t *h = &w->assembler.head;
     window_buf_t *b = &w->buf[w->active ^ 1u];
     const int32_t n = (int32_t)h->dims[0] * h->dims[1] * h->dims[2];
-    for (int32_t i = 0; i < n; i++) {
-        if (!isfinite(b->density[i])) {
+    const int32_t total = n * (int32_t)h->channels;
+    for (int32_t i = 0; i < total; i++) {
+        if (!isfinite(b->field[i]) || (i >= n && b->field[i] < 0.0f)) {
             w->chunks_refused++;
             asm_target_back(w);
             return PROTO_ERR_VALUE;
@@ -75,6 +81,12 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     b->material.stiffness = h->stiffness;
     b->material.damping = h->damping;
     b->material.plastic_rate_hz = h->plastic_rate_hz;
+    b->density = b->field;
+    b->node_stiffness = h->channels > 1 ? b->field + n : 0;
+    b->max_stiffness = h->stiffness;
+    for (int32_t i = 0; b->node_stiffness && i < n; i++)
+        if (b->node_stiffness[i] > b->max_stiffness)
+            b->max_stiffness = b->node_stiffness[i];
     if (!spring_material_valid(&b->material)) {
         w->chunks_refused++;
         asm_target_back(w);
@@ -95,7 +107,7 @@ void window_swap(window_t *w)
         return;
     w->active ^= 1u;
     window_buf_t *b = &w->buf[w->active];
-    const int32_t n = b->dims[0] * b->dims[1] * b->dims[2];
+    const int32_t n = window_nodes(b);
     memcpy(b->rest, b->density, (size_t)n * sizeof(float));
     memset(b->velocity, 0, (size_t)n * sizeof(float));
     memset(b->force, 0, (size_t)n * sizeof(float));

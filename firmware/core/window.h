@@ -21,7 +21,11 @@ typedef struct {
     float spacing_m;
     float iso;
     spring_material_t material;
-    float density[ARGIL_WINDOW_SAMPLES_MAX];
+    /* What the host sent: densities, then (channels = 2) per-node stiffness. */
+    float field[PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX];
+    float *density;                /* = field */
+    const float *node_stiffness;   /* = field + N, or NULL when the stiffness is uniform */
+    float max_stiffness;           /* largest node stiffness (or the uniform one) */
     float rest[ARGIL_WINDOW_SAMPLES_MAX];
     float velocity[ARGIL_WINDOW_SAMPLES_MAX];
     float force[ARGIL_WINDOW_SAMPLES_MAX];
@@ -31,7 +35,7 @@ typedef struct {
     window_buf_t buf[2];
     uint8_t active;                /* index of the buffer in use */
     bool pending;                  /* the back buffer holds a complete, checked window */
-    window_asm_t assembler;        /* writes into buf[!active].density */
+    window_asm_t assembler;        /* writes into buf[!active].field */
     uint32_t chunks_refused;
 } window_t;
 
@@ -56,6 +60,18 @@ bool window_sample(const window_buf_t *b, vec3_t p_m, float *density, vec3_t *gr
 
 /* Linear index of sample (x,y,z), or -1 outside. */
 int32_t window_index(const window_buf_t *b, int32_t x, int32_t y, int32_t z);
+
+/* Stiffness of the density spring at node i (per-node when the host sent it). */
+static inline float window_node_stiffness(const window_buf_t *b, int32_t i)
+{
+    return b->node_stiffness ? b->node_stiffness[i] : b->material.stiffness;
+}
+
+/* Nodes in the window. */
+static inline int32_t window_nodes(const window_buf_t *b)
+{
+    return b->dims[0] * b->dims[1] * b->dims[2];
+}
 
 /* Model-space position of sample (x,y,z). */
 vec3_t window_node_pos(const window_buf_t *b, int32_t x, int32_t y, int32_t z);

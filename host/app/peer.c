@@ -109,8 +109,8 @@ static void apply_impulses(peer_t *p, const msg_impulse_t *im)
             p->stats.impulses_unmapped++;
         }
     }
-    if (im->impulse_seq > p->impulse_seq_applied)
-        p->impulse_seq_applied = im->impulse_seq;
+    if ((int32_t)(im->impulse_seq - p->impulse_seq_received) > 0)
+        p->impulse_seq_received = im->impulse_seq;
 }
 
 void peer_receive(peer_t *p, const uint8_t *bytes, size_t len)
@@ -202,7 +202,8 @@ static void start_window(peer_t *p)
     p->head.damping = g->material.damping;
     p->head.plastic_rate_hz = g->material.plastic_rate_hz;
     p->head.impulse_seq = p->impulse_seq_applied;
-    p->head.chunk_count = window_chunk_count(p->head.dims);
+    p->head.channels = 1;
+    p->head.chunk_count = window_chunk_count(p->head.dims, p->head.channels);
     p->sending = r;
     p->sending_active = true;
     p->next_chunk = 0;
@@ -230,6 +231,21 @@ static bool tool_near_edge(const peer_t *p)
     return false;
 }
 
+/* Keeps box simulated until it comes to rest; with no room, merges the two oldest boxes. */
+static void remember_settling(peer_t *p, const peer_box_t *box)
+{
+    if (p->settling_count == PEER_SETTLING_MAX) {
+        peer_box_t *a = &p->settling[0];
+        const peer_box_t *b = &p->settling[1];
+        for (int k = 0; k < 3; k++) {
+            if (b->lo[k] < a->lo[k]) a->lo[k] = b->lo[k];
+            if (b->hi[k] > a->hi[k]) a->hi[k] = b->hi[k];
+        }
+        p->settling[1] = p->settling[--p->settling_count];
+    }
+    p->settling[p->settling_count++] = *box;
+}
+
 static void solve(peer_t *p)
 {
     grid_t *g = p->grid;
@@ -243,19 +259,39 @@ static void solve(peer_t *p)
             p->field_dirty = true;
         }
     }
-    /* The physical window of the global solve: the board's window and a margin around it. */
+    /* The physical window of the global solve: the board's window and a margin around it;
+     * plus the regions the tool left that are still moving (elastic clay springing back). */
     if (!p->have_current)
         return;
-    int32_t lo[3], hi[3];
+    peer_box_t box;
     for (int a = 0; a < 3; a++) {
-        lo[a] = p->current.corner[a] - 4;
-        hi[a] = p->current.corner[a] + p->current.dims[a] + 4;
+        box.lo[a] = p->current.corner[a] - 4;
+        box.hi[a] = p->current.corner[a] + p->current.dims[a] + 4;
     }
+    if (p->have_box && memcmp(&box, &p->box, sizeof(box)) != 0)
+        remember_settling(p, &p->box);
+    p->box = box;
+    p->have_box = true;
+    /* Impulses received so far act in this step: from now on windows include them. */
+    p->impulse_seq_applied = p->impulse_seq_received;
     spring_field_t f = grid_springs(g);
-    const float acc = springs_step(&f, &g->material, lo, hi, (float)p->cfg.solve_period_us * 1e-6f);
+    const float dt_s = (float)p->cfg.solve_period_us * 1e-6f;
+    const float acc = springs_step(&f, &g->material, box.lo, box.hi, dt_s);
     if (acc > 0.0f) {
-        mark_dirty(p, lo, hi);
+        mark_dirty(p, box.lo, box.hi);
         p->field_dirty = true;
+    }
+    for (uint32_t k = 0; k < p->settling_count;) {
+        const peer_box_t *s = &p->settling[k];
+        const float a = springs_step(&f, &g->material, s->lo, s->hi, dt_s);
+        if (a > 0.0f)
+            mark_dirty(p, s->lo, s->hi);
+        if (a < PEER_REST_ACCEL) {
+            /* At rest: stop simulating it. */
+            p->settling[k] = p->settling[--p->settling_count];
+        } else {
+            k++;
+        }
     }
 }
 

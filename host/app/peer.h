@@ -15,6 +15,13 @@
 #define PEER_VERSIONS_KEPT 32u        /* window versions whose layout is remembered */
 #define PEER_CHUNKS_PER_TICK 4u       /* WINDOW chunks sent per millisecond at most */
 
+#define PEER_SETTLING_MAX 4u          /* regions the tool left that still settle */
+#define PEER_REST_ACCEL 1e-3f         /* |density acceleration| (1/s²) below which a region rests */
+
+typedef struct {
+    int32_t lo[3], hi[3];             /* sample index box [lo, hi) */
+} peer_box_t;
+
 typedef struct {
     uint32_t version;
     int32_t corner[3];
@@ -74,8 +81,13 @@ typedef struct {
     uint32_t since_window_us;
     uint32_t since_heartbeat_us;
     uint32_t since_solve_us;
-    uint32_t impulse_seq_applied;
+    uint32_t impulse_seq_received;    /* newest IMPULSE batch taken in */
+    uint32_t impulse_seq_applied;     /* newest batch integrated by a solve step */
     int32_t dirty_lo[3], dirty_hi[3]; /* samples changed since the last mesh (lo > hi: none) */
+    peer_box_t box;                   /* the solve's physical window now */
+    bool have_box;
+    peer_box_t settling[PEER_SETTLING_MAX];
+    uint32_t settling_count;
     peer_stats_t stats;
     proto_msg_t scratch;
 } peer_t;

@@ -10,15 +10,48 @@
 
 #include "shared/proto.h"
 
-static const char *const PARAM_NAMES[PARAM_COUNT] = {"radius_mm", "alpha", "stiffness_n_per_mm",
-                                                     "max_force_n"};
-static const float PARAM_MIN[PARAM_COUNT] = {0.5f, 0.0f, 0.01f, 0.1f};
-static const float PARAM_MAX[PARAM_COUNT] = {50.0f, 1e7f, 10.0f, 10.0f};
-static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull", "carve"};
+/* Every tunable with its range and default: one row each (docs/script.md lists them). */
+static const struct {
+    const char *name;
+    float min, max, def;
+} PARAMS[PARAM_COUNT] = {
+    [PARAM_RADIUS_MM] = {"radius_mm", 0.5f, 50.0f, 4.0f},
+    [PARAM_ALPHA] = {"alpha", 0.0f, 1e7f, 30000.0f},
+    [PARAM_STIFFNESS_N_PER_MM] = {"stiffness_n_per_mm", 0.01f, 10.0f, 0.8f},
+    [PARAM_MAX_FORCE_N] = {"max_force_n", 0.1f, 10.0f, 3.3f},
+    [PARAM_LENGTH_MM] = {"length_mm", 0.0f, 100.0f, 10.0f},
+    [PARAM_YIELD_FORCE_N] = {"yield_force_n", 0.0f, 10.0f, 0.5f},
+    [PARAM_FRICTION] = {"friction", 0.0f, 2.0f, 0.3f},
+    [PARAM_ISO] = {"iso", 0.05f, 0.95f, 0.5f},
+    [PARAM_PROBE_GAIN] = {"probe_gain", 0.0f, 100.0f, 0.02f},
+    [PARAM_ROPE_STIFFNESS_N_PER_MM] = {"rope_stiffness_n_per_mm", 0.0f, 5.0f, 0.2f},
+    [PARAM_CLAY_STIFFNESS] = {"clay_stiffness", 0.0f, 5000.0f, 2.0f},
+    [PARAM_CLAY_DAMPING] = {"clay_damping", 0.1f, 1000.0f, 40.0f},
+    [PARAM_PLASTIC_RATE_HZ] = {"plastic_rate_hz", 0.0f, 1000.0f, 20.0f},
+};
+static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull",
+                                                        "carve", "probe", "rope"};
+static const char *const SHAPE_NAMES[TOOL_SHAPE_COUNT] = {"point", "curve", "area"};
+static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussian", "spherical",
+                                                            "cylindrical", "conical"};
 
 const char *script_param_name(script_param_t p)
 {
-    return (p >= 0 && p < PARAM_COUNT) ? PARAM_NAMES[p] : "?";
+    return (p >= 0 && p < PARAM_COUNT) ? PARAMS[p].name : "?";
+}
+
+float script_param_default(script_param_t p)
+{
+    return (p >= 0 && p < PARAM_COUNT) ? PARAMS[p].def : 0.0f;
+}
+
+/* Index of word in names[0..n), or -1. */
+static int find_name(const char *word, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (strcmp(word, names[k]) == 0)
+            return k;
+    return -1;
 }
 
 void script_init(script_t *s)
@@ -95,36 +128,52 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
     c->value = 0.0f;
     c->target_m = vec3(0, 0, 0);
     const char *op = w[0];
-    if (strcmp(op, "tool") == 0) {
-        if (n != 2)
-            FAIL("line %d: 'tool' takes one name (touch, push, pull, carve)", lineno);
-        for (int k = 0; k < TOOL_KIND_COUNT; k++) {
-            if (strcmp(w[1], TOOL_NAMES[k]) == 0) {
-                c->op = SCRIPT_TOOL;
-                c->arg_int = k;
-                return ARGIL_OK;
-            }
+    if (strcmp(op, "tool") == 0 || strcmp(op, "shape") == 0 || strcmp(op, "filter") == 0) {
+        const char *const *names = op[0] == 't' ? TOOL_NAMES : op[0] == 's' ? SHAPE_NAMES : FILTER_NAMES;
+        const int count = op[0] == 't' ? TOOL_KIND_COUNT : op[0] == 's' ? TOOL_SHAPE_COUNT
+                                                                           : BETA_FILTER_COUNT;
+        char list[128] = "";
+        for (int k = 0; k < count; k++) {
+            strncat(list, names[k], sizeof(list) - strlen(list) - 1);
+            if (k + 1 < count)
+                strncat(list, ", ", sizeof(list) - strlen(list) - 1);
         }
-        FAIL("line %d: unknown tool '%s' (touch, push, pull, carve)", lineno, w[1]);
+        if (n != 2)
+            FAIL("line %d: '%s' takes one name (%s)", lineno, op, list);
+        const int k = find_name(w[1], names, count);
+        if (k < 0)
+            FAIL("line %d: unknown %s '%s' (%s)", lineno, op, w[1], list);
+        c->op = op[0] == 't' ? SCRIPT_TOOL : op[0] == 's' ? SCRIPT_SHAPE : SCRIPT_FILTER;
+        c->arg_int = k;
+        return ARGIL_OK;
+    }
+    if (strcmp(op, "axis") == 0) {
+        float x, y, z;
+        if (n != 4 || !parse_float(w[1], &x) || !parse_float(w[2], &y) || !parse_float(w[3], &z))
+            FAIL("line %d: 'axis' takes three numbers X Y Z", lineno);
+        const float len = sqrtf(x * x + y * y + z * z);
+        if (!(len > 1e-6f) || !isfinite(len))
+            FAIL("line %d: 'axis' must not be the zero vector", lineno);
+        c->op = SCRIPT_AXIS;
+        c->target_m = vec3(x / len, y / len, z / len);
+        return ARGIL_OK;
     }
     if (strcmp(op, "set") == 0) {
         if (n != 3)
             FAIL("line %d: 'set' takes a name and a value", lineno);
         for (int k = 0; k < PARAM_COUNT; k++) {
-            if (strcmp(w[1], PARAM_NAMES[k]) == 0) {
+            if (strcmp(w[1], PARAMS[k].name) == 0) {
                 if (!parse_float(w[2], &c->value))
                     FAIL("line %d: '%s' is not a number", lineno, w[2]);
-                if (c->value < PARAM_MIN[k] || c->value > PARAM_MAX[k])
-                    FAIL("line %d: %s must be within %g … %g, got %s", lineno, PARAM_NAMES[k],
-                         (double)PARAM_MIN[k], (double)PARAM_MAX[k], w[2]);
+                if (c->value < PARAMS[k].min || c->value > PARAMS[k].max)
+                    FAIL("line %d: %s must be within %g … %g, got %s", lineno, PARAMS[k].name,
+                         (double)PARAMS[k].min, (double)PARAMS[k].max, w[2]);
                 c->op = SCRIPT_SET;
                 c->arg_int = k;
                 return ARGIL_OK;
             }
         }
-        FAIL("line %d: unknown parameter '%s' (radius_mm, alpha, stiffness_n_per_mm, "
-             "max_force_n)",
-             lineno, w[1]);
+        FAIL("line %d: unknown parameter '%s' (see docs/script.md)", lineno, w[1]);
     }
     if (strcmp(op, "move") == 0) {
         float x, y, z, t;
@@ -158,7 +207,9 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
         c->op = SCRIPT_WAIT;
         return ARGIL_OK;
     }
-    FAIL("line %d: unknown command '%s' (tool, set, move, press, release, wait)", lineno, op);
+    FAIL("line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
+         "wait)",
+         lineno, op);
 }
 
 argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len)
@@ -257,10 +308,11 @@ void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
     p->from_m = start_m;
     p->to_m = start_m;
     p->tool = TOOL_TOUCH;
-    p->params[PARAM_RADIUS_MM] = 4.0f;
-    p->params[PARAM_ALPHA] = 12000.0f;
-    p->params[PARAM_STIFFNESS_N_PER_MM] = 0.8f;
-    p->params[PARAM_MAX_FORCE_N] = 3.3f;
+    p->shape = TOOL_SHAPE_POINT;
+    p->filter = BETA_GAUSSIAN;
+    p->axis = vec3(0, 0, 1);
+    for (int k = 0; k < PARAM_COUNT; k++)
+        p->params[k] = PARAMS[k].def;
     p->params_changed = 1;
 }
 
@@ -272,6 +324,18 @@ int script_player_step(script_player_t *p, float dt_s)
         switch (c->op) {
         case SCRIPT_TOOL:
             p->tool = c->arg_int;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_SHAPE:
+            p->shape = c->arg_int;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_FILTER:
+            p->filter = c->arg_int;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_AXIS:
+            p->axis = c->target_m;
             p->params_changed = 1;
             break;
         case SCRIPT_SET:

@@ -9,7 +9,10 @@
 #include "shared/vec3.h"
 
 typedef enum {
-    SCRIPT_TOOL,      /* tool touch|push|pull|carve */
+    SCRIPT_TOOL,      /* tool touch|push|pull|carve|probe|rope */
+    SCRIPT_SHAPE,     /* shape point|curve|area */
+    SCRIPT_FILTER,    /* filter constant|gaussian|spherical|cylindrical|conical */
+    SCRIPT_AXIS,      /* axis X Y Z: the tool axis (curve and area orientation) */
     SCRIPT_SET,       /* set NAME VALUE */
     SCRIPT_MOVE,      /* move X_MM Y_MM Z_MM SECONDS */
     SCRIPT_PRESS,     /* press 1|2 */
@@ -22,14 +25,23 @@ typedef enum {
     PARAM_ALPHA,
     PARAM_STIFFNESS_N_PER_MM,
     PARAM_MAX_FORCE_N,
+    PARAM_LENGTH_MM,
+    PARAM_YIELD_FORCE_N,
+    PARAM_FRICTION,
+    PARAM_ISO,
+    PARAM_PROBE_GAIN,
+    PARAM_ROPE_STIFFNESS_N_PER_MM,
+    PARAM_CLAY_STIFFNESS,
+    PARAM_CLAY_DAMPING,
+    PARAM_PLASTIC_RATE_HZ,
     PARAM_COUNT
 } script_param_t;
 
 typedef struct {
     script_op_t op;
     int line;                 /* 1-based line in the file */
-    int arg_int;              /* tool kind, button number, or param id */
-    vec3_t target_m;          /* move: model space */
+    int arg_int;              /* tool kind, shape, filter, button number, or param id */
+    vec3_t target_m;          /* move: model space; axis: unit vector */
     float value;              /* set: value; move/wait: seconds */
 } script_cmd_t;
 
@@ -52,8 +64,9 @@ argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, s
 /* Reads and parses a file; err names the file and line. */
 argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len);
 
-/* The name a param is written with in scripts. */
+/* The name a param is written with in scripts, and its default value. */
 const char *script_param_name(script_param_t p);
+float script_param_default(script_param_t p);
 
 /* Total duration (s) of the moves and waits. */
 float script_duration_s(const script_t *s);
@@ -70,6 +83,9 @@ typedef struct {
     vec3_t vel_m_s;
     int buttons;              /* bit 0: button 1, bit 1: button 2 */
     int tool;                 /* tool_kind_t */
+    int shape;                /* tool_shape_t */
+    int filter;               /* beta_filter_t */
+    vec3_t axis;              /* unit */
     float params[PARAM_COUNT];
     int params_changed;       /* set when tool or a param changed since the last call */
 } script_player_t;

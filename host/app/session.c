@@ -83,10 +83,22 @@ static void tool_from_player(const session_t *s, msg_tool_t *tool)
     const script_player_t *p = &s->player;
     memset(tool, 0, sizeof(*tool));
     tool->kind = (uint8_t)p->tool;
+    tool->shape = (uint8_t)p->shape;
+    tool->filter = (uint8_t)p->filter;
+    tool->flags = TOOL_FLAG_ISO;
     tool->radius_m = p->params[PARAM_RADIUS_MM] * 1e-3f;
+    tool->length_m = p->params[PARAM_LENGTH_MM] * 1e-3f;
+    tool->axis[0] = p->axis.x;
+    tool->axis[1] = p->axis.y;
+    tool->axis[2] = p->axis.z;
     tool->alpha = p->params[PARAM_ALPHA];
     tool->contact_stiffness_n_per_m = p->params[PARAM_STIFFNESS_N_PER_MM] * 1e3f;
     tool->max_force_n = p->params[PARAM_MAX_FORCE_N];
+    tool->iso = p->params[PARAM_ISO];
+    tool->yield_force_n = p->params[PARAM_YIELD_FORCE_N];
+    tool->friction = p->params[PARAM_FRICTION];
+    tool->probe_gain = p->params[PARAM_PROBE_GAIN];
+    tool->rope_stiffness_n_per_m = p->params[PARAM_ROPE_STIFFNESS_N_PER_MM] * 1e3f;
     tool->model_scale = 1.0f;
     tool->model_offset_m[0] = s->model_offset_m.x;
     tool->model_offset_m[1] = s->model_offset_m.y;
@@ -304,6 +316,9 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             msg_tool_t tool;
             tool_from_player(s, &tool);
             peer_set_tool(&s->peer, &tool);
+            s->grid.material.stiffness = s->player.params[PARAM_CLAY_STIFFNESS];
+            s->grid.material.damping = s->player.params[PARAM_CLAY_DAMPING];
+            s->grid.material.plastic_rate_hz = s->player.params[PARAM_PLASTIC_RATE_HZ];
             s->player.params_changed = 0;
         }
 

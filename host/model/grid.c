@@ -89,6 +89,7 @@ spring_field_t grid_springs(grid_t *g)
     f.rest = g->rest;
     f.velocity = g->velocity;
     f.force = g->force;
+    f.stiffness = NULL; /* uniform: g->material.stiffness */
     return f;
 }
 

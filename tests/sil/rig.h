@@ -1,0 +1,269 @@
+/* The SIL rig shared by the scenario tests: the simulated arm and drives, the board core and a
+ * host on one virtual clock. Either the host is argil's own peer over a clay sphere (full
+ * system), or the test plays the host itself and hands the board windows it built (to set up
+ * walls, stiffness maps and broken input exactly). Header-only: each scenario is one binary. */
+#ifndef ARGIL_SIL_RIG_H
+#define ARGIL_SIL_RIG_H
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "firmware/core/board_hal.h"
+#include "firmware/hal/hal_sim.h"
+#include "host/app/peer.h"
+#include "host/model/grid.h"
+#include "shared/gpio_lines.h"
+#include "sim/sim_device.h"
+
+typedef struct {
+    hal_t hal;
+    board_t board;
+    board_io_t io;
+    sim_device_t dev;
+    sim_params_t sp;
+    grid_t grid;
+    peer_t peer;
+    bool manual_host;         /* the test plays the host (rig_send_window, heartbeats here) */
+    msg_tool_t tool;
+    vec3_t offset_m;          /* model = device + offset */
+    vec3_t hand_model_m;
+    bool hand_released;
+    bool btn1;
+    bool host_alive;          /* the host ticks and answers */
+    uint32_t host_seq;
+    uint32_t window_version;
+    bool armed_sent;
+    can_batch_t last_from_board;
+    uint8_t rx[HAL_SIM_LINK_BYTES];
+    uint32_t ms;
+} rig_t;
+
+static inline bool rig_send(void *ctx, const uint8_t *f, size_t len)
+{
+    rig_t *r = ctx;
+    return hal_sim_host_send(&r->hal, f, len) == ARGIL_OK;
+}
+
+/* A sensible tool of the given kind, as the host would send it. */
+static inline msg_tool_t rig_tool(const rig_t *r, tool_kind_t kind, float stiffness_n_per_mm)
+{
+    msg_tool_t t;
+    memset(&t, 0, sizeof(t));
+    t.kind = (uint8_t)kind;
+    t.shape = TOOL_SHAPE_POINT;
+    t.filter = BETA_GAUSSIAN;
+    t.flags = 0;
+    t.radius_m = 0.004f;
+    t.length_m = 0.0f;
+    t.axis[2] = 1.0f;
+    t.alpha = 30000.0f;
+    t.contact_stiffness_n_per_m = stiffness_n_per_mm * 1000.0f;
+    t.max_force_n = 3.3f;
+    t.iso = 0.5f;
+    t.yield_force_n = 0.5f;
+    t.friction = 0.0f;
+    t.probe_gain = 0.02f;
+    t.rope_stiffness_n_per_m = 200.0f;
+    t.model_scale = 1.0f;
+    t.model_offset_m[0] = r->offset_m.x;
+    t.model_offset_m[1] = r->offset_m.y;
+    t.model_offset_m[2] = r->offset_m.z;
+    return t;
+}
+
+static inline void rig_tick(rig_t *r);
+
+/* Sends one frame to the board; when the link is full (a 32³ window is larger than the link's
+ * buffer), lets the system run a tick at a time until there is room. */
+static inline void rig_send_msg(rig_t *r, proto_msg_t *m)
+{
+    uint8_t buf[PROTO_FRAME_MAX];
+    size_t len = 0;
+    assert_int_equal(proto_encode(m, r->host_seq++, buf, sizeof(buf), &len), PROTO_OK);
+    int tries = 0;
+    while (hal_sim_host_send(&r->hal, buf, len) == ARGIL_ERR_FULL && tries++ < 1000)
+        rig_tick(r);
+    assert_int_equal(tries <= 1000, 1);
+}
+
+/* Builds the rig. manual_host: the test provides windows; otherwise argil's peer over a
+ * 30 mm clay sphere at the model origin. The stylus starts at model (0, 0, 60 mm). */
+static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
+{
+    rig_t *r = calloc(1, sizeof(*r));
+    assert_non_null(r);
+    sim_params_default(&r->sp);
+    sim_device_init(&r->dev, &r->sp);
+    hal_sim_init(&r->hal);
+    board_cfg_t bc;
+    board_cfg_default(&bc);
+    bc.arm = r->sp.arm.desc;
+    assert_int_equal(board_init(&r->board, &bc), ARGIL_OK);
+    board_io_init(&r->io);
+    r->manual_host = manual_host;
+    r->offset_m = vec3_sub(vec3(0, 0, 0.060f), sim_device_tip_m(&r->dev));
+    r->hand_model_m = vec3(0, 0, 0.060f);
+    r->host_alive = true;
+    r->tool = rig_tool(r, TOOL_TOUCH, stiffness_n_per_mm);
+    if (!manual_host) {
+        const int32_t dims[3] = {72, 72, 72};
+        const float half = 0.5f * 71 * 0.00125f;
+        assert_int_equal(grid_init(&r->grid, dims, 0.00125f, vec3(-half, -half, -half)),
+                         ARGIL_OK);
+        grid_fill_sphere(&r->grid, vec3(0, 0, 0), 0.030f);
+        peer_cfg_t pc;
+        peer_cfg_default(&pc);
+        assert_int_equal(peer_init(&r->peer, &pc, &r->grid, rig_send, NULL, r), ARGIL_OK);
+        peer_set_tool(&r->peer, &r->tool);
+        peer_request_arm(&r->peer);
+    } else {
+        proto_msg_t m;
+        memset(&m, 0, sizeof(m));
+        m.type = MSG_TOOL;
+        m.u.tool = r->tool;
+        rig_send_msg(r, &m);
+    }
+    return r;
+}
+
+static rig_t *rig_new(float stiffness_n_per_mm)
+{
+    return rig_new_mode(stiffness_n_per_mm, false);
+}
+
+static inline void rig_free(rig_t *r)
+{
+    if (!r->manual_host) {
+        peer_free(&r->peer);
+        grid_free(&r->grid);
+    }
+    free(r);
+}
+
+/* Changes the tool (both modes). */
+static inline void rig_set_tool(rig_t *r, const msg_tool_t *t)
+{
+    r->tool = *t;
+    if (!r->manual_host) {
+        peer_set_tool(&r->peer, t);
+        return;
+    }
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = MSG_TOOL;
+    m.u.tool = *t;
+    rig_send_msg(r, &m);
+}
+
+/* Manual host: sends a whole window (density, and stiffness when not NULL) as one version. */
+static inline void rig_send_window(rig_t *r, const float *density, const float *stiffness,
+                            const int32_t dims[3], vec3_t origin_m, float spacing_m,
+                            const spring_material_t *mat)
+{
+    static proto_msg_t m;
+    static float all[PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX];
+    const int32_t n = dims[0] * dims[1] * dims[2];
+    memcpy(all, density, (size_t)n * sizeof(float));
+    if (stiffness)
+        memcpy(all + n, stiffness, (size_t)n * sizeof(float));
+    msg_window_t head;
+    memset(&head, 0, sizeof(head));
+    head.version = ++r->window_version;
+    for (int a = 0; a < 3; a++)
+        head.dims[a] = (uint8_t)dims[a];
+    head.channels = stiffness ? 2 : 1;
+    head.origin_m[0] = origin_m.x;
+    head.origin_m[1] = origin_m.y;
+    head.origin_m[2] = origin_m.z;
+    head.spacing_m = spacing_m;
+    head.iso = 0.5f;
+    head.node_mass = mat->node_mass;
+    head.stiffness = mat->stiffness;
+    head.damping = mat->damping;
+    head.plastic_rate_hz = mat->plastic_rate_hz;
+    head.chunk_count = window_chunk_count(head.dims, head.channels);
+    for (uint16_t i = 0; i < head.chunk_count; i++) {
+        memset(&m, 0, sizeof(m));
+        m.type = MSG_WINDOW;
+        assert_int_equal(window_chunk_fill(&head, all, i, &m.u.window), PROTO_OK);
+        rig_send_msg(r, &m);
+    }
+}
+
+/* One millisecond of the whole system. */
+static inline void rig_tick(rig_t *r)
+{
+    if (r->hand_released)
+        sim_device_release_hand(&r->dev);
+    else
+        sim_device_set_hand(&r->dev, vec3_sub(r->hand_model_m, r->offset_m), vec3(0, 0, 0),
+                            r->btn1, false);
+    can_batch_t to_board = {0};
+    hal_sim_take_from_board(&r->hal, &r->last_from_board);
+    sim_device_step(&r->dev, &r->last_from_board, hal_sim_gpio_out(&r->hal), &to_board, 1000);
+    hal_sim_put_to_board(&r->hal, &to_board);
+    hal_sim_set_gpio_in(&r->hal, sim_device_gpio_in(&r->dev));
+    (void)board_run_tick(&r->board, &r->io, &r->hal);
+    const size_t n = hal_sim_host_receive(&r->hal, r->rx, sizeof(r->rx));
+    if (r->host_alive && !r->manual_host) {
+        peer_receive(&r->peer, r->rx, n);
+        peer_tick(&r->peer, 1000);
+    } else if (r->host_alive && r->ms % 5u == 0) {
+        proto_msg_t m;
+        memset(&m, 0, sizeof(m));
+        m.type = MSG_HEARTBEAT;
+        m.u.heartbeat.time_us = (uint64_t)r->ms * 1000u;
+        m.u.heartbeat.window_version = r->window_version;
+        m.u.heartbeat.impulse_seq = r->board.impulse_seq;
+        if (!r->armed_sent && r->board.safety.state == SAFETY_IDLE && r->window_version > 0) {
+            m.u.heartbeat.command = PROTO_CMD_ARM;
+            r->armed_sent = true;
+        }
+        rig_send_msg(r, &m);
+    }
+    r->ms++;
+}
+
+/* Runs until the board is ACTIVE; returns the milliseconds it took (or -1). */
+static inline int rig_until_active(rig_t *r, int max_ms)
+{
+    for (int i = 0; i < max_ms; i++) {
+        rig_tick(r);
+        if (r->board.safety.state == SAFETY_ACTIVE)
+            return i + 1;
+    }
+    return -1;
+}
+
+/* Moves the hand in a straight line over ms milliseconds. */
+static inline void rig_move(rig_t *r, vec3_t to_m, int ms)
+{
+    const vec3_t from = r->hand_model_m;
+    for (int i = 1; i <= ms; i++) {
+        r->hand_model_m = vec3_add(from, vec3_scale(vec3_sub(to_m, from), (float)i / (float)ms));
+        rig_tick(r);
+    }
+}
+
+/* The stylus tip in model space (the truth, from the simulator). */
+static inline vec3_t rig_tip_model(const rig_t *r)
+{
+    return vec3_add(sim_device_tip_m(&r->dev), r->offset_m);
+}
+
+/* Where the host's clay surface crosses the +z axis through (x, y), in metres (-1 if none). */
+static inline float rig_surface_z(const rig_t *r, float x, float y)
+{
+    float prev = grid_density_at(&r->grid, vec3(x, y, 0.045f));
+    for (int k = 1; k <= 4500; k++) {
+        const float z = 0.045f - 1e-5f * (float)k;
+        const float d = grid_density_at(&r->grid, vec3(x, y, z));
+        if (prev < r->grid.iso && d >= r->grid.iso)
+            return z + 1e-5f * (d - r->grid.iso) / (d - prev);
+        prev = d;
+    }
+    return -1.0f;
+}
+
+#endif

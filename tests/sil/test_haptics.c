@@ -1,0 +1,355 @@
+/* SIL: what the person feels, measured the way a haptics engineer would (issue "haptic
+ * rendering"): yielding clay, plastic and elastic recovery, a stiff virtual wall and its
+ * passivity, a window swap under load, probing a stiffness step, and broken numbers. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+
+#include "shared/crc32c.h"
+#include "tests/sil/rig.h"
+
+#define EDGE 16
+#define H 0.00125f
+
+/* Pushes the stylus into the top (+z) of the clay sphere at 50 mm/s with the push tool, by
+ * `depth_m` beyond first contact, then lets go. Fills the surface height before and after. */
+static void push_scenario(rig_t *r, float depth_m, float *z_before, float *z_after,
+                          float *yield_force, bool *monotonic, float *density_drop)
+{
+    assert_true(rig_until_active(r, 1000) > 0);
+    const float r_tool = r->tool.radius_m;
+    *z_before = rig_surface_z(r, 0, 0);
+    const vec3_t probe_pt = vec3(0, 0, *z_before - 0.0005f);
+    const float d0 = grid_density_at(&r->grid, probe_pt);
+    /* Approach to just above the surface, button down, push at 50 mm/s. */
+    rig_move(r, vec3(0, 0, *z_before + r_tool + 0.002f), 500);
+    msg_tool_t t = rig_tool(r, TOOL_PUSH, 1.0f);
+    t.yield_force_n = 0.3f;
+    rig_set_tool(r, &t);
+    for (int i = 0; i < 50; i++)
+        rig_tick(r);
+    r->btn1 = true;
+    const float z0 = *z_before + r_tool + 0.002f, z1 = *z_before + r_tool - depth_m;
+    const int ms = (int)((z0 - z1) / 0.050f * 1000.0f);
+    float last = 0.0f, peak = 0.0f;
+    *monotonic = true;
+    bool yielded = false;
+    for (int i = 1; i <= ms; i++) {
+        r->hand_model_m = vec3(0, 0, z0 + (z1 - z0) * (float)i / (float)ms);
+        rig_tick(r);
+        const float f = r->board.force_n.z;
+        if (!yielded && f > 0.05f) {
+            /* Before the clay yields, the resistance only grows with depth. */
+            if (f < last - 0.02f)
+                *monotonic = false;
+            if (r->board.sculpting) {
+                yielded = true;
+                *yield_force = f;
+            }
+        }
+        last = f;
+        if (f > peak)
+            peak = f;
+    }
+    assert_true(yielded);
+    /* Hold the push for a moment (the person keeps pressing), then let go. */
+    for (int i = 0; i < 600; i++)
+        rig_tick(r);
+    const float front_z = rig_tip_model(r).z - r_tool;
+    const float held_z = rig_surface_z(r, 0, 0);
+    r->btn1 = false;
+    rig_move(r, vec3(0, 0, 0.060f), 600);
+    for (int i = 0; i < 1500; i++)
+        rig_tick(r);
+    *z_after = rig_surface_z(r, 0, 0);
+    *density_drop = d0 - grid_density_at(&r->grid, probe_pt);
+    printf("# push %.1f mm: surface %.2f -> %.2f mm (tool front %.2f, surface %.2f while held), "
+           "yield at %.2f N, peak %.2f N\n",
+           depth_m * 1e3, *z_before * 1e3, *z_after * 1e3, front_z * 1e3, held_z * 1e3,
+           *yield_force, peak);
+}
+
+static void test_push_yields_and_keeps_the_dent_when_plastic(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new(1.0f);
+    float zb, za, fy, drop;
+    bool mono;
+    const float depth = 0.005f;
+    push_scenario(r, depth, &zb, &za, &fy, &mono, &drop);
+    rig_free(r);
+    assert_true(mono);                        /* force rises with depth until the clay yields */
+    assert_in_range((long)(fy * 1000), 250, 700); /* …at about the 0.3 N yield force */
+    assert_true(drop > 0.2f);                 /* the density at the contact fell */
+    assert_true(zb - za >= 0.8f * depth);     /* ≥ 80 % of the commanded penetration stays */
+}
+
+static void test_elastic_clay_springs_back(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new(1.0f);
+    r->grid.material.stiffness = 300.0f;      /* elastic: stiff rest springs, no plastic flow */
+    r->grid.material.plastic_rate_hz = 0.0f;
+    float zb, za, fy, drop;
+    bool mono;
+    const float depth = 0.005f;
+    push_scenario(r, depth, &zb, &za, &fy, &mono, &drop);
+    rig_free(r);
+    assert_true(fabsf(zb - za) <= 0.05f * depth); /* back to within 5 % */
+}
+
+/* A manual-host window holding a wall: material below the plane z = wall_z (model). */
+static void send_wall(rig_t *r, float wall_z, vec3_t centre, float k_node, float k_node_right)
+{
+    static float d[EDGE * EDGE * EDGE], k[EDGE * EDGE * EDGE];
+    const vec3_t origin = vec3(centre.x - 0.5f * (EDGE - 1) * H, centre.y - 0.5f * (EDGE - 1) * H,
+                               centre.z - 0.5f * (EDGE - 1) * H);
+    for (int z = 0; z < EDGE; z++)
+        for (int y = 0; y < EDGE; y++)
+            for (int x = 0; x < EDGE; x++) {
+                const float pz = origin.z + z * H, px = origin.x + x * H;
+                float v = 0.5f + 0.5f * (wall_z - pz) / (4.0f * H);
+                v = v < 0 ? 0 : (v > 1 ? 1 : v);
+                d[x + EDGE * (y + EDGE * z)] = v;
+                k[x + EDGE * (y + EDGE * z)] = px < centre.x ? k_node : k_node_right;
+            }
+    spring_material_t mat;
+    spring_material_default(&mat);
+    const int32_t dims[3] = {EDGE, EDGE, EDGE};
+    rig_send_window(r, d, k_node_right > 0.0f ? k : NULL, dims, origin, H, &mat);
+}
+
+static void test_stiff_wall_settles_and_stays_passive(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new_mode(1.0f, true);
+    /* The stylus rests 5 mm inside a 1 N/mm wall when the force comes on, with no hand. */
+    const vec3_t tip = rig_tip_model(r);
+    send_wall(r, tip.z + 0.005f - r->tool.radius_m, tip, 0.0f, 0.0f);
+    r->hand_released = true;
+    assert_true(rig_until_active(r, 1000) > 0);
+    float pen_max[8] = {0};
+    for (int ms = 0; ms < 400; ms++) {
+        rig_tick(r);
+        const float pen = (tip.z + 0.005f) - rig_tip_model(r).z; /* > 0 inside */
+        if (pen > pen_max[ms / 50])
+            pen_max[ms / 50] = pen;
+        assert_int_equal(r->board.safety.state, SAFETY_ACTIVE);
+    }
+    /* No sustained oscillation: the deepest penetration halves (or better) every 50 ms. */
+    for (int w = 1; w < 8; w++)
+        assert_true(pen_max[w] <= 0.5f * pen_max[w - 1] + 1e-5f);
+    printf("# wall: penetration peaks per 50 ms %.2f %.2f %.2f %.2f mm; PO max %.3f mJ\n",
+           pen_max[0] * 1e3, pen_max[1] * 1e3, pen_max[2] * 1e3, pen_max[3] * 1e3,
+           r->board.passivity.max_energy_j * 1e3);
+    assert_true(r->board.passivity.max_energy_j <= 1e-3f); /* ≤ 1 mJ generated */
+    rig_free(r);
+}
+
+static void test_window_swap_under_3N_is_not_felt(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new_mode(1.0f, true);
+    const vec3_t tip = rig_tip_model(r);
+    const float wall = tip.z - r->tool.radius_m - 0.001f; /* 1 mm in front of the tool */
+    send_wall(r, wall, tip, 0.0f, 0.0f);
+    assert_true(rig_until_active(r, 1000) > 0);
+    /* Press until the wall pushes back with about 3 N. */
+    int ms = 0;
+    while (r->board.force_n.z < 3.0f && ms < 3000) {
+        r->hand_model_m = vec3(tip.x, tip.y, r->hand_model_m.z - 0.00001f);
+        rig_tick(r);
+        ms++;
+    }
+    assert_true(r->board.force_n.z >= 3.0f);
+    for (int i = 0; i < 300; i++)
+        rig_tick(r);
+    /* The host recentres the window and its field has moved 0.4 mm (as the clay settled). */
+    const uint32_t swaps = r->board.stats.windows_swapped;
+    send_wall(r, wall - 0.0004f, vec3_add(rig_tip_model(r), vec3(0.002f, 0.0f, 0.001f)), 0.0f,
+              0.0f);
+    float prev = r->board.force_n.z, worst = 0.0f;
+    for (int i = 0; i < 200; i++) {
+        rig_tick(r);
+        const float dz = fabsf(r->board.force_n.z - prev);
+        if (dz > worst)
+            worst = dz;
+        prev = r->board.force_n.z;
+    }
+    assert_int_equal(r->board.stats.windows_swapped, swaps + 1);
+    printf("# swap at %.2f N: largest tick-to-tick change %.4f N\n", prev, worst);
+    assert_true(worst < 0.1f);
+    rig_free(r);
+}
+
+static void test_probe_feels_four_times_the_stiffness(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new_mode(1.0f, true);
+    const vec3_t tip = rig_tip_model(r);
+    /* All material (the wall far above), stiffness k left of the centre and 4k right of it. */
+    send_wall(r, tip.z + 0.05f, tip, 50.0f, 200.0f);
+    msg_tool_t t = rig_tool(r, TOOL_PROBE, 1.0f);
+    t.radius_m = 0.003f;
+    t.probe_gain = 0.05f;
+    rig_set_tool(r, &t);
+    assert_true(rig_until_active(r, 1000) > 0);
+    rig_move(r, vec3_add(tip, vec3(-0.007f, 0, 0)), 300);
+    for (int i = 0; i < 100; i++)
+        rig_tick(r);
+    /* Sweep along +x at 20 mm/s through both halves. */
+    double f_soft = 0, f_hard = 0;
+    int n_soft = 0, n_hard = 0;
+    const vec3_t a = vec3_add(tip, vec3(-0.007f, 0, 0)), b = vec3_add(tip, vec3(0.007f, 0, 0));
+    for (int i = 1; i <= 700; i++) {
+        r->hand_model_m = vec3_add(a, vec3_scale(vec3_sub(b, a), (float)i / 700.0f));
+        rig_tick(r);
+        const float x = rig_tip_model(r).x - tip.x;
+        if (x < -0.0045f && x > -0.0065f) { f_soft += fabsf(r->board.force_n.x); n_soft++; }
+        if (x > 0.0045f && x < 0.0065f) { f_hard += fabsf(r->board.force_n.x); n_hard++; }
+    }
+    assert_true(n_soft > 20 && n_hard > 20);
+    const double ratio = (f_hard / n_hard) / (f_soft / n_soft);
+    printf("# probe: %.3f N in k, %.3f N in 4k, ratio %.2f\n", f_soft / n_soft, f_hard / n_hard, ratio);
+    assert_true(ratio >= 3.5 && ratio <= 4.5);
+    rig_free(r);
+}
+
+/* Runs until ACTIVE against a wall the stylus presses lightly, so a force is being felt. */
+static rig_t *pressing_rig(void)
+{
+    rig_t *r = rig_new_mode(1.0f, true);
+    const vec3_t tip = rig_tip_model(r);
+    send_wall(r, tip.z - r->tool.radius_m + 0.001f, tip, 0.0f, 0.0f);
+    assert_true(rig_until_active(r, 1000) > 0);
+    for (int i = 0; i < 100; i++)
+        rig_tick(r);
+    assert_true(vec3_norm(r->board.force_n) > 0.3f);
+    return r;
+}
+
+static void test_nan_window_faults_with_zero_force_in_the_tick(void **st)
+{
+    (void)st;
+    rig_t *r = pressing_rig();
+    /* A WINDOW chunk with a NaN sample, CRC made valid: it must not be used as clay. */
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    static float s[EDGE * EDGE * EDGE];
+    msg_window_t head;
+    memset(&head, 0, sizeof(head));
+    head.version = 99;
+    head.dims[0] = head.dims[1] = head.dims[2] = EDGE;
+    head.channels = 1;
+    head.spacing_m = H;
+    head.iso = 0.5f;
+    head.node_mass = 1.0f;
+    head.damping = 1.0f;
+    head.chunk_count = window_chunk_count(head.dims, 1);
+    m.type = MSG_WINDOW;
+    assert_int_equal(window_chunk_fill(&head, s, 0, &m.u.window), PROTO_OK);
+    uint8_t buf[PROTO_FRAME_MAX];
+    size_t len;
+    assert_int_equal(proto_encode(&m, 1, buf, sizeof(buf), &len), PROTO_OK);
+    const float nan = NAN;
+    const size_t sample_at = len - 4u - (size_t)m.u.window.sample_count * 4u; /* first sample */
+    memcpy(buf + sample_at, &nan, 4);
+    const uint32_t crc = crc32c(0, buf, len - 4u);
+    for (int k = 0; k < 4; k++)
+        buf[len - 4u + (size_t)k] = (uint8_t)(crc >> (8 * k));
+    assert_int_equal(hal_sim_host_send(&r->hal, buf, len), ARGIL_OK);
+    rig_tick(r);
+    assert_int_equal(r->board.safety.state, SAFETY_FAULT);
+    assert_int_equal(r->board.safety.fault, FAULT_NONFINITE);
+    assert_float_equal(vec3_norm(r->board.force_n), 0.0f, 0.0f);
+    rig_free(r);
+}
+
+static void test_nan_gain_or_position_faults_in_the_tick(void **st)
+{
+    (void)st;
+    for (int c = 0; c < 3; c++) {
+        rig_t *r = pressing_rig();
+        /* A corrupted gain or transform in the board's memory (the decoder refuses them on
+         * the wire, so poke them): the very next tick must be safe. */
+        if (c == 0) r->board.tool.contact_stiffness_n_per_m = NAN;
+        if (c == 1) r->board.tool.model_scale = INFINITY;
+        if (c == 2) r->board.tool.model_offset_m[1] = NAN;
+        rig_tick(r);
+        assert_int_equal(r->board.safety.state, SAFETY_FAULT);
+        assert_int_equal(r->board.safety.fault, FAULT_NONFINITE);
+        assert_float_equal(vec3_norm(r->board.force_n), 0.0f, 0.0f);
+        rig_free(r);
+    }
+}
+
+static void test_stiff_clay_halves_the_step_and_stays_stable(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new_mode(1.0f, true);
+    const vec3_t tip = rig_tip_model(r);
+    /* Springs so stiff that one explicit 1 ms step would blow up (ω·dt ≈ 2.8). */
+    send_wall(r, tip.z - r->tool.radius_m - 0.001f, tip, 4e6f, 4e6f);
+    msg_tool_t t = rig_tool(r, TOOL_PUSH, 1.0f);
+    t.yield_force_n = 0.1f;
+    rig_set_tool(r, &t);
+    assert_true(rig_until_active(r, 1000) > 0);
+    r->btn1 = true;
+    rig_move(r, vec3_add(tip, vec3(0, 0, -0.004f)), 300);
+    for (int i = 0; i < 200; i++)
+        rig_tick(r);
+    assert_true(r->board.stats.max_substeps >= 4); /* halved at least twice */
+    const window_buf_t *w = window_active(&r->board.window);
+    for (int32_t i = 0; i < window_nodes(w); i++)
+        assert_true(w->density[i] >= 0.0f && w->density[i] <= 1.0f && isfinite(w->velocity[i]));
+    assert_int_equal(r->board.safety.state, SAFETY_ACTIVE);
+    rig_free(r);
+}
+
+static void test_soft_limit_pushes_back_before_the_joint_stop(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new_mode(1.0f, true);
+    const vec3_t tip = rig_tip_model(r);
+    send_wall(r, tip.z - 0.05f, tip, 0.0f, 0.0f); /* clay far away: no contact force */
+    assert_true(rig_until_active(r, 1000) > 0);
+    /* Drag the stylus sideways until the yaw joint is inside its 0.1 rad margin. */
+    const float q_max = r->board.cfg.arm.q_max_rad[0];
+    float q[3];
+    int ms = 0;
+    do {
+        r->hand_model_m = vec3_add(r->hand_model_m, vec3(0.0002f, 0, 0));
+        rig_tick(r);
+        sim_device_q_rad(&r->dev, q);
+    } while (fabsf(q[0]) < q_max - 0.05f && ++ms < 3000);
+    assert_true(fabsf(q[0]) >= q_max - 0.05f);
+    for (int i = 0; i < 5; i++)
+        rig_tick(r);
+    /* The board now commands a yaw torque back towards the middle of the range. */
+    float tq[3];
+    sim_device_motor_torque_nm(&r->dev, tq);
+    assert_true(tq[0] * q[0] < 0.0f);
+    assert_true(fabsf(tq[0]) * r->board.cfg.arm.gear_ratio[0] > 0.5f * 0.04f * 0.5f);
+    rig_free(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_push_yields_and_keeps_the_dent_when_plastic),
+        cmocka_unit_test(test_elastic_clay_springs_back),
+        cmocka_unit_test(test_stiff_wall_settles_and_stays_passive),
+        cmocka_unit_test(test_window_swap_under_3N_is_not_felt),
+        cmocka_unit_test(test_probe_feels_four_times_the_stiffness),
+        cmocka_unit_test(test_nan_window_faults_with_zero_force_in_the_tick),
+        cmocka_unit_test(test_nan_gain_or_position_faults_in_the_tick),
+        cmocka_unit_test(test_soft_limit_pushes_back_before_the_joint_stop),
+        cmocka_unit_test(test_stiff_clay_halves_the_step_and_stays_stable),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
