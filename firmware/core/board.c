@@ -13,7 +13,7 @@ void board_cfg_default(board_cfg_t *cfg)
     cfg->max_force_n = 3.3f;
     cfg->impulse_period_us = 5000u;
     cfg->heartbeat_period_us = 10000u;
-    cfg->swap_smoothing = 0.95f;
+    cfg->swap_fade_ticks = 20u;
     cfg->contact_damping_n_s_per_m = 0.5f;
     cfg->contact_damping_s = 0.0025f;
     cfg->io_delay_ticks = 2u;
@@ -36,8 +36,7 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     if (cfg->tick_us < 100u || cfg->tick_us > 10000u || !(cfg->max_force_n > 0.0f) ||
         !isfinite(cfg->max_force_n) || cfg->impulse_period_us == 0 ||
         cfg->heartbeat_period_us == 0 || !(cfg->velocity_filter > 0.0f) ||
-        cfg->velocity_filter > 1.0f || !(cfg->swap_smoothing >= 0.0f) ||
-        !(cfg->swap_smoothing < 1.0f) || !(cfg->contact_damping_n_s_per_m >= 0.0f) || !(cfg->contact_damping_s >= 0.0f) ||
+        cfg->velocity_filter > 1.0f || cfg->swap_fade_ticks > 10000u || !(cfg->contact_damping_n_s_per_m >= 0.0f) || !(cfg->contact_damping_s >= 0.0f) ||
         cfg->io_delay_ticks < 1u || cfg->io_delay_ticks > PASSIVITY_DELAY_MAX ||
         !(cfg->slew_n_per_s > 0.0f) || !(cfg->pc_max_damping_n_s_per_m >= 0.0f) || !(cfg->pc_deadband_j >= 0.0f) ||
         !(cfg->joint_margin_rad >= 0.0f) || !(cfg->joint_limit_stiffness_nm_per_rad >= 0.0f) ||
@@ -316,7 +315,8 @@ static vec3_t shape_force(board_t *b, const haptics_out_t *h, float scale, float
         b->swapped = false;
     }
     f = vec3_add(f, b->swap_offset_n);
-    b->swap_offset_n = vec3_scale(b->swap_offset_n, b->cfg.swap_smoothing);
+    const float alpha = b->cfg.swap_fade_ticks > 0u ? 1.0f - 1.0f / (float)b->cfg.swap_fade_ticks : 0.0f;
+    b->swap_offset_n = vec3_scale(b->swap_offset_n, alpha);
     const float limit = b->tool_valid && b->tool.max_force_n < b->cfg.max_force_n
                             ? b->tool.max_force_n
                             : b->cfg.max_force_n;

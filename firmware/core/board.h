@@ -29,8 +29,9 @@ typedef struct {
     float max_force_n;                 /* hard limit on the force to the hand (3.3 N) */
     uint32_t impulse_period_us;        /* how often impulses go to the host (5 ms) */
     uint32_t heartbeat_period_us;      /* board heartbeat (10 ms) */
-    float swap_smoothing;              /* Guo et al.'s α: share of a window swap's force step kept
-                                        * each tick (exponential weighted average), 0 … <1 */
+    uint32_t swap_fade_ticks;          /* a window swap's force step fades in over about this
+                                        * many ticks: Guo et al.'s exponential weighted average
+                                        * with α = 1 − 1/ticks (0: no fade) */
     float contact_damping_n_s_per_m;   /* velocity damping while in contact, b0 */
     float contact_damping_s;           /* … plus this many seconds × the contact stiffness */
     uint32_t io_delay_ticks;           /* ticks from a force to the motion it acts on (2: CiA 402) */
