@@ -4,27 +4,16 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "host/io/argil_file.h"
+#include "tests/fuzz/fuzz_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char path[] = "/tmp/argil_fuzz_argil_XXXXXX";
-    const int fd = mkstemp(path);
-    if (fd < 0)
-        return 0;
-    size_t done = 0;
-    while (done < size) {
-        const ssize_t n = write(fd, data + done, size - done);
-        if (n <= 0)
-            break;
-        done += (size_t)n;
-    }
-    close(fd);
-    if (done == size) {
+    char path[FUZZ_PATH_MAX];
+    if (fuzz_write_temp(data, size, "argil", path)) {
         char err[512];
         err[0] = '\0';
         argil_doc_t d;
@@ -33,7 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (d.grid.density == NULL)
                 abort();
             argil_doc_free(&d);
-        } else if (err[0] == 0 || strstr(err, path) == NULL || d.grid.density != NULL) {
+        } else if (!fuzz_error_names_file(err, path) || d.grid.density != NULL) {
             abort();
         }
     }

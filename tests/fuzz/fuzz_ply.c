@@ -3,28 +3,17 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "host/io/ply.h"
 #include "host/mesh/mesh_check.h"
+#include "tests/fuzz/fuzz_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char path[] = "/tmp/argil_fuzz_ply_XXXXXX";
-    const int fd = mkstemp(path);
-    if (fd < 0)
-        return 0;
-    size_t done = 0;
-    while (done < size) {
-        const ssize_t n = write(fd, data + done, size - done);
-        if (n <= 0)
-            break;
-        done += (size_t)n;
-    }
-    close(fd);
-    if (done == size) {
+    char path[FUZZ_PATH_MAX];
+    if (fuzz_write_temp(data, size, "ply", path)) {
         mesh_t m;
         mesh_init(&m);
         char err[256];
@@ -36,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (m.tri[i] >= m.n_vert)
                     abort();
             (void)mesh_volume_m3(&m);
-        } else if (err[0] == '\0' || strstr(err, path) == NULL) {
+        } else if (!fuzz_error_names_file(err, path)) {
             abort(); /* every error names the file */
         }
         mesh_free(&m);

@@ -4,30 +4,19 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <math.h>
 #include <stdbool.h>
 
 #include "host/io/mesh_import.h"
+#include "tests/fuzz/fuzz_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char path[] = "/tmp/argil_fuzz_xyz_XXXXXX";
-    const int fd = mkstemp(path);
-    if (fd < 0)
-        return 0;
-    size_t done = 0;
-    while (done < size) {
-        const ssize_t n = write(fd, data + done, size - done);
-        if (n <= 0)
-            break;
-        done += (size_t)n;
-    }
-    close(fd);
-    if (done == size) {
+    char path[FUZZ_PATH_MAX];
+    if (fuzz_write_temp(data, size, "xyz", path)) {
         char err[512];
         err[0] = '\0';
         mesh_t m;
@@ -41,7 +30,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (size_t i = 0; i < 3 * m.n_vert; i++)
                 if (!isfinite(m.pos[i]))
                     abort();
-        } else if (err[0] == 0 || strstr(err, path) == NULL || strchr(err, 10) != NULL) {
+        } else if (!fuzz_error_names_file(err, path)) {
             abort(); /* every error is one line naming the file */
         }
         (void)nrm;
