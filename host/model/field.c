@@ -178,7 +178,7 @@ float field_eval(const field_t *f, vec3_t x_m, vec3_t *grad)
     return (float)v;
 }
 
-static float *field_scratch(field_t *f, size_t n)
+float *field_scratch(field_t *f, size_t n)
 {
     if (n > f->scratch_n) {
         float *p = realloc(f->scratch, n * sizeof(float));
@@ -188,6 +188,50 @@ static float *field_scratch(field_t *f, size_t n)
         f->scratch_n = n;
     }
     return f->scratch;
+}
+
+void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],
+                        const int32_t slo[3], const int32_t shi[3], float *out, float *tmp)
+{
+    int32_t blo[3], bhi[3], nc[3], ns[3];
+    field_coefs_of_samples(f, slo, shi, blo, bhi);
+    for (int a = 0; a < 3; a++) {
+        nc[a] = bhi[a] - blo[a];
+        ns[a] = shi[a] - slo[a];
+    }
+    const size_t sy = (size_t)cn[0], sz = (size_t)cn[0] * cn[1];
+    const float *P0 = P + (size_t)(blo[0] - clo[0]) + sy * (size_t)(blo[1] - clo[1]) + sz * (size_t)(blo[2] - clo[2]);
+    float *T1 = tmp, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
+    /* d = A p with A = A_z ⊗ A_y ⊗ A_x (Hua & Qin eq. 5): one axis at a time */
+    for (int32_t x = 0; x < ns[0]; x++) {
+        float w[4];
+        const int32_t c0 = field_sample_taps(f, slo[0] + x, w) - blo[0];
+        for (int32_t z = 0; z < nc[2]; z++)
+            for (int32_t y = 0; y < nc[1]; y++) {
+                const float *src = P0 + sy * (size_t)y + sz * (size_t)z + c0;
+                T1[(size_t)x + (size_t)ns[0] * ((size_t)y + (size_t)nc[1] * z)] =
+                    w[0] * src[0] + w[1] * src[1] + w[2] * src[2] + w[3] * src[3];
+            }
+    }
+    const size_t st = (size_t)ns[0];
+    for (int32_t z = 0; z < nc[2]; z++)
+        for (int32_t y = 0; y < ns[1]; y++) {
+            float w[4];
+            const int32_t c0 = field_sample_taps(f, slo[1] + y, w) - blo[1];
+            float *dst = T2 + st * (y + (size_t)ns[1] * z);
+            const float *s0 = T1 + st * (c0 + (size_t)nc[1] * z);
+            for (int32_t x = 0; x < ns[0]; x++)
+                dst[x] = w[0] * s0[x] + w[1] * s0[x + st] + w[2] * s0[x + 2 * st] + w[3] * s0[x + 3 * st];
+        }
+    const size_t plane = (size_t)ns[0] * ns[1];
+    for (int32_t z = 0; z < ns[2]; z++) {
+        float w[4];
+        const int32_t c0 = field_sample_taps(f, slo[2] + z, w) - blo[2];
+        const float *s0 = T2 + plane * (size_t)c0;
+        float *dst = out + plane * (size_t)z;
+        for (size_t i = 0; i < plane; i++)
+            dst[i] = w[0] * s0[i] + w[1] * s0[i + plane] + w[2] * s0[i + 2 * plane] + w[3] * s0[i + 3 * plane];
+    }
 }
 
 argil_err_t field_refresh(field_t *f, const int32_t slo[3], const int32_t shi[3])
@@ -212,36 +256,9 @@ argil_err_t field_refresh(field_t *f, const int32_t slo[3], const int32_t shi[3]
     float *buf = field_scratch(f, n_p + n_1 + n_2 + n_3);
     if (buf == NULL)
         return ARGIL_ERR_NOMEM;
-    float *P = buf, *T1 = P + n_p, *T2 = T1 + n_1, *D = T2 + n_2;
+    float *P = buf, *T = P + n_p, *D = T + n_1 + n_2;
     sparse_read_box(&f->coef, FC_P, clo, nc, P);
-    /* d = A p with A = A_z ⊗ A_y ⊗ A_x (Hua & Qin eq. 5): one axis at a time */
-    for (int32_t x = 0; x < ns[0]; x++) {
-        float w[4];
-        const int32_t c0 = field_sample_taps(f, slo[0] + x, w) - clo[0];
-        for (size_t r = 0; r < (size_t)nc[1] * nc[2]; r++) {
-            const float *src = P + r * nc[0] + c0;
-            T1[r * ns[0] + x] = w[0] * src[0] + w[1] * src[1] + w[2] * src[2] + w[3] * src[3];
-        }
-    }
-    for (int32_t z = 0; z < nc[2]; z++)
-        for (int32_t y = 0; y < ns[1]; y++) {
-            float w[4];
-            const int32_t c0 = field_sample_taps(f, slo[1] + y, w) - clo[1];
-            float *dst = T2 + (size_t)ns[0] * (y + (size_t)ns[1] * z);
-            const float *s0 = T1 + (size_t)ns[0] * (c0 + (size_t)nc[1] * z);
-            const size_t st = (size_t)ns[0];
-            for (int32_t x = 0; x < ns[0]; x++)
-                dst[x] = w[0] * s0[x] + w[1] * s0[x + st] + w[2] * s0[x + 2 * st] + w[3] * s0[x + 3 * st];
-        }
-    for (int32_t z = 0; z < ns[2]; z++) {
-        float w[4];
-        const int32_t c0 = field_sample_taps(f, slo[2] + z, w) - clo[2];
-        const size_t plane = (size_t)ns[0] * ns[1];
-        const float *s0 = T2 + plane * (size_t)c0;
-        float *dst = D + plane * (size_t)z;
-        for (size_t i = 0; i < plane; i++)
-            dst[i] = w[0] * s0[i] + w[1] * s0[i + plane] + w[2] * s0[i + 2 * plane] + w[3] * s0[i + 3 * plane];
-    }
+    field_samples_from(f, P, clo, nc, slo, shi, D, T);
     return sparse_write_box(&f->samp, FS_D, slo, ns, D);
 }
 

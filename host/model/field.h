@@ -72,9 +72,21 @@ bool field_point_taps(const field_t *f, vec3_t x_m, int32_t lo[3], float w[3][4]
 /* Value of the B-spline at x (density units); grad (may be NULL) gets the analytic gradient (1/m). */
 float field_eval(const field_t *f, vec3_t x_m, vec3_t *grad);
 
+/* A host-side buffer of at least n floats kept between calls (NULL when out of memory); its
+ * contents are lost by the next field_scratch or field_refresh. */
+float *field_scratch(field_t *f, size_t n);
+
 /* Recomputes d = A p (Hua & Qin eq. 5) for the samples in [slo, shi), separably, and marks the
  * changed blocks dirty for re-meshing. ARGIL_ERR_ARG for an empty or huge box, ARGIL_ERR_NOMEM. */
 argil_err_t field_refresh(field_t *f, const int32_t slo[3], const int32_t shi[3]);
+
+/* d = A p (eq. 5) for the sample box [slo, shi) from the dense coefficient box P (first index
+ * clo, dims cn, x fastest), which must hold every coefficient those samples depend on; out gets
+ * the samples (x fastest). tmp holds ns_x*nc_y*nc_z + ns_x*ns_y*nc_z floats for the coefficient
+ * box of the samples. Same arithmetic in the same order as field_refresh, so results match bit
+ * for bit. */
+void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],
+                        const int32_t slo[3], const int32_t shi[3], float *out, float *tmp);
 
 /* Signed distance callback (m, positive inside) used to build shapes. */
 typedef float (*field_sdf_fn)(void *ctx, vec3_t x_m);

@@ -8,6 +8,9 @@
 #include <string.h>
 
 #define SOLVER_BOX_MAX ((int64_t)1 << 26)
+/* The separable passes and the spring stencil are simple streaming loops: -O3 vectorises them
+ * (gcc's -O2 cost model leaves loops of unknown trip count scalar). */
+#define SOLVER_HOT __attribute__((optimize("O3")))
 
 void solver_cfg_default(solver_cfg_t *c)
 {
@@ -32,7 +35,10 @@ void solver_free(solver_t *s)
         free(s->tap_first[a]);
         free(s->tap_w[a]);
         free(s->kedge[a]);
+        free(s->tapt_lo[a]);
+        free(s->tapt_hi[a]);
     }
+    free(s->kdiag);
     free(s->p);
     free(s->p_prev);
     free(s->fixed);
@@ -81,8 +87,11 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
         s->tap_first[a] = calloc((size_t)ns[a], sizeof(int32_t));
         s->tap_w[a] = calloc((size_t)ns[a] * 4, sizeof(float));
         s->kedge[a] = calloc(s->nsamp, sizeof(float));
-        ok = ok && s->tap_first[a] && s->tap_w[a] && s->kedge[a];
+        s->tapt_lo[a] = calloc((size_t)nc[a], sizeof(int32_t));
+        s->tapt_hi[a] = calloc((size_t)nc[a], sizeof(int32_t));
+        ok = ok && s->tap_first[a] && s->tap_w[a] && s->kedge[a] && s->tapt_lo[a] && s->tapt_hi[a];
     }
+    s->kdiag = calloc(s->nsamp, sizeof(float));
     s->p = calloc(s->ncoef, sizeof(float));
     s->p_prev = calloc(s->ncoef, sizeof(float));
     s->fixed = calloc(s->ncoef, 1);
@@ -104,7 +113,7 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
     }
     const size_t mid = (size_t)ns[0] * nc[1] * nc[2] + (size_t)ns[0] * ns[1] * nc[2];
     s->w_mid = malloc(mid * sizeof(float));
-    ok = ok && s->p && s->p_prev && s->fixed && s->mlump && s->dlump && s->d_fixed && s->mass_kg &&
+    ok = ok && s->kdiag && s->p && s->p_prev && s->fixed && s->mlump && s->dlump && s->d_fixed && s->mass_kg &&
          s->damp_n_s && s->kscale && s->rest && s->force_n && s->w_mid;
     if (!ok) {
         solver_free(s);
@@ -120,7 +129,7 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
 }
 
 /* d = A x (samples from coefficients), separable: x, then y, then z. */
-static void solver_apply_A(solver_t *s, const float *x, float *y)
+SOLVER_HOT static void solver_apply_A(solver_t *s, const float *restrict x, float *restrict y)
 {
     const int32_t *nc = s->nc, *ns = s->ns;
     float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
@@ -154,37 +163,39 @@ static void solver_apply_A(solver_t *s, const float *x, float *y)
 }
 
 /* x = Aᵀ y (coefficients from samples), the transpose of solver_apply_A. */
-static void solver_apply_At(solver_t *s, const float *y, float *x)
+SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, float *restrict x)
 {
     const int32_t *nc = s->nc, *ns = s->ns;
     float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
     const size_t plane = (size_t)ns[0] * ns[1];
-    memset(T2, 0, sizeof(float) * plane * (size_t)nc[2]);
-    for (int32_t k = 0; k < ns[2]; k++) {
-        const float *w = s->tap_w[2] + 4 * k;
-        float *q = T2 + plane * (size_t)s->tap_first[2][k];
-        const float *src = y + plane * (size_t)k;
-        for (size_t i = 0; i < plane; i++) {
-            const float v = src[i];
-            q[i] += w[0] * v;
-            q[i + plane] += w[1] * v;
-            q[i + 2 * plane] += w[2] * v;
-            q[i + 3 * plane] += w[3] * v;
+    /* gathered per coefficient plane (the plane stays in cache), samples in ascending order: the
+     * same sums as scattering sample by sample */
+    for (int32_t c = 0; c < nc[2]; c++) {
+        float *restrict q = T2 + plane * (size_t)c;
+        memset(q, 0, sizeof(float) * plane);
+        for (int32_t k = s->tapt_lo[2][c]; k < s->tapt_hi[2][c]; k++) {
+            const int32_t j = c - s->tap_first[2][k];
+            if (j < 0 || j > 3)
+                continue;
+            const float w = s->tap_w[2][4 * k + j];
+            const float *restrict src = y + plane * (size_t)k;
+            for (size_t i = 0; i < plane; i++)
+                q[i] += w * src[i];
         }
     }
     const size_t st = (size_t)ns[0];
-    memset(T1, 0, sizeof(float) * st * (size_t)nc[1] * nc[2]);
     for (int32_t z = 0; z < nc[2]; z++)
-        for (int32_t j = 0; j < ns[1]; j++) {
-            const float *w = s->tap_w[1] + 4 * j;
-            float *q = T1 + st * ((size_t)s->tap_first[1][j] + (size_t)nc[1] * z);
-            const float *src = T2 + st * ((size_t)j + (size_t)ns[1] * z);
-            for (int32_t i = 0; i < ns[0]; i++) {
-                const float v = src[i];
-                q[i] += w[0] * v;
-                q[i + st] += w[1] * v;
-                q[i + 2 * st] += w[2] * v;
-                q[i + 3 * st] += w[3] * v;
+        for (int32_t c = 0; c < nc[1]; c++) {
+            float *restrict q = T1 + st * ((size_t)c + (size_t)nc[1] * z);
+            memset(q, 0, sizeof(float) * st);
+            for (int32_t k = s->tapt_lo[1][c]; k < s->tapt_hi[1][c]; k++) {
+                const int32_t j = c - s->tap_first[1][k];
+                if (j < 0 || j > 3)
+                    continue;
+                const float w = s->tap_w[1][4 * k + j];
+                const float *restrict src = T2 + st * ((size_t)k + (size_t)ns[1] * z);
+                for (int32_t i = 0; i < ns[0]; i++)
+                    q[i] += w * src[i];
             }
         }
     const size_t rows = (size_t)nc[1] * nc[2];
@@ -206,6 +217,20 @@ static void solver_apply_At(solver_t *s, const float *y, float *x)
 
 void solver_material_changed(solver_t *s)
 {
+    for (int a = 0; a < 3; a++) { /* the transpose of the taps: samples each coefficient reaches */
+        for (int32_t c = 0; c < s->nc[a]; c++) {
+            s->tapt_lo[a][c] = s->ns[a];
+            s->tapt_hi[a][c] = 0;
+        }
+        for (int32_t k = 0; k < s->ns[a]; k++)
+            for (int32_t j = 0; j < 4; j++) {
+                const int32_t c = s->tap_first[a][k] + j;
+                if (c < 0 || c >= s->nc[a])
+                    continue;
+                s->tapt_lo[a][c] = k < s->tapt_lo[a][c] ? k : s->tapt_lo[a][c];
+                s->tapt_hi[a][c] = k + 1 > s->tapt_hi[a][c] ? k + 1 : s->tapt_hi[a][c];
+            }
+    }
     const size_t stride[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
     for (int a = 0; a < 3; a++) {
         for (int32_t z = 0; z < s->ns[2]; z++)
@@ -219,6 +244,12 @@ void solver_material_changed(solver_t *s)
                                          ? 0.5f * s->coupling_n * (s->kscale[i] + s->kscale[i + stride[a]])
                                          : 0.0f;
                 }
+    }
+    for (size_t i = 0; i < s->nsamp; i++) {
+        float k = s->k_rest_n * s->kscale[i];
+        for (int a = 0; a < 3; a++)
+            k += s->kedge[a][i] + (i >= stride[a] ? s->kedge[a][i - stride[a]] : 0.0f);
+        s->kdiag[i] = k;
     }
     /* lumped mass Aᵀ (m ⊙ A 1) for the explicit solver */
     float *one = s->w_nc[5], *d = s->w_ns[3], *a1 = s->w_ns[2];
@@ -239,21 +270,36 @@ void solver_material_changed(solver_t *s)
             s->mlump[i] = 1.0e-12f;
 }
 
-/* out = K e on samples: rest springs plus the six neighbour springs (Hua & Qin eq. 6). */
-static void solver_apply_K(const solver_t *s, const float *e, float *out)
+/* K e at sample i with every neighbour checked against the array ends. */
+static float solver_K_at(const solver_t *s, const float *e, size_t i)
 {
-    for (size_t i = 0; i < s->nsamp; i++)
-        out[i] = s->k_rest_n * s->kscale[i] * e[i];
-    const size_t stride[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
+    const size_t st[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
+    float v = s->kdiag[i] * e[i];
     for (int a = 0; a < 3; a++) {
-        const float *k = s->kedge[a];
-        const size_t st = stride[a];
-        for (size_t i = 0; i + st < s->nsamp; i++) {
-            const float f = k[i] * (e[i] - e[i + st]);
-            out[i] += f;
-            out[i + st] -= f;
-        }
+        if (i + st[a] < s->nsamp)
+            v -= s->kedge[a][i] * e[i + st[a]];
+        if (i >= st[a])
+            v -= s->kedge[a][i - st[a]] * e[i - st[a]];
     }
+    return v;
+}
+
+/* out = K e on samples: rest springs plus the six neighbour springs (Hua & Qin eq. 6),
+ * (K e)_i = kdiag_i e_i - Σ_a k_a,i e_{i+a} - k_a,i-a e_{i-a}; springs across the region's
+ * border have k = 0, so only the first and last planes need bounds checks. */
+SOLVER_HOT static void solver_apply_K(const solver_t *s, const float *restrict e, float *restrict out)
+{
+    const size_t n = s->nsamp, sy = (size_t)s->ns[0], sz = sy * (size_t)s->ns[1];
+    const size_t lo = sz < n ? sz : n, hi = n > 2 * sz ? n - sz : lo;
+    for (size_t i = 0; i < lo; i++)
+        out[i] = solver_K_at(s, e, i);
+    const float *restrict kd = s->kdiag, *restrict kx = s->kedge[0], *restrict ky = s->kedge[1],
+                          *restrict kz = s->kedge[2];
+    for (size_t i = lo; i < hi; i++)
+        out[i] = kd[i] * e[i] - kx[i] * e[i + 1] - kx[i - 1] * e[i - 1] - ky[i] * e[i + sy] -
+                 ky[i - sy] * e[i - sy] - kz[i] * e[i + sz] - kz[i - sz] * e[i - sz];
+    for (size_t i = hi; i < n; i++)
+        out[i] = solver_K_at(s, e, i);
 }
 
 void solver_densities(solver_t *s, float *d)
@@ -362,7 +408,7 @@ static void solver_reduce(const solver_t *s, float *y)
 }
 
 /* y = (2 M~ + dt D~ + 2 dt² K~) x, matrix-free (left side of Hua & Qin eq. 12). */
-static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
+SOLVER_HOT static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
 {
     float *d = s->w_ns[0], *kd = s->w_ns[1];
     solver_apply_A(s, x, d);

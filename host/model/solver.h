@@ -47,6 +47,7 @@ typedef struct {
     size_t ncoef, nsamp;
     int32_t *tap_first[3];       /* per axis and sample: first of 4 coefficients (0..nc-4) */
     float *tap_w[3];             /* per axis and sample: 4 weights (0 for coefficients outside) */
+    int32_t *tapt_lo[3], *tapt_hi[3]; /* per axis and coefficient: samples [lo, hi) it reaches (derived) */
     float *p, *p_prev;           /* coefficients now and one step ago */
     float dt_prev_s;             /* step that separates p_prev from p */
     uint8_t *fixed;              /* 1 = coefficient held where it is (fixed point) */
@@ -57,6 +58,7 @@ typedef struct {
     float *force_n;              /* samples: external force, constant over the step */
     float k_rest_n, coupling_n;  /* base stiffness of the rest and the neighbour springs */
     float *kedge[3];             /* samples: neighbour spring to +x/+y/+z (derived) */
+    float *kdiag;                /* samples: rest spring + the 6 neighbour springs (derived) */
     solver_row_t *soft, *hard;
     int32_t nsoft, nhard, soft_cap, hard_cap;
     solver_cfg_t cfg;
@@ -79,7 +81,8 @@ void solver_free(solver_t *s);
 argil_err_t solver_init_patch(solver_t *s, const bspline_t *b, const int32_t ns[3],
                               const solver_cfg_t *cfg);
 
-/* Must be called after the material arrays or k_rest/coupling change (rebuilds kedge). */
+/* Must be called after the taps, the material arrays or k_rest/coupling change (rebuilds the
+ * derived arrays). */
 void solver_material_changed(solver_t *s);
 
 /* d = A p + d_fixed for the current p (nsamp floats). */

@@ -249,10 +249,204 @@ static float tool_action_coef(const field_t *f, const tool_params_t *p, float bo
     }
 }
 
+/* True when the action cannot change a coefficient of value pold, whatever the tool: the
+ * signed distance need not be computed (carving empty space, adding to full material). */
+static bool tool_coef_fixed_point(tool_action_t a, float pold)
+{
+    switch (a) {
+    case TOOL_CARVE:
+        return pold <= 0.0f;
+    case TOOL_INTERIOR_CARVE:
+        return !(pold >= 1.0f);
+    case TOOL_ADD:
+        return pold >= 1.0f;
+    default:
+        return false;
+    }
+}
+
+/* Stores new densities dnew for the samples [lo, hi) of sample block key; the rest density moves
+ * by the same Δd (a plastic edit); changed values are noted for undo and the block marked dirty.
+ * *nchanged counts the samples whose density changed. */
+static argil_err_t tool_store_samples(field_t *f, const int32_t key[3], const int32_t lo[3],
+                                      const int32_t hi[3], const float *dnew, undo_t *u,
+                                      size_t *nchanged)
+{
+    sparse_block_t *b = sparse_find(&f->samp, key);
+    const int32_t n0 = hi[0] - lo[0], n1 = hi[1] - lo[1], n2 = hi[2] - lo[2];
+    const int32_t base[3] = {key[0] * SPARSE_B, key[1] * SPARSE_B, key[2] * SPARSE_B};
+    const float d_def = f->samp.defaults[FS_D];
+    bool any = false;
+    for (int32_t z = 0, i = 0; z < n2 && !any; z++)
+        for (int32_t y = 0; y < n1 && !any; y++)
+            for (int32_t x = 0; x < n0; x++, i++) {
+                const size_t li = (size_t)(lo[0] - base[0] + x) +
+                                  SPARSE_B * ((size_t)(lo[1] - base[1] + y) + SPARSE_B * (size_t)(lo[2] - base[2] + z));
+                const float dold = b != NULL ? b->data[FS_D * SPARSE_BN + li] : d_def;
+                if (memcmp(&dold, &dnew[i], sizeof(float)) != 0) {
+                    any = true;
+                    break;
+                }
+            }
+    if (!any)
+        return ARGIL_OK;
+    if (b == NULL) {
+        argil_err_t e = sparse_touch(&f->samp, key, &b);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    b->dirty = true;
+    for (int32_t z = 0, i = 0; z < n2; z++)
+        for (int32_t y = 0; y < n1; y++)
+            for (int32_t x = 0; x < n0; x++, i++) {
+                const size_t li = (size_t)(lo[0] - base[0] + x) +
+                                  SPARSE_B * ((size_t)(lo[1] - base[1] + y) + SPARSE_B * (size_t)(lo[2] - base[2] + z));
+                float *d = &b->data[FS_D * SPARSE_BN + li], *r = &b->data[FS_REST * SPARSE_BN + li];
+                if (memcmp(d, &dnew[i], sizeof(float)) == 0)
+                    continue;
+                const float rnew = *r + (dnew[i] - *d);
+                if (u != NULL) {
+                    const int32_t ijk[3] = {lo[0] + x, lo[1] + y, lo[2] + z};
+                    argil_err_t e = undo_note(u, UNDO_STORE_SAMP, FS_D, ijk, *d, dnew[i]);
+                    if (e == ARGIL_OK && memcmp(r, &rnew, sizeof(float)) != 0)
+                        e = undo_note(u, UNDO_STORE_SAMP, FS_REST, ijk, *r, rnew);
+                    if (e != ARGIL_OK)
+                        return e;
+                }
+                *d = dnew[i];
+                *r = rnew;
+                (*nchanged)++;
+            }
+    return ARGIL_OK;
+}
+
+/* Coefficient actions: new coefficients over [blo, bhi) from one read of the box (plus the ring
+ * the samples and the smoothing need), written back where they changed; then d = A p again only
+ * in the sample blocks a changed coefficient reaches (Hua & Qin eq. 5), the rest shape moved by
+ * the same Δd, and the changes noted for undo as they are made. */
+static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const tool_params_t *p,
+                                    const int32_t blo[3], const int32_t bhi[3], undo_t *u,
+                                    tool_stats_t *stats)
+{
+    const float bound = tool_bound_m(U->t);
+    const int32_t R = f->ratio;
+    int32_t slo[3], shi[3], clo[3], chi[3], cn[3], bn[3], klo[3], kn[3];
+    field_samples_of_coefs(f, blo, bhi, slo, shi);
+    field_coefs_of_samples(f, slo, shi, clo, chi);
+    size_t nc = 1, nk = 1;
+    for (int a = 0; a < 3; a++) {
+        bn[a] = bhi[a] - blo[a];
+        cn[a] = chi[a] - clo[a];
+        nc *= (size_t)cn[a];
+        klo[a] = sparse_block_of(slo[a]);
+        kn[a] = sparse_block_of(shi[a] - 1) - klo[a] + 1;
+        nk *= (size_t)kn[a];
+    }
+    argil_err_t e = ARGIL_OK;
+    if (u != NULL && (e = undo_begin(u, f, blo, blo, 0, slo, slo, 0)) != ARGIL_OK)
+        return e;
+    const size_t nb = (size_t)bn[0] * bn[1] * bn[2];
+    float *C = field_scratch(f, nc + (nk + 3) / 4 + 2 * nb); /* kept warm between edits */
+    if (C == NULL) {
+        e = ARGIL_ERR_NOMEM;
+        goto out;
+    }
+    uint8_t *mark = (uint8_t *)(C + nc);
+    uint32_t *ch_ci = (uint32_t *)(C + nc + (nk + 3) / 4); /* changed: index in C, new value */
+    float *ch_after = (float *)(ch_ci + nb);
+    size_t nch = 0;
+    memset(mark, 0, nk);
+    sparse_read_box(&f->coef, FC_P, clo, cn, C);
+    const size_t sy = (size_t)cn[0], sz = (size_t)cn[0] * cn[1];
+    for (int32_t z = 0; z < bn[2]; z++)
+        for (int32_t y = 0; y < bn[1]; y++) {
+            const size_t row = (size_t)(blo[0] - clo[0]) + sy * (size_t)(blo[1] - clo[1] + y) +
+                               sz * (size_t)(blo[2] - clo[2] + z);
+            for (int32_t x = 0; x < bn[0]; x++) {
+                const size_t ci = row + (size_t)x;
+                const float pold = C[ci];
+                if (tool_coef_fixed_point(p->action, pold))
+                    continue;
+                const int32_t c[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
+                const vec3_t xc = field_coef_pos(f, c);
+                const float sd = tool_union_sd(U, xc);
+                if (sd == -INFINITY)
+                    continue;
+                const float nb6[6] = {C[ci - 1], C[ci + 1], C[ci - sy], C[ci + sy], C[ci - sz], C[ci + sz]};
+                const float pnew = tool_action_coef(f, p, bound, pold, sd, xc, nb6);
+                if (pnew == pold)
+                    continue;
+                ch_ci[nch] = (uint32_t)ci;
+                ch_after[nch++] = pnew;
+                /* sample blocks this coefficient reaches: samples ((c-2)R, (c+2)R) per axis */
+                int32_t k0[3], k1[3];
+                for (int a = 0; a < 3; a++) {
+                    k0[a] = sparse_block_of((c[a] - 2) * R + 1) - klo[a];
+                    k1[a] = sparse_block_of((c[a] + 2) * R - 1) - klo[a];
+                    k0[a] = k0[a] < 0 ? 0 : k0[a];
+                    k1[a] = k1[a] >= kn[a] ? kn[a] - 1 : k1[a];
+                }
+                for (int32_t kz = k0[2]; kz <= k1[2]; kz++)
+                    for (int32_t ky = k0[1]; ky <= k1[1]; ky++)
+                        for (int32_t kx = k0[0]; kx <= k1[0]; kx++)
+                            mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)] = 1;
+            }
+        }
+    if (stats != NULL) {
+        stats->coefs_visited += nb;
+        stats->coefs_changed += nch;
+    }
+    /* write the changed coefficients (the lookup cached per block) and note them for undo */
+    sparse_block_t *cb = NULL;
+    for (size_t k = 0; k < nch && e == ARGIL_OK; k++) {
+        const size_t ci = ch_ci[k];
+        const float before = C[ci];
+        C[ci] = ch_after[k];
+        const int32_t c[3] = {clo[0] + (int32_t)(ci % sy), clo[1] + (int32_t)(ci / sy % (size_t)cn[1]),
+                              clo[2] + (int32_t)(ci / sz)};
+        const int32_t key[3] = {sparse_block_of(c[0]), sparse_block_of(c[1]), sparse_block_of(c[2])};
+        if (cb == NULL || memcmp(cb->key, key, sizeof(key)) != 0)
+            e = sparse_touch(&f->coef, key, &cb);
+        if (e != ARGIL_OK)
+            break;
+        cb->dirty = true;
+        cb->data[FC_P * SPARSE_BN + (c[0] - key[0] * SPARSE_B) +
+                 SPARSE_B * ((c[1] - key[1] * SPARSE_B) + SPARSE_B * (c[2] - key[2] * SPARSE_B))] = ch_after[k];
+        if (u != NULL)
+            e = undo_note(u, UNDO_STORE_COEF, FC_P, c, before, ch_after[k]);
+    }
+    /* d = A p in the reached sample blocks only */
+    size_t refreshed = 0, changed_samples = 0;
+    for (int32_t kz = 0; kz < kn[2] && e == ARGIL_OK; kz++)
+        for (int32_t ky = 0; ky < kn[1] && e == ARGIL_OK; ky++)
+            for (int32_t kx = 0; kx < kn[0] && e == ARGIL_OK; kx++) {
+                if (!mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)])
+                    continue;
+                const int32_t key[3] = {klo[0] + kx, klo[1] + ky, klo[2] + kz};
+                int32_t lo[3], hi[3];
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = key[a] * SPARSE_B > slo[a] ? key[a] * SPARSE_B : slo[a];
+                    hi[a] = (key[a] + 1) * SPARSE_B < shi[a] ? (key[a] + 1) * SPARSE_B : shi[a];
+                }
+                float dnew[SPARSE_BN], tmp[2 * SPARSE_B * (SPARSE_B + 3) * (SPARSE_B + 3)];
+                field_samples_from(f, C, clo, cn, lo, hi, dnew, tmp);
+                refreshed += (size_t)(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+                e = tool_store_samples(f, key, lo, hi, dnew, u, &changed_samples);
+            }
+    if (stats != NULL)
+        stats->samples_refreshed += refreshed;
+out:
+    if (u != NULL) { /* whatever was done, even partly, is one undo step */
+        const argil_err_t ec = undo_commit(u, f);
+        if (e == ARGIL_OK)
+            e = ec;
+    }
+    return e;
+}
+
 static argil_err_t tool_apply_union(field_t *f, const tool_union_t *U, const tool_params_t *p,
                                     undo_t *u, tool_stats_t *stats)
 {
-    const float bound = tool_bound_m(U->t);
     vec3_t lo = U->poses[0].pos_m, hi = lo;
     for (size_t i = 1; i < U->n; i++) {
         const vec3_t q = U->poses[i].pos_m;
@@ -315,71 +509,7 @@ static argil_err_t tool_apply_union(field_t *f, const tool_union_t *U, const too
             stats->samples_refreshed += n;
         return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
     }
-    /* coefficients: read with one extra ring (smoothing neighbours) */
-    int32_t rlo[3], rn[3], slo[3], shi[3], sn[3];
-    for (int a = 0; a < 3; a++) {
-        rlo[a] = blo[a] - 1;
-        rn[a] = bn[a] + 2;
-    }
-    field_samples_of_coefs(f, blo, bhi, slo, shi);
-    size_t ns = 1;
-    for (int a = 0; a < 3; a++) {
-        sn[a] = shi[a] - slo[a];
-        ns *= (size_t)sn[a];
-    }
-    if (u != NULL && (e = undo_begin(u, f, blo, bhi, 1u << FC_P, slo, shi,
-                                      (1u << FS_D) | (1u << FS_REST))) != ARGIL_OK)
-        return e;
-    const size_t nr = (size_t)rn[0] * rn[1] * rn[2], nb = (size_t)bn[0] * bn[1] * bn[2];
-    float *P = malloc(sizeof(float) * (nr + nb + 3 * ns));
-    if (P == NULL)
-        return ARGIL_ERR_NOMEM;
-    float *Pn = P + nr, *d0 = Pn + nb, *d1 = d0 + ns, *rest = d1 + ns;
-    sparse_read_box(&f->coef, FC_P, rlo, rn, P);
-    size_t changed = 0, i = 0;
-    const size_t sy = (size_t)rn[0], sz = (size_t)rn[0] * rn[1];
-    for (int32_t z = 0; z < bn[2]; z++)
-        for (int32_t y = 0; y < bn[1]; y++)
-            for (int32_t x = 0; x < bn[0]; x++, i++) {
-                const size_t ri = (size_t)(x + 1) + sy * (size_t)(y + 1) + sz * (size_t)(z + 1);
-                const float pold = P[ri];
-                const int32_t c[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
-                const vec3_t xc = field_coef_pos(f, c);
-                const float sd = tool_union_sd(U, xc);
-                if (sd == -INFINITY) {
-                    Pn[i] = pold;
-                    continue;
-                }
-                const float nb6[6] = {P[ri - 1], P[ri + 1], P[ri - sy], P[ri + sy], P[ri - sz], P[ri + sz]};
-                Pn[i] = tool_action_coef(f, p, bound, pold, sd, xc, nb6);
-                changed += Pn[i] != pold;
-            }
-    if (stats != NULL) {
-        stats->coefs_visited += nb;
-        stats->coefs_changed += changed;
-        stats->samples_refreshed += ns;
-    }
-    if (changed == 0) {
-        free(P);
-        return u != NULL ? undo_commit(u, f) : ARGIL_OK;
-    }
-    e = sparse_write_box(&f->coef, FC_P, blo, bn, Pn);
-    /* samples: d = A p again; the rest shape moves by the same edit (a plastic change) */
-    if (e == ARGIL_OK) {
-        sparse_read_box(&f->samp, FS_D, slo, sn, d0);
-        e = field_refresh(f, slo, shi);
-    }
-    if (e == ARGIL_OK) {
-        sparse_read_box(&f->samp, FS_D, slo, sn, d1);
-        sparse_read_box(&f->samp, FS_REST, slo, sn, rest);
-        for (size_t k = 0; k < ns; k++)
-            rest[k] += d1[k] - d0[k];
-        e = sparse_write_box(&f->samp, FS_REST, slo, sn, rest);
-    }
-    free(P);
-    if (e == ARGIL_OK && u != NULL)
-        e = undo_commit(u, f);
-    return e;
+    return tool_apply_coefs(f, U, p, blo, bhi, u, stats);
 }
 
 /* Reach of the tool's influence beyond its origin for this action. */

@@ -23,6 +23,7 @@ void undo_free(undo_t *u)
         undo_drop_step(&u->steps[i]);
     free(u->steps);
     free(u->snap);
+    free(u->pend);
     memset(u, 0, sizeof(*u));
 }
 
@@ -75,8 +76,37 @@ argil_err_t undo_begin(undo_t *u, const field_t *f, const int32_t clo[3], const 
             sparse_read_box(&f->samp, c, slo, u->sdims, dst);
             dst += ns;
         }
+    u->npend = 0;
     u->open = true;
     return ARGIL_OK;
+}
+
+/* Appends one entry to a growing array. */
+static argil_err_t undo_push(undo_entry_t **e, size_t *n, size_t *cap, int store, int ch,
+                             const int32_t ijk[3], float before, float after)
+{
+    if (*n == *cap) {
+        const size_t nc = *cap ? 2 * *cap : 256;
+        undo_entry_t *p = realloc(*e, nc * sizeof(undo_entry_t));
+        if (p == NULL)
+            return ARGIL_ERR_NOMEM;
+        *e = p;
+        *cap = nc;
+    }
+    undo_entry_t *en = &(*e)[(*n)++];
+    en->store = (uint8_t)store;
+    en->ch = (uint8_t)ch;
+    memcpy(en->ijk, ijk, sizeof(en->ijk));
+    en->before = before;
+    en->after = after;
+    return ARGIL_OK;
+}
+
+argil_err_t undo_note(undo_t *u, int store, int ch, const int32_t ijk[3], float before, float after)
+{
+    if (!u->open)
+        return ARGIL_ERR_STATE;
+    return undo_push(&u->pend, &u->npend, &u->pend_cap, store, ch, ijk, before, after);
 }
 
 /* Appends the entries of one channel box whose value changed; grows *e as needed. */
@@ -98,24 +128,11 @@ static argil_err_t undo_diff(const sparse_t *s, int store, int ch, const int32_t
             for (int32_t x = 0; x < dims[0]; x++) {
                 if (memcmp(&b[x], &now[x], sizeof(float)) == 0)
                     continue;
-                if (*n == *cap) {
-                    const size_t nc = *cap ? 2 * *cap : 256;
-                    undo_entry_t *p = realloc(*e, nc * sizeof(undo_entry_t));
-                    if (p == NULL) {
-                        free(now);
-                        return ARGIL_ERR_NOMEM;
-                    }
-                    *e = p;
-                    *cap = nc;
+                const int32_t ijk[3] = {lo[0] + x, lo[1] + y, lo[2] + z};
+                if (undo_push(e, n, cap, store, ch, ijk, b[x], now[x]) != ARGIL_OK) {
+                    free(now);
+                    return ARGIL_ERR_NOMEM;
                 }
-                undo_entry_t *en = &(*e)[(*n)++];
-                en->store = (uint8_t)store;
-                en->ch = (uint8_t)ch;
-                en->ijk[0] = lo[0] + x;
-                en->ijk[1] = lo[1] + y;
-                en->ijk[2] = lo[2] + z;
-                en->before = b[x];
-                en->after = now[x];
             }
         }
     free(now);
@@ -127,8 +144,8 @@ argil_err_t undo_commit(undo_t *u, const field_t *f)
     if (!u->open)
         return ARGIL_ERR_STATE;
     u->open = false;
-    undo_entry_t *e = NULL;
-    size_t n = 0, cap = 0;
+    undo_entry_t *e = u->pend; /* the noted entries first, then the snapshot diffs */
+    size_t n = u->npend, cap = u->pend_cap;
     const size_t nc = (size_t)u->cdims[0] * u->cdims[1] * u->cdims[2];
     const size_t ns = (size_t)u->sdims[0] * u->sdims[1] * u->sdims[2];
     const float *src = u->snap;
@@ -143,10 +160,15 @@ argil_err_t undo_commit(undo_t *u, const field_t *f)
             err = undo_diff(&f->samp, UNDO_STORE_SAMP, c, u->slo, u->sdims, src, &e, &n, &cap);
             src += ns;
         }
-    if (err != ARGIL_OK || n == 0) {
-        free(e);
+    u->pend = e; /* the working buffer stays warm for the next step */
+    u->pend_cap = cap;
+    u->npend = 0;
+    if (err != ARGIL_OK || n == 0)
         return err;
-    }
+    e = malloc(n * sizeof(undo_entry_t)); /* the step holds exactly its entries */
+    if (e == NULL)
+        return ARGIL_ERR_NOMEM;
+    memcpy(e, u->pend, n * sizeof(undo_entry_t));
     for (size_t i = u->done; i < u->nsteps; i++) { /* a new edit clears the redo steps */
         u->bytes -= u->steps[i].n * sizeof(undo_entry_t);
         undo_drop_step(&u->steps[i]);

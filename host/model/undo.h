@@ -36,6 +36,8 @@ typedef struct {
     uint32_t cmask, smask;    /* channels snapshotted */
     float *snap;
     size_t snap_cap;
+    undo_entry_t *pend;       /* entries noted by the editor during the open step */
+    size_t npend, pend_cap;
 } undo_t;
 
 void undo_init(undo_t *u, size_t budget_bytes);
@@ -45,6 +47,11 @@ void undo_free(undo_t *u);
  * before an edit. ARGIL_ERR_STATE when a step is already open, ARGIL_ERR_ARG, ARGIL_ERR_NOMEM. */
 argil_err_t undo_begin(undo_t *u, const field_t *f, const int32_t clo[3], const int32_t chi[3],
                        uint32_t cmask, const int32_t slo[3], const int32_t shi[3], uint32_t smask);
+
+/* Adds one change the editor made itself (instead of a snapshotted box) to the open step; each
+ * point must be noted at most once per step and not also lie in a snapshotted channel.
+ * ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
+argil_err_t undo_note(undo_t *u, int store, int ch, const int32_t ijk[3], float before, float after);
 
 /* Records what changed since undo_begin as one step (none when nothing changed), drops the redo
  * steps, then the oldest steps while over budget. ARGIL_ERR_STATE without undo_begin. */
