@@ -171,7 +171,7 @@ bench: all
 A64 := $(BUILD)/aarch64
 A64_CC := aarch64-linux-gnu-gcc
 A64_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
-A64_UNIT := $(filter $(UNIT_TESTS),test_safety test_safety_transitions test_drives test_canopen test_spsc_ring test_rt_stats test_window test_arm_kin)
+A64_UNIT := $(filter $(UNIT_TESTS),test_safety test_safety_table test_safety_transitions test_drives test_canopen test_spsc_ring test_rt_stats test_window test_arm_kin)
 A64_SIL := $(filter $(SIL_TESTS),test_board_sim)
 CM := $(BUILD)/cortexm
 CM_CC := arm-none-eabi-gcc

@@ -77,7 +77,8 @@ float safety_process(safety_t *s, const safety_cfg_t *cfg, const safety_inputs_t
         enter(s, SAFETY_IDLE, FAULT_NONE);
         break;
     case SAFETY_IDLE:
-        if (in->arm_request && f == FAULT_NONE)
+        /* ARM is the host's command: only from a live host, never with a fault cause present. */
+        if (in->arm_request && f == FAULT_NONE && host_fresh)
             enter(s, SAFETY_ARMED, FAULT_NONE);
         break;
     case SAFETY_ARMED:
@@ -102,6 +103,12 @@ float safety_process(safety_t *s, const safety_cfg_t *cfg, const safety_inputs_t
         break;
     case SAFETY_FAULT:
     case SAFETY_ESTOP:
+        /* A hard fault while the force still fades after host loss: torque off now, and that
+         * fault becomes the recorded cause. */
+        if (s->state == SAFETY_FAULT && s->fade > 0.0f && f != FAULT_NONE) {
+            s->fault = f;
+            s->fade = 0.0f;
+        }
         /* Latched: leave only on the host's re-arm with every cause gone. */
         if (in->arm_request && f == FAULT_NONE && host_fresh) {
             enter(s, SAFETY_ARMED, FAULT_NONE);
