@@ -7,5 +7,7 @@ int cmd_sculpt(int argc, char **argv);
 int cmd_mesh(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_fit(int argc, char **argv);
+int cmd_view(int argc, char **argv);
+int cmd_plot(int argc, char **argv);
 
 #endif

@@ -29,6 +29,8 @@ static const struct {
     {"fit", cmd_fit, "fit a point cloud, mesh or volume into a model (see 'argil fit --help')"},
     {"mesh", cmd_mesh, "write a model's surface as PLY, STL or OBJ (see 'argil mesh --help')"},
     {"info", cmd_info, "describe a model, mesh, point cloud or volume file"},
+    {"plot", cmd_plot, "draw a session's telemetry.csv as a PNG chart (see 'argil plot --help')"},
+    {"view", cmd_view, "render a mesh to a PNG or show it in a window (see 'argil view --help')"},
 };
 
 static void usage_main(FILE *f)
@@ -45,7 +47,7 @@ static void usage_sculpt(FILE *f)
 {
     fprintf(f,
             "usage: argil sculpt [--device sim] [--script FILE] [--out DIR] [--window N]\n"
-            "                    [--quiet] [--no-deadline-fault]\n"
+            "                    [--quiet] [--no-deadline-fault] [--screenshot FILE.png]\n"
             "\n"
             "Runs a sculpting session. With --device sim (the default) the arm, its drives and\n"
             "the hand holding the stylus are simulated in lockstep on a virtual clock, so the\n"
@@ -61,6 +63,9 @@ static void usage_sculpt(FILE *f)
             "  --window N      edge of the board's local density window in samples, 4..32\n"
             "                  (default 16)\n"
             "  --quiet         no progress line and no summary\n"
+            "  --screenshot FILE.png\n"
+            "                  afterwards, render the final clay with the tool where it ended\n"
+            "                  (as 'argil view DIR/final.ply --telemetry DIR/telemetry.csv')\n"
             "  --no-deadline-fault\n"
             "                  count deadline misses but do not fault on a streak of them\n"
             "                  (for profiling under valgrind, where every tick overruns)\n"
@@ -72,6 +77,7 @@ int cmd_sculpt(int argc, char **argv)
     session_opts_t o;
     session_opts_default(&o);
     int quiet = 0;
+    const char *screenshot = NULL;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -83,7 +89,8 @@ int cmd_sculpt(int argc, char **argv)
         } else if (strcmp(a, "--no-deadline-fault") == 0) {
             o.deadline_faults = false;
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--script") == 0 ||
-                   strcmp(a, "--out") == 0 || strcmp(a, "--window") == 0) {
+                   strcmp(a, "--out") == 0 || strcmp(a, "--window") == 0 ||
+                   strcmp(a, "--screenshot") == 0) {
             if (!v) {
                 fprintf(stderr, "argil sculpt: %s needs a value (see --help)\n", a);
                 return 2;
@@ -101,6 +108,8 @@ int cmd_sculpt(int argc, char **argv)
                 o.script_path = v;
             } else if (strcmp(a, "--out") == 0) {
                 o.out_dir = v;
+            } else if (strcmp(a, "--screenshot") == 0) {
+                screenshot = v;
             } else {
                 char *end;
                 const long n = strtol(v, &end, 10);
@@ -152,6 +161,14 @@ int cmd_sculpt(int argc, char **argv)
     if (rc != ARGIL_OK) {
         fprintf(stderr, "argil sculpt: %s\n", err);
         return 1;
+    }
+    if (screenshot != NULL && o.out_dir != NULL && s.triangles > 0) {
+        char ply[4096], csv[4096];
+        snprintf(ply, sizeof(ply), "%s/final.ply", o.out_dir);
+        snprintf(csv, sizeof(csv), "%s/telemetry.csv", o.out_dir);
+        char *view_argv[] = {ply, "--screenshot", (char *)screenshot, "--telemetry", csv};
+        if (cmd_view(5, view_argv) != 0)
+            return 1;
     }
     return s.interrupted ? 130 : 0;
 }

@@ -1,0 +1,365 @@
+/* argil view: renders a mesh (a session's final.ply, or any mesh file) to a PNG, or shows it in
+ * a window with a virtual-trackball camera; optionally with the tool, its force and the board's
+ * window box. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/app/commands.h"
+#include "host/io/mesh_import.h"
+#include "host/render/camera.h"
+#include "host/render/offscreen.h"
+#include "host/render/png_write.h"
+#include "host/render/telemetry_log.h"
+
+static void usage_view(FILE *f)
+{
+    fprintf(f,
+            "usage: argil view MODEL [--screenshot FILE.png] [--width W] [--height H]\n"
+            "                  [--mode plain|clearcoat] [--backend auto|egl|glfw]\n"
+            "                  [--telemetry FILE.csv] [--tool X Y Z R] [--force FX FY FZ]\n"
+            "                  [--box X0 Y0 Z0 X1 Y1 Z1] [--key X Y Z] [--fill X Y Z]\n"
+            "                  [--yaw DEG] [--pitch DEG]\n"
+            "\n"
+            "Draws MODEL (a mesh: .ply .stl .obj, e.g. a session's out/final.ply) lit by a key\n"
+            "and a fill light. With --screenshot it renders one frame offscreen (a hidden GLFW\n"
+            "window when DISPLAY is set, else EGL surfaceless) and writes a PNG; without it, it\n"
+            "opens a window: drag with the left button to turn the model, wheel to zoom, Esc\n"
+            "to quit.\n"
+            "\n"
+            "options:\n"
+            "  --screenshot FILE  write one frame to FILE (PNG) and exit\n"
+            "  --width W, --height H  image or window size in pixels (default 1024 x 768)\n"
+            "  --mode M           plain (Blinn-Phong) or clearcoat (glossy lacquer reflecting\n"
+            "                     an analytic studio); default plain\n"
+            "  --backend B        auto (default), egl (offscreen, no display needed) or glfw\n"
+            "  --telemetry FILE   a session's telemetry.csv: the tool is drawn where its last row\n"
+            "                     puts it, with the force of that row\n"
+            "  --tool X Y Z R     draw the tool sphere at (X, Y, Z) mm with radius R mm\n"
+            "                     (default radius with --telemetry: 4 mm)\n"
+            "  --force FX FY FZ   draw the force on the tool, N (10 mm per N)\n"
+            "  --box X0 Y0 Z0 X1 Y1 Z1  draw the board's local window, corners in mm\n"
+            "  --key X Y Z, --fill X Y Z  directions toward the key and fill lights in view\n"
+            "                     space (+x right, +y up, +z toward you)\n"
+            "  --yaw DEG, --pitch DEG  turn the model before the first frame\n"
+            "  -h, --help         this text\n");
+}
+
+/* Parses n floats from argv[*i + 1 …]; 0 on success (advancing *i), else prints and returns 2. */
+static int take_floats(int argc, char **argv, int *i, int n, float *out)
+{
+    const char *opt = argv[*i];
+    if (*i + n >= argc) {
+        fprintf(stderr, "argil view: %s needs %d number%s (see --help)\n", opt, n,
+                n > 1 ? "s" : "");
+        return 2;
+    }
+    for (int k = 0; k < n; k++) {
+        const char *s = argv[*i + 1 + k];
+        char *end;
+        const double d = strtod(s, &end);
+        if (end == s || *end != '\0' || !isfinite(d) || fabs(d) > 1e6) {
+            fprintf(stderr, "argil view: %s: '%s' is not a number (within ±1e6)\n", opt, s);
+            return 2;
+        }
+        out[k] = (float)d;
+    }
+    *i += n;
+    return 0;
+}
+
+static int take_int(int argc, char **argv, int *i, int lo, int hi, int *out)
+{
+    const char *opt = argv[*i];
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "argil view: %s needs a value (see --help)\n", opt);
+        return 2;
+    }
+    const char *s = argv[++*i];
+    char *end;
+    const long v = strtol(s, &end, 10);
+    if (end == s || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "argil view: %s must be a whole number %d..%d, got '%s'\n", opt, lo, hi,
+                s);
+        return 2;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+/* Area-weighted vertex normals for meshes read without any. */
+static void normals_from_faces(mesh_t *m)
+{
+    memset(m->normal, 0, sizeof(float) * 3 * m->n_vert);
+    for (size_t t = 0; t < m->n_tri; t++) {
+        const uint32_t *ix = m->tri + 3 * t;
+        const float *a = m->pos + 3 * ix[0], *b = m->pos + 3 * ix[1], *c = m->pos + 3 * ix[2];
+        const vec3_t n = vec3_cross(vec3(b[0] - a[0], b[1] - a[1], b[2] - a[2]),
+                                    vec3(c[0] - a[0], c[1] - a[1], c[2] - a[2]));
+        for (int k = 0; k < 3; k++) {
+            float *d = m->normal + 3 * ix[k];
+            d[0] += n.x;
+            d[1] += n.y;
+            d[2] += n.z;
+        }
+    }
+    for (size_t v = 0; v < m->n_vert; v++) {
+        float *d = m->normal + 3 * v;
+        const float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (len > 0.0f) {
+            d[0] /= len;
+            d[1] /= len;
+            d[2] /= len;
+        }
+    }
+}
+
+/* The box around the mesh, grown to hold the tool and the force's tip when they are shown. */
+static void scene_bounds(const mesh_t *m, const render_scene_t *s, vec3_t *lo, vec3_t *hi)
+{
+    *lo = vec3(INFINITY, INFINITY, INFINITY);
+    *hi = vec3(-INFINITY, -INFINITY, -INFINITY);
+    for (size_t v = 0; v < m->n_vert; v++) {
+        const float *p = m->pos + 3 * v;
+        *lo = vec3(fminf(lo->x, p[0]), fminf(lo->y, p[1]), fminf(lo->z, p[2]));
+        *hi = vec3(fmaxf(hi->x, p[0]), fmaxf(hi->y, p[1]), fmaxf(hi->z, p[2]));
+    }
+    if (s->show_tool) {
+        const vec3_t r = vec3(s->tool_radius_m, s->tool_radius_m, s->tool_radius_m);
+        const vec3_t a = vec3_sub(s->tool_pos_m, r), b = vec3_add(s->tool_pos_m, r);
+        *lo = vec3(fminf(lo->x, a.x), fminf(lo->y, a.y), fminf(lo->z, a.z));
+        *hi = vec3(fmaxf(hi->x, b.x), fmaxf(hi->y, b.y), fmaxf(hi->z, b.z));
+    }
+    if (s->show_box) {
+        *lo = vec3(fminf(lo->x, s->box_lo_m.x), fminf(lo->y, s->box_lo_m.y),
+                   fminf(lo->z, s->box_lo_m.z));
+        *hi = vec3(fmaxf(hi->x, s->box_hi_m.x), fmaxf(hi->y, s->box_hi_m.y),
+                   fmaxf(hi->z, s->box_hi_m.z));
+    }
+}
+
+static int run_screenshot(const mesh_t *m, render_scene_t *s, camera_t *cam,
+                          render_backend_t backend, int w, int h, const char *png)
+{
+    char err[512] = "";
+    offscreen_t *o = calloc(1, sizeof(*o));
+    uint8_t *rgb = malloc((size_t)w * (size_t)h * 3);
+    if (o == NULL || rgb == NULL) {
+        free(o);
+        free(rgb);
+        fprintf(stderr, "argil view: out of memory for a %d x %d image\n", w, h);
+        return 1;
+    }
+    int status = 1;
+    if (offscreen_open(o, backend, w, h, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil view: %s\n", err);
+    } else if (renderer_set_mesh(&o->renderer, m) != ARGIL_OK) {
+        fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
+    } else {
+        camera_matrices(cam, (float)w / (float)h, s->view, s->proj);
+        offscreen_render(o, s, rgb);
+        if (png_write_rgb(png, w, h, rgb, err, sizeof(err)) != ARGIL_OK)
+            fprintf(stderr, "argil view: %s\n", err);
+        else
+            status = 0;
+    }
+    offscreen_close(o);
+    free(o);
+    free(rgb);
+    return status;
+}
+
+static int run_window(const mesh_t *m, render_scene_t *s, camera_t *cam, int w, int h,
+                      const char *title)
+{
+    char err[512] = "";
+    glfw_window_t win;
+    gl_api_t gl;
+    renderer_t r;
+    if (glfw_window_open(&win, w, h, true, 4, title, &gl, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil view: %s (use --screenshot FILE.png without a display)\n", err);
+        return 1;
+    }
+    if (renderer_init(&r, &gl, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil view: %s\n", err);
+        glfw_window_close(&win);
+        return 1;
+    }
+    if (renderer_set_mesh(&r, m) != ARGIL_OK) {
+        fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
+        renderer_free(&r);
+        glfw_window_close(&win);
+        return 1;
+    }
+    gl.Enable(GL_MULTISAMPLE);
+    glfw_input_t in, prev = {0};
+    while (!glfw_window_should_close(&win)) {
+        glfw_window_poll(&win, &in);
+        if (in.escape)
+            break;
+        int fw = 0, fh = 0;
+        glfw_window_size(&win, &fw, &fh);
+        if (in.left_down && prev.left_down)
+            camera_arcball(cam, prev.cursor_x, prev.cursor_y, in.cursor_x, in.cursor_y, fw, fh);
+        camera_zoom(cam, glfw_window_take_scroll(&win));
+        prev = in;
+        if (fw > 0 && fh > 0) {
+            camera_matrices(cam, (float)fw / (float)fh, s->view, s->proj);
+            renderer_draw(&r, s, fw, fh);
+        }
+        glfw_window_swap(&win);
+    }
+    renderer_free(&r);
+    glfw_window_close(&win);
+    return 0;
+}
+
+int cmd_view(int argc, char **argv)
+{
+    const char *model = NULL, *png = NULL, *csv = NULL;
+    int w = 1024, h = 768;
+    render_backend_t backend = RENDER_BACKEND_AUTO;
+    render_scene_t s;
+    render_scene_default(&s);
+    float tool[4] = {0}, force[3] = {0}, box[6] = {0}, yaw = 0.0f, pitch = 0.0f;
+    int have_tool = 0, have_force = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int rc = 0;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage_view(stdout);
+            return 0;
+        } else if (strcmp(a, "--screenshot") == 0 || strcmp(a, "--mode") == 0 ||
+                   strcmp(a, "--backend") == 0 || strcmp(a, "--telemetry") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "argil view: %s needs a value (see --help)\n", a);
+                return 2;
+            }
+            const char *v = argv[++i];
+            if (strcmp(a, "--screenshot") == 0) {
+                png = v;
+            } else if (strcmp(a, "--telemetry") == 0) {
+                csv = v;
+            } else if (strcmp(a, "--mode") == 0) {
+                if (strcmp(v, "plain") == 0)
+                    s.mode = RENDER_MODE_PLAIN;
+                else if (strcmp(v, "clearcoat") == 0)
+                    s.mode = RENDER_MODE_CLEARCOAT;
+                else {
+                    fprintf(stderr, "argil view: unknown mode '%s' (plain, clearcoat)\n", v);
+                    return 2;
+                }
+            } else {
+                if (strcmp(v, "auto") == 0)
+                    backend = RENDER_BACKEND_AUTO;
+                else if (strcmp(v, "egl") == 0)
+                    backend = RENDER_BACKEND_EGL;
+                else if (strcmp(v, "glfw") == 0)
+                    backend = RENDER_BACKEND_GLFW;
+                else {
+                    fprintf(stderr, "argil view: unknown backend '%s' (auto, egl, glfw)\n", v);
+                    return 2;
+                }
+            }
+        } else if (strcmp(a, "--width") == 0) {
+            rc = take_int(argc, argv, &i, 16, 8192, &w);
+        } else if (strcmp(a, "--height") == 0) {
+            rc = take_int(argc, argv, &i, 16, 8192, &h);
+        } else if (strcmp(a, "--tool") == 0) {
+            rc = take_floats(argc, argv, &i, 4, tool);
+            have_tool = 1;
+            if (rc == 0 && !(tool[3] > 0.0f)) {
+                fprintf(stderr, "argil view: --tool radius must be > 0 mm\n");
+                return 2;
+            }
+        } else if (strcmp(a, "--force") == 0) {
+            rc = take_floats(argc, argv, &i, 3, force);
+            have_force = 1;
+        } else if (strcmp(a, "--box") == 0) {
+            rc = take_floats(argc, argv, &i, 6, box);
+            s.show_box = true;
+        } else if (strcmp(a, "--key") == 0 || strcmp(a, "--fill") == 0) {
+            float d[3];
+            rc = take_floats(argc, argv, &i, 3, d);
+            if (rc == 0 && vec3_norm(vec3(d[0], d[1], d[2])) < 1e-6f) {
+                fprintf(stderr, "argil view: %s needs a non-zero direction\n", a);
+                return 2;
+            }
+            if (a[2] == 'k')
+                s.key.dir = vec3(d[0], d[1], d[2]);
+            else
+                s.fill.dir = vec3(d[0], d[1], d[2]);
+        } else if (strcmp(a, "--yaw") == 0) {
+            rc = take_floats(argc, argv, &i, 1, &yaw);
+        } else if (strcmp(a, "--pitch") == 0) {
+            rc = take_floats(argc, argv, &i, 1, &pitch);
+        } else if (a[0] == '-' && a[1] != '\0') {
+            fprintf(stderr, "argil view: unknown option '%s' (see --help)\n", a);
+            return 2;
+        } else if (model == NULL) {
+            model = a;
+        } else {
+            fprintf(stderr, "argil view: one model at a time ('%s' and '%s')\n", model, a);
+            return 2;
+        }
+        if (rc != 0)
+            return rc;
+    }
+    if (model == NULL) {
+        usage_view(stderr);
+        return 2;
+    }
+    char err[1024] = "";
+    if (csv != NULL) {
+        telemetry_log_t log;
+        if (telemetry_log_read(csv, &log, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil view: %s\n", err);
+            return 1;
+        }
+        const size_t last = log.n - 1;
+        if (!have_tool) {
+            memcpy(tool, log.pos_mm + 3 * last, 3 * sizeof(float));
+            tool[3] = 4.0f;
+            have_tool = 1;
+        }
+        if (!have_force) {
+            memcpy(force, log.force_n + 3 * last, 3 * sizeof(float));
+            have_force = 1;
+        }
+        telemetry_log_free(&log);
+    }
+    s.show_tool = have_tool;
+    s.tool_pos_m = vec3(tool[0] * 1e-3f, tool[1] * 1e-3f, tool[2] * 1e-3f);
+    s.tool_radius_m = tool[3] * 1e-3f;
+    s.show_force = have_force;
+    s.force_n = vec3(force[0], force[1], force[2]);
+    s.box_lo_m = vec3(fminf(box[0], box[3]) * 1e-3f, fminf(box[1], box[4]) * 1e-3f,
+                      fminf(box[2], box[5]) * 1e-3f);
+    s.box_hi_m = vec3(fmaxf(box[0], box[3]) * 1e-3f, fmaxf(box[1], box[4]) * 1e-3f,
+                      fmaxf(box[2], box[5]) * 1e-3f);
+
+    mesh_t m;
+    mesh_init(&m);
+    bool has_normals = false;
+    if (mesh_import(model, &m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil view: %s\n", err);
+        return 1;
+    }
+    if (m.n_tri == 0) {
+        fprintf(stderr, "argil view: %s: no triangles to draw (a point cloud?)\n", model);
+        mesh_free(&m);
+        return 1;
+    }
+    if (!has_normals)
+        normals_from_faces(&m);
+    vec3_t lo, hi;
+    scene_bounds(&m, &s, &lo, &hi);
+    camera_t cam;
+    camera_frame(&cam, lo, hi);
+    camera_orbit(&cam, yaw * (float)M_PI / 180.0f, pitch * (float)M_PI / 180.0f);
+    const int status = png ? run_screenshot(&m, &s, &cam, backend, w, h, png)
+                           : run_window(&m, &s, &cam, w, h, model);
+    mesh_free(&m);
+    return status;
+}

@@ -1,0 +1,49 @@
+/* A GLFW window with an OpenGL 3.3 core context (a real X display or Xvfb). libglfw is opened
+ * at run time, so nothing links to it; the window may be hidden for screenshots. */
+#ifndef ARGIL_BACKEND_GLFW_H
+#define ARGIL_BACKEND_GLFW_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "host/render/gl_api.h"
+#include "shared/argil_err.h"
+
+typedef struct {
+    void *lib;          /* dlopen handle of libglfw.so.3 */
+    void *window;       /* GLFWwindow */
+    void *fns;          /* the GLFW entry points (backend-private) */
+    double scroll_y;    /* wheel steps accumulated since the last glfw_window_take_scroll */
+} glfw_window_t;
+
+typedef struct {
+    bool left_down;     /* left mouse button held */
+    double cursor_x, cursor_y;  /* pixels from the top-left corner */
+    bool escape;        /* Esc pressed */
+} glfw_input_t;
+
+/* Opens a width × height window (hidden when !visible) with a current GL 3.3 core context,
+ * samples-× multisampling asked for (0: none), and loads gl. ARGIL_ERR_STATE with a one-line
+ * reason (no libglfw, no display, no 3.3 context). */
+argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visible, int samples,
+                             const char *title, gl_api_t *gl, char *err, size_t err_len);
+
+/* Processes pending events and returns the mouse and keyboard state. */
+void glfw_window_poll(glfw_window_t *w, glfw_input_t *in);
+
+/* Returns the wheel steps since the last call (positive: away from the person). */
+double glfw_window_take_scroll(glfw_window_t *w);
+
+/* True once the person closed the window. */
+bool glfw_window_should_close(const glfw_window_t *w);
+
+/* The framebuffer's size in pixels. */
+void glfw_window_size(const glfw_window_t *w, int *width, int *height);
+
+/* Shows the frame just drawn into the default framebuffer. */
+void glfw_window_swap(glfw_window_t *w);
+
+/* Destroys the window and terminates GLFW; safe on a zeroed or failed w. */
+void glfw_window_close(glfw_window_t *w);
+
+#endif

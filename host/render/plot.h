@@ -1,0 +1,17 @@
+/* Draws a session's telemetry as a chart: force magnitude, tool height z and the board's state
+ * over time, in three stacked panels sharing the time axis, with ticks and labels. */
+#ifndef ARGIL_PLOT_H
+#define ARGIL_PLOT_H
+
+#include "host/render/raster.h"
+#include "host/render/telemetry_log.h"
+#include "shared/argil_err.h"
+
+/* Draws log into c (at least 320 × 240; ARGIL_ERR_ARG otherwise or for an empty log) under
+ * title (may be NULL). */
+argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *title);
+
+/* A step of 1, 2 or 5 × 10^k giving about `count` intervals over span (> 0). */
+double plot_nice_step(double span, int count);
+
+#endif

@@ -1,0 +1,103 @@
+#!/bin/sh
+# argil view and argil plot on a real session's output: PNGs of the asked size that are not
+# blank, offscreen (EGL, no display) and, when Xvfb is installed, through a hidden GLFW window;
+# clear one-line errors for a malformed log. The GL runs use the release build: Mesa's JIT
+# leaves allocations LeakSanitizer cannot attribute (tests/unit/test_render.c covers the
+# renderer under ASan with leak checks paused around the context).
+set -eu
+rel="$REL/argil"
+san="$SAN/argil"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+py=/usr/bin/python3
+
+# Prints "W H DISTINCT_COLOURS SHARE_NOT_BACKGROUND" for an 8-bit RGB PNG (stdlib only).
+png_stats() {
+    "$py" - "$@" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+pos, idat, w = 8, b'', 0
+while pos < len(data):
+    n, kind = struct.unpack('>I4s', data[pos:pos + 8])
+    body = data[pos + 8:pos + 8 + n]
+    if kind == b'IHDR':
+        w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
+        assert depth == 8 and ctype == 2, 'not 8-bit RGB'
+    elif kind == b'IDAT':
+        idat += body
+    pos += 12 + n
+if len(sys.argv) > 2:  # header only
+    print(w, h, 0, 0)
+    sys.exit(0)
+raw = zlib.decompress(idat)
+stride, prev, rows = w * 3, bytearray(w * 3), []
+for y in range(h):
+    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+    for i in range(stride):
+        a = line[i - 3] if i >= 3 else 0
+        b = prev[i]
+        c = prev[i - 3] if i >= 3 else 0
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + b) & 255
+        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c
+            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    rows.append(bytes(line))
+    prev = line
+px = [r[i:i + 3] for r in rows for i in range(0, stride, 3)]
+bg = px[0]
+print(w, h, len(set(px)), round(sum(p != bg for p in px) / len(px), 3))
+PY
+}
+
+"$rel" sculpt --device sim --script scripts/default.scn --out "$tmp/out" --quiet \
+    --screenshot "$tmp/sculpt.png" || fail "sculpt --screenshot failed"
+
+# Offscreen (no display): plain and clear-coat.
+for mode in plain clearcoat; do
+    env -u DISPLAY "$rel" view "$tmp/out/final.ply" --screenshot "$tmp/$mode.png" --width 320 \
+        --height 240 --mode "$mode" --telemetry "$tmp/out/telemetry.csv" ||
+        fail "view --mode $mode failed"
+    set -- $(png_stats "$tmp/$mode.png")
+    echo "view $mode: $1 x $2, $3 colours, $4 of the frame not background"
+    [ "$1" = 320 ] && [ "$2" = 240 ] || fail "$mode.png is $1 x $2, not 320 x 240"
+    [ "$3" -gt 200 ] || fail "$mode.png has only $3 colours (blank?)"
+    awk -v s="$4" 'BEGIN { exit !(s > 0.03 && s < 0.9) }' || fail "$mode.png object share $4"
+done
+cmp -s "$tmp/plain.png" "$tmp/clearcoat.png" && fail "clear-coat looks the same as plain"
+set -- $(png_stats "$tmp/sculpt.png" header)
+[ "$1" = 1024 ] && [ "$2" = 768 ] || fail "sculpt.png: $*"
+
+# Through a hidden GLFW window on Xvfb, when it is installed.
+if command -v xvfb-run >/dev/null 2>&1; then
+    xvfb-run -a -s "-screen 0 640x480x24" "$rel" view "$tmp/out/final.ply" --backend glfw \
+        --screenshot "$tmp/glfw.png" --width 300 --height 200 || fail "view through GLFW failed"
+    set -- $(png_stats "$tmp/glfw.png")
+    echo "view glfw: $1 x $2, $3 colours"
+    [ "$1" = 300 ] && [ "$2" = 200 ] && [ "$3" -gt 200 ] || fail "glfw.png: $*"
+fi
+
+# The chart (no GL: the sanitizer build).
+"$san" plot "$tmp/out/telemetry.csv" -o "$tmp/plot.png" --width 900 --height 500 ||
+    fail "plot failed"
+set -- $(png_stats "$tmp/plot.png")
+echo "plot: $1 x $2, $3 colours, $4 not background"
+[ "$1" = 900 ] && [ "$2" = 500 ] && [ "$3" -gt 5 ] || fail "plot.png: $*"
+
+# Errors: one line, naming the file and the line.
+head -n 50 "$tmp/out/telemetry.csv" >"$tmp/bad.csv"
+echo "1.0,0,0,zz,0,0,0,0,ACTIVE,0,0,0,0" >>"$tmp/bad.csv"
+if "$san" plot "$tmp/bad.csv" -o "$tmp/bad.png" 2>"$tmp/err"; then fail "a bad log was plotted"; fi
+cat "$tmp/err"
+grep -q "bad.csv: line 51: z_mm is not a finite number" "$tmp/err" || fail "error text"
+[ "$(wc -l <"$tmp/err")" = 1 ] || fail "the error is not one line"
+[ ! -e "$tmp/bad.png" ] || fail "a PNG was written for a bad log"
+if env -u DISPLAY "$rel" view "$tmp/nothing.ply" --screenshot "$tmp/x.png" 2>"$tmp/err"; then
+    fail "a missing model was viewed"
+fi
+[ "$(wc -l <"$tmp/err")" = 1 ] || fail "the view error is not one line"
+echo "view and plot: all checks passed"
