@@ -30,6 +30,7 @@ void argil_doc_free(argil_doc_t *d)
         grid_free(&d->grid);
     free(d->rgb);
     rbf_free(&d->rbf);
+    octfit_free(&d->octree);
     argil_doc_init(d);
 }
 
@@ -103,13 +104,19 @@ static uint64_t af_grid_bytes(size_t n)
     return 36u + 4u * (uint64_t)n;
 }
 
+/* OCTB: 40-byte head, a uint32 child link per node, OCTFIT_NCOEF floats per leaf. */
+static uint64_t af_octb_bytes(const octfit_model_t *m)
+{
+    return 40u + 4u * (uint64_t)m->n_nodes + 4u * OCTFIT_NCOEF * (uint64_t)m->n_leaves;
+}
+
 static const char *af_write_body(FILE *f, const void *vctx)
 {
     const af_wctx_t *c = vctx;
     const argil_doc_t *d = c->d;
     const grid_t *g = &d->grid;
     af_out_t o = {f, 0, 0, false};
-    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0);
+    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0) + (d->has_octree != 0);
     uint64_t total = ARGIL_FILE_HEADER_BYTES + 4;
     total += AF_SEC_OVERHEAD + af_grid_bytes(c->n);
     total += AF_SEC_OVERHEAD + 20 + AF_SEC_OVERHEAD + 16 + AF_SEC_OVERHEAD + 20;
@@ -117,6 +124,8 @@ static const char *af_write_body(FILE *f, const void *vctx)
         total += AF_SEC_OVERHEAD + 3u * (uint64_t)c->n;
     if (d->has_rbf)
         total += AF_SEC_OVERHEAD + 28u + 16u * (uint64_t)d->rbf.n;
+    if (d->has_octree)
+        total += AF_SEC_OVERHEAD + af_octb_bytes(&d->octree);
     uint8_t h[ARGIL_FILE_HEADER_BYTES] = {0};
     memcpy(h, AF_MAGIC, 8);
     io_put_u32le(h + 8, ARGIL_FILE_VERSION);
@@ -182,6 +191,25 @@ static const char *af_write_body(FILE *f, const void *vctx)
         }
         af_end(&o);
     }
+    if (d->has_octree) {
+        const octfit_model_t *om = &d->octree;
+        af_begin(&o, "OCTB", af_octb_bytes(om));
+        io_put_u32le(b, om->n_nodes);
+        io_put_u32le(b + 4, OCTFIT_N);
+        io_put_u32le(b + 8, om->kind);
+        const float of[7] = {om->origin_m[0], om->origin_m[1], om->origin_m[2], om->size_m,
+                             om->rms_err, om->max_err, OCTFIT_OVERLAP};
+        for (int k = 0; k < 7; k++)
+            io_put_f32le(b + 12 + 4 * k, of[k]);
+        af_put(&o, b, 40);
+        for (uint32_t i = 0; i < om->n_nodes; i++) {
+            io_put_u32le(b, om->child[i]);
+            af_put(&o, b, 4);
+        }
+        for (uint32_t i = 0; i < om->n_leaves; i++)
+            af_put_f32s(&o, om->leaf[i].coef, OCTFIT_NCOEF);
+        af_end(&o);
+    }
     uint8_t t[4];
     io_put_u32le(t, o.file_crc);
     if (!o.bad && fwrite(t, 1, 4, f) != 4)
@@ -212,6 +240,19 @@ argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, 
                         !af_finite(d->rbf.weight, d->rbf.n) || !af_finite(d->rbf.poly, 4)))) {
         io_err(err, err_len, "argil_file_write: %s: the model holds NaN or Inf", path);
         return ARGIL_ERR_NONFINITE;
+    }
+    if (d->has_octree) {
+        const octfit_model_t *m = &d->octree;
+        bool ok = m->n_nodes >= 1 && m->n_nodes <= OCTFIT_NODES_MAX && m->kind <= 1;
+        const float of[6] = {m->origin_m[0], m->origin_m[1], m->origin_m[2], m->size_m,
+                             m->rms_err, m->max_err};
+        ok = ok && af_finite(of, 6);
+        for (uint32_t i = 0; ok && i < m->n_leaves; i++)
+            ok = af_finite(m->leaf[i].coef, OCTFIT_NCOEF);
+        if (!ok) {
+            io_err(err, err_len, "argil_file_write: %s: octree fit holds NaN, Inf or no nodes", path);
+            return ARGIL_ERR_NONFINITE;
+        }
     }
     if (d->has_rbf && d->rbf.n > RBF_CENTRES_MAX) {
         io_err(err, err_len, "argil_file_write: %s: RBF has too many centres", path);
@@ -275,6 +316,57 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         if (!isfinite(v) || v < 0.0f || v > 1.0f)
             return af_fail(c, off + 36 + 4 * i, "GRID density not a finite number in [0, 1]");
         d->grid.density[i] = d->grid.rest[i] = v;
+    }
+    return ARGIL_OK;
+}
+
+/* Decodes the OCTB section (head at file offset pos, payload of len bytes at p / off). */
+static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t pos,
+                           size_t off, argil_doc_t *d)
+{
+    if (d->has_octree || len < 40)
+        return af_fail(c, pos, "OCTB section repeated or shorter than its 40-byte head");
+    const uint32_t n = io_get_u32le(p), per_axis = io_get_u32le(p + 4), kind = io_get_u32le(p + 8);
+    if (n < 1 || n > OCTFIT_NODES_MAX || (uint64_t)len < 40u + 4u * (uint64_t)n)
+        return af_fail(c, off, "OCTB node count not in 1..65537 or past the section's end");
+    if (per_axis != OCTFIT_N)
+        return af_fail(c, off + 4, "OCTB coefficients per axis not 6");
+    if (kind > 1)
+        return af_fail(c, off + 8, "OCTB kind not 0 (signed distance) or 1 (intensity)");
+    float of[7];
+    af_get_f32s(p + 12, of, 7);
+    if (!af_finite(of, 7) || !(of[3] > 0) || of[6] != OCTFIT_OVERLAP)
+        return af_fail(c, off + 12, "OCTB origin, size, errors or overlap not finite (size > 0, "
+                                    "overlap 0.25)");
+    uint32_t *child = malloc((size_t)n * sizeof(uint32_t));
+    if (child == NULL) {
+        io_err(c->err, c->err_len, "%s: out of memory", c->path);
+        return ARGIL_ERR_NOMEM;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        child[i] = io_get_u32le(p + 40 + 4 * (size_t)i);
+    const argil_err_t e = octfit_alloc(&d->octree, n, child, of, of[3]);
+    free(child);
+    if (e == ARGIL_ERR_NOMEM) {
+        io_err(c->err, c->err_len, "%s: out of memory", c->path);
+        return e;
+    }
+    if (e != ARGIL_OK)
+        return af_fail(c, off + 40, "OCTB child links do not form an octree (each node the child "
+                                    "of one earlier node, 8 consecutive children, depth <= 10)");
+    d->has_octree = true;
+    octfit_model_t *m = &d->octree;
+    if (len != af_octb_bytes(m))
+        return af_fail(c, off, "OCTB section length does not match its nodes and leaves");
+    m->kind = kind;
+    m->rms_err = of[4];
+    m->max_err = of[5];
+    const uint8_t *q = p + 40 + 4 * (size_t)n;
+    for (uint32_t i = 0; i < m->n_leaves; i++) {
+        af_get_f32s(q + 4 * OCTFIT_NCOEF * (size_t)i, m->leaf[i].coef, OCTFIT_NCOEF);
+        if (!af_finite(m->leaf[i].coef, OCTFIT_NCOEF))
+            return af_fail(c, off + (size_t)(q - p) + 4 * OCTFIT_NCOEF * (size_t)i,
+                           "OCTB coefficient NaN or Inf");
     }
     return ARGIL_OK;
 }
@@ -392,6 +484,8 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
             if (!af_finite(rf, 6) || !af_finite(d->rbf.centre_m, 3 * (size_t)n) ||
                 !af_finite(d->rbf.weight, n))
                 return af_fail(c, off, "RBF3 holds NaN or Inf");
+        } else if (strcmp(tag, "OCTB") == 0) {
+            e = af_octb(c, p, sl, pos, off, d);
         }
         /* other tags: a later minor revision's optional data, checked and skipped */
         if (e != ARGIL_OK)

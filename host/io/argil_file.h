@@ -1,5 +1,5 @@
 /* The .argil session file: model (density grid + optional painted colours), material, tool
- * settings, undo-independent state and an optional compact RBF form. Versioned header, a CRC-32C
+ * settings, undo-independent state and an optional compact RBF or octree B-spline form. Versioned header, a CRC-32C
  * per section and over the whole file, written atomically so a crash mid-save keeps the previous
  * file. Layout byte by byte: docs/files.md. */
 #ifndef ARGIL_ARGIL_FILE_H
@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/fit/octree_fit.h"
 #include "host/fit/rbf.h"
 #include "host/model/grid.h"
 #include "shared/argil_err.h"
@@ -37,6 +38,8 @@ typedef struct {
     argil_state_t state;
     bool has_rbf;
     rbf_model_t rbf;
+    bool has_octree;
+    octfit_model_t octree; /* Hua & Qin §4 hierarchical fit (section OCTB) */
 } argil_doc_t;
 
 /* An empty document (no grid allocated), default tool and identity device transform. */

@@ -1,7 +1,8 @@
 #!/bin/sh
-# argil fit / mesh / info end to end: a sphere point cloud is fitted, meshed to every export
-# format, each file loads in assimp and is watertight, the surface is within 0.5 % (mean) and
-# 2 % (max) of the true sphere, and bad files and options give one clear line.
+# argil fit / mesh / info end to end: a sphere point cloud is fitted (RBF, octree B-spline, without
+# normals, and as a closed STL through its signed distance), meshed to every export format, each
+# file loads in assimp and is watertight, every surface is within 0.5 % (mean) and 2 % (max) of
+# the true sphere, and bad files and options give one clear line.
 set -eu
 bin="$SAN/argil"
 tmp=$(mktemp -d)
@@ -53,9 +54,36 @@ expect_error 1 "bad.argil: byte .*checksum mismatch" mesh "$tmp/bad.argil" -o "$
 [ ! -e "$tmp/x.ply" ] || fail "a refused model still wrote a mesh"
 printf '0 0 0\n1 2\n' >"$tmp/bad.xyz"
 expect_error 1 "bad.xyz: line 2: 2 values" fit "$tmp/bad.xyz" -o "$tmp/y.argil"
-awk '{ print $1, $2, $3 }' "$tmp/s.xyz" >"$tmp/p.xyz"
-expect_error 1 "p.xyz: no normals" fit "$tmp/p.xyz" -o "$tmp/y.argil"
-expect_error 2 "not in this build" fit "$tmp/s.xyz" -o "$tmp/y.argil" --max-depth 6
+# sphere surface check on an ASCII PLY mesh of a model: mean <= 0.5 %, max <= 2 % of 60 mm
+check_sphere() { # model label
+    "$bin" mesh "$1" -o "$tmp/c.ply" --ascii --resolution 60 --quiet || fail "$2: mesh"
+    awk -v label="$2" 'NR == 1, /end_header/ { next } NF == 6 { r = sqrt($1 * $1 + $2 * $2 + $3 * $3); d = r - 0.03;
+         if (d < 0) d = -d; s += d; n++; if (d > m) m = d }
+         END { printf "%s: %d vertices, mean %.4f %%, max %.4f %% of size\n", label, n, 100 * s / n / 0.06, 100 * m / 0.06;
+               exit !(n > 1000 && s / n <= 0.005 * 0.06 && m <= 0.02 * 0.06) }' "$tmp/c.ply" || fail "$2: sphere surface off"
+}
+# the octree B-spline fit (Hua & Qin 4), with a depth limit; the model file keeps its OCTB section
+"$bin" fit "$tmp/s.xyz" -o "$tmp/o.argil" --method octree --max-depth 3 --resolution 48 --quiet \
+    || fail "octree fit failed"
+grep -q OCTB "$tmp/o.argil" || fail "the octree form is not in the model file"
+"$bin" info "$tmp/o.argil" >/dev/null || fail "info on the octree model failed"
+check_sphere "$tmp/o.argil" "octree fit"
+# a cloud without normals: PCA + MST orientation, then the fit (auto picks octree above 1000 points)
+awk 'BEGIN { n = 1500; for (i = 0; i < n; i++) { z = 1 - 2 * (i + 0.5) / n; r = sqrt(1 - z * z);
+     t = i * 3.14159265 * (3 - sqrt(5)); printf "%.7f %.7f %.7f\n", 0.03 * r * cos(t), 0.03 * r * sin(t), 0.03 * z } }' >"$tmp/p.xyz"
+"$bin" fit "$tmp/p.xyz" -o "$tmp/p.argil" --resolution 48 >"$tmp/o" 2>/dev/null || fail "fit without normals failed"
+grep -q "octree B-spline" "$tmp/o" || { cat "$tmp/o"; fail "auto did not choose the octree for 1500 points"; }
+check_sphere "$tmp/p.argil" "unoriented cloud"
+# a closed mesh becomes a signed distance grid; an open one is refused with the count
+"$bin" mesh "$tmp/s.argil" -o "$tmp/m.stl" --resolution 40 --quiet || fail "mesh for sdf"
+"$bin" fit "$tmp/m.stl" -o "$tmp/m.argil" --resolution 48 --quiet || fail "fit of a closed STL failed"
+check_sphere "$tmp/m.argil" "closed mesh -> sdf"
+cnt=$(od -An -tu4 -j80 -N4 "$tmp/m.stl" | tr -d ' ')
+{ head -c 80 "$tmp/m.stl"; printf "$(printf '\\%03o\\%03o\\%03o\\%03o' $(((cnt - 1) & 255)) $(((cnt - 1) >> 8 & 255)) $(((cnt - 1) >> 16 & 255)) $(((cnt - 1) >> 24 & 255)))";
+  tail -c +85 "$tmp/m.stl" | head -c $(((cnt - 1) * 50)); } >"$tmp/open.stl"
+expect_error 1 "open.stl: the mesh is not closed (3 boundary" fit "$tmp/open.stl" -o "$tmp/y.argil"
+expect_error 2 "--max-depth needs a number from 0 to 10" fit "$tmp/s.xyz" -o "$tmp/y.argil" --max-depth 11
+expect_error 2 "--method needs auto, octree, rbf, sdf or grid" fit "$tmp/s.xyz" -o "$tmp/y.argil" --method spline
 expect_error 2 "must end in .ply, .stl or .obj" mesh "$tmp/s.argil" -o "$tmp/x.vtk"
 expect_error 2 "--resolution needs a number" mesh "$tmp/s.argil" -o "$tmp/x.ply" --resolution 1
 expect_error 2 "unknown option '--bogus'" fit "$tmp/s.xyz" --bogus

@@ -423,6 +423,97 @@ static void test_each_rule(void **state)
     expect_rule(p, "byte 0", "shorter than the 32-byte header");
 }
 
+/* The OCTB section (octree B-spline fit): round trip to the same function, and each rule. */
+static size_t octb_payload(uint8_t *p, uint32_t n, uint32_t per_axis, uint32_t kind, float size,
+                           const uint32_t *links, float coef)
+{
+    io_put_u32le(p, n);
+    io_put_u32le(p + 4, per_axis);
+    io_put_u32le(p + 8, kind);
+    const float f[7] = {0, 0, 0, size, 1e-4f, 2e-4f, 0.25f};
+    for (int k = 0; k < 7; k++)
+        io_put_f32le(p + 12 + 4 * k, f[k]);
+    for (uint32_t i = 0; i < n; i++)
+        io_put_u32le(p + 40 + 4 * i, links[i]);
+    size_t len = 40 + 4 * (size_t)n;
+    for (uint32_t i = 0; i < OCTFIT_NCOEF; i++, len += 4)
+        io_put_f32le(p + len, coef);
+    return len;
+}
+
+static void test_octb(void **state)
+{
+    (void)state;
+    char p[128], err[256];
+    snprintf(p, sizeof(p), "%s/o.argil", g_dir);
+    argil_doc_t d, r;
+    make_doc(&d, false);
+    uint32_t links[9] = {1, 0, 0, 0, 0, 0, 0, 0, 0};
+    const float org[3] = {-0.01f, -0.01f, -0.01f};
+    assert_int_equal(octfit_alloc(&d.octree, 9, links, org, 0.02f), ARGIL_OK);
+    d.has_octree = true;
+    for (uint32_t l = 0; l < 8; l++)
+        for (uint32_t c = 0; c < OCTFIT_NCOEF; c++)
+            d.octree.leaf[l].coef[c] = 0.001f * (float)l - 0.00001f * (float)c;
+    d.octree.rms_err = 3e-5f;
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_true(r.has_octree);
+    assert_int_equal(r.octree.n_nodes, 9);
+    assert_int_equal(r.octree.n_leaves, 8);
+    assert_float_equal(r.octree.rms_err, 3e-5f, 0);
+    for (int k = 0; k < 50; k++) {
+        const vec3_t q = vec3(0.0004f * (float)k - 0.01f, 0.003f, -0.0002f * (float)k);
+        assert_float_equal(octfit_eval(&r.octree, q), octfit_eval(&d.octree, q), 0);
+    }
+    argil_doc_free(&r);
+    argil_doc_free(&d);
+
+    build_t f;
+    uint8_t g[512], o[1200];
+    const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
+    const uint32_t leaf[2] = {0, 0};
+    const struct {
+        uint32_t n, per_axis, kind;
+        float size, coef;
+        size_t cut;
+        const char *where, *rule;
+    } bad[] = {
+        {1, 6, 0, 0.02f, 0.0f, 900, "byte 92", "OCTB section repeated or shorter"},
+        {0, 6, 0, 0.02f, 0.0f, 0, "byte 104", "OCTB node count not in 1..65537"},
+        {1, 5, 0, 0.02f, 0.0f, 0, "byte 108", "OCTB coefficients per axis not 6"},
+        {1, 6, 2, 0.02f, 0.0f, 0, "byte 112", "OCTB kind not 0"},
+        {1, 6, 0, 0.0f, 0.0f, 0, "byte 116", "OCTB origin, size, errors or overlap"},
+        {2, 6, 0, 0.02f, 0.0f, 0, "byte 144", "OCTB child links do not form an octree"},
+        {1, 6, 0, 0.02f, 0.0f, 4, "byte 104", "OCTB section length does not match"},
+        {1, 6, 0, 0.02f, NAN, 0, "byte 148", "OCTB coefficient NaN or Inf"},
+    };
+    for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+        size_t ol = octb_payload(o, bad[k].n, bad[k].per_axis, bad[k].kind, bad[k].size, leaf,
+                                 bad[k].coef);
+        if (bad[k].cut == 900)
+            ol = 36;
+        else
+            ol -= bad[k].cut;
+        b_begin(&f);
+        b_sec(&f, "GRID", g, gl);
+        b_sec(&f, "OCTB", o, ol);
+        b_end(&f, p, 1);
+        expect_rule(p, bad[k].where, bad[k].rule);
+    }
+    const size_t ol = octb_payload(o, 1, 6, 0, 0.02f, leaf, 0.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    b_sec(&f, "OCTB", o, ol);
+    b_end(&f, p, 1);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_float_equal(octfit_eval(&r.octree, vec3(0.01f, 0.01f, 0.01f)), 0.5f, 1e-5f);
+    argil_doc_free(&r);
+    b_sec(&f, "OCTB", o, ol);
+    b_end(&f, p, 1);
+    expect_rule(p, "byte 1016", "OCTB section repeated");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -430,6 +521,7 @@ int main(void)
         cmocka_unit_test(test_atomic),
         cmocka_unit_test(test_any_corruption_refused),
         cmocka_unit_test(test_each_rule),
+        cmocka_unit_test(test_octb),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

@@ -1,0 +1,28 @@
+/* Normals for point clouds that come without them: a tangent plane per point from the k nearest
+ * neighbours (PCA, Hoppe et al. 1992), then one consistent outward orientation propagated over
+ * a minimum spanning tree of the neighbour graph (weight 1 - |n_i . n_j|), starting in every
+ * connected part from its largest-x point, whose normal must point towards +x. */
+#ifndef ARGIL_NORMALS_H
+#define ARGIL_NORMALS_H
+
+#include <stdint.h>
+
+#include "host/mesh/mesh.h"
+#include "shared/argil_err.h"
+
+#define NORMALS_K_DEFAULT 12u
+
+typedef struct {
+    uint32_t k;                 /* neighbours per point incl. itself, 4..KNN_K_MAX (0 = 12) */
+    const volatile int *stop;   /* set non-zero to abandon (ARGIL_ERR_STATE) */
+    void (*progress)(void *ctx, double fraction); /* may be NULL */
+    void *progress_ctx;
+} normals_opts_t;
+
+/* Gives m (a cloud of >= 4 finite points; triangles ignored) unit normals, replacing any it had.
+ * *parts (may be NULL) receives the number of connected parts of the neighbour graph
+ * (each oriented from its own extreme point). ARGIL_ERR_ARG (fewer than 4 points, NaN / Inf),
+ * NOMEM, STATE (stopped). o may be NULL for the defaults. */
+argil_err_t normals_estimate(mesh_t *m, const normals_opts_t *o, uint32_t *parts);
+
+#endif
