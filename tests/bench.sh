@@ -79,3 +79,42 @@ for i in 1 2 3; do "$tmp/bench_model" >"$tmp/model.$i"; done
 # each run already prints medians of 9-15 repetitions per row; all three runs are shown
 for i in 1 2 3; do echo "  -- run $i"; cat "$tmp/model.$i"; done
 echo "  (goals: Table 1 128^3 / 40^3 row <= 2 ms; Table 2 15^3 / 20^3 row <= 0.5 ms; 32^3 / 64^3 implicit step <= 16 ms)"
+
+echo "== board tick by tick (tests/bench/bench_ticks.c: the default session, board_run_tick only)"
+# Instructions: callgrind collects only inside board_run_tick and dumps after every tick
+# (--combine-dumps: one part per tick in one file); -z now resolves every PLT entry at start-up,
+# so no tick pays for the dynamic linker. Wall time: the same program natively, 3 runs.
+bt="$tmp/bench_ticks"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_ticks.c "$rel/libargil.a" -lm -Wl,-z,now -o "$bt"
+for edge in 16 32; do
+    : >"$tmp/bt.med"; : >"$tmp/bt.p99"; : >"$tmp/bt.worst"
+    for i in 1 2 3; do
+        "$bt" --window "$edge" >"$tmp/bt.out"
+        sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\1/p' "$tmp/bt.out" >>"$tmp/bt.med"
+        sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\2/p' "$tmp/bt.out" >>"$tmp/bt.p99"
+        sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\3/p' "$tmp/bt.out" >>"$tmp/bt.worst"
+    done
+    printf '  %s\n' "$(head -n 1 "$tmp/bt.out")"
+    printf '    wall-clock per tick (median of 3 runs): median %s us, p99 %s us, worst %s us\n' \
+        "$(median <"$tmp/bt.med")" "$(median <"$tmp/bt.p99")" "$(median <"$tmp/bt.worst")"
+    if command -v valgrind >/dev/null 2>&1 && [ -f /usr/include/valgrind/callgrind.h ]; then
+        valgrind --tool=callgrind --collect-atstart=no --combine-dumps=yes --dump-line=no \
+            --callgrind-out-file="$tmp/ticks.cg" "$bt" --window "$edge" >"$tmp/bt.cg.out" 2>/dev/null
+        ticks=$(sed -n 's/^window [0-9]*^3: \([0-9]*\) ticks.*/\1/p' "$tmp/bt.cg.out")
+        # one "totals:" per part; the last part is the dump at exit (nothing collected)
+        sed -n 's/^totals: \([0-9]*\)$/\1/p' "$tmp/ticks.cg" | head -n "$ticks" >"$tmp/ticks.ir"
+        rm -f "$tmp/ticks.cg"
+        sort -n "$tmp/ticks.ir" >"$tmp/ticks.sorted"
+        n=$(wc -l <"$tmp/ticks.ir")
+        med=$(sed -n "$(((n + 1) / 2))p" "$tmp/ticks.sorted")
+        p99=$(sed -n "$((n * 99 / 100))p" "$tmp/ticks.sorted")
+        awk -v goal=150000 -v med="$med" -v p99="$p99" '
+            { n++; if ($1 + 0 > worst + 0) { worst = $1; at = n } if ($1 + 0 > goal) over++ }
+            END {
+                printf "    instructions per tick over %d ticks: median %d, p99 %d, worst %d (tick %d, at %.3f s); %d ticks above %d\n", n, med, p99, worst, at - 1, (at - 1) / 1000, over, goal
+            }' "$tmp/ticks.ir"
+    else
+        echo "    valgrind (with valgrind/callgrind.h) not installed: instruction counts skipped"
+    fi
+done
+echo "  (goal for issue 3: worst tick with a 16^3 window <= 150,000 instructions)"

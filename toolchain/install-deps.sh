@@ -1,14 +1,19 @@
 #!/bin/sh
 # Installs the Debian 12 packages argil needs to build and test, and only the
 # missing ones. Idempotent: a second run installs nothing and says so.
-# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz ...]
-#   build: what `make` and `make run` need; test: + the test tools; fuzz: + clang/libFuzzer.
+# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render ...]
+#   build: what `make` and `make run` need (includes render); test: + the test tools;
+#   fuzz: + clang/libFuzzer; render: argil view/plot (GLFW, EGL, Mesa, stb, Xvfb).
 #   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
 BUILD_PKGS="make gcc libc6-dev libgpiod-dev" # the build (libgpiod 1.6: argil-board's GPIO lines)
-TEST_PKGS="libcmocka-dev assimp-utils"   # unit-test runner; a third-party mesh reader for tests
+TEST_PKGS="libcmocka-dev assimp-utils valgrind" # unit-test runner; a third-party mesh reader; callgrind (+ valgrind/callgrind.h) for make bench
 FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
+# argil view / argil plot (docs/render.md): headers at build time (GL, EGL, GLFW, stb's PNG
+# writer); at run time libglfw/libEGL/Mesa are opened with dlopen, so no link flags are needed.
+# Mesa's llvmpipe renders with no GPU (EGL surfaceless); Xvfb gives GLFW a display in tests.
+RENDER_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libstb-dev xvfb xauth"
 # make cross (and the cross tier of make test): aarch64 board daemon + its tests under
 # qemu-user, the Cortex-M image under qemu-system-arm. The :arm64 libraries need Debian's
 # arm64 architecture enabled (done below, once).
@@ -19,18 +24,18 @@ groups=""
 for a in "$@"; do
     case "$a" in
         --check) check_only=1 ;;
-        build|test|fuzz|cross) groups="$groups $a" ;;
-        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross)" >&2; exit 2 ;;
+        build|test|fuzz|cross|render) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render)" >&2; exit 2 ;;
     esac
 done
-[ -n "$groups" ] || groups="build test fuzz cross"
+[ -n "$groups" ] || groups="build test fuzz cross render"
 PACKAGES=""
 for g in $groups; do
     case "$g" in
-        build) PACKAGES="$PACKAGES $BUILD_PKGS" ;;
-        test) PACKAGES="$PACKAGES $BUILD_PKGS $TEST_PKGS" ;;
-        fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $FUZZ_PKGS" ;;
-        cross) PACKAGES="$PACKAGES $BUILD_PKGS $CROSS_PKGS" ;;
+        build|render) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS" ;;
+        test) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $TEST_PKGS" ;;
+        fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $FUZZ_PKGS" ;;
+        cross) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $CROSS_PKGS" ;;
     esac
 done
 

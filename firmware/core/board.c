@@ -220,9 +220,11 @@ static void log_impulse(board_t *b, uint32_t seq, vec3_t pos_m, float impulse_ns
 static void reapply_impulses(board_t *b, window_buf_t *w)
 {
     const float inv_h = 1.0f / w->spacing_m;
-    for (uint32_t k = 0; k < b->log_count; k++) {
+    /* The log is in sending order: walk back from the newest until the host has them all. */
+    for (uint32_t n = 0; n < b->log_count; n++) {
+        const uint32_t k = (b->log_head + BOARD_IMPULSE_LOG - 1u - n) % BOARD_IMPULSE_LOG;
         if ((int32_t)(b->log_seq[k] - w->impulse_seq) <= 0)
-            continue;
+            break;
         const vec3_t d = vec3_sub(b->log_pos_m[k], w->origin_m);
         const int32_t i = window_index(w, (int32_t)lrintf(d.x * inv_h), (int32_t)lrintf(d.y * inv_h),
                                        (int32_t)lrintf(d.z * inv_h));
@@ -382,13 +384,12 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
             b->settle_left = BOARD_SETTLE_TICKS;
         }
         /* Step the springs only in a box around where the tool works the clay — the nodes
-         * its forces reach and one cell beyond — the board's own physical window (Hua & Qin
-         * §6.3). */
+         * its forces reach — the board's own physical window (Hua & Qin §6.3). */
         if (h.sculpting) {
             b->work_m = h.work_m;
             b->work_radius_m = h.work_radius_m;
         }
-        const float reach = b->work_radius_m + w->spacing_m;
+        const float reach = b->work_radius_m;
         int32_t lo[3], hi[3];
         const float p[3] = {b->work_m.x - w->origin_m.x, b->work_m.y - w->origin_m.y,
                             b->work_m.z - w->origin_m.z};
