@@ -5,7 +5,9 @@
 #include "board.h"
 #include "firmware/hal/hal.h"
 
-#define BOARD_LINK_RX_MAX 8192u   /* bytes of host frames taken per tick */
+/* Bytes of host frames taken per tick: two full WINDOW chunks and the small frames, so no tick
+ * decodes more than two 1 KiB chunks; the rest waits in the link's queue. */
+#define BOARD_LINK_RX_MAX 2304u
 
 typedef struct {
     can_batch_t can_rx;

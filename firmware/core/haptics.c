@@ -34,12 +34,12 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
     if (!(gn > 1e-6f))
         return false;
     /* Along the gradient line through p (Guo et al.'s contact point along the force direction):
-     * march half a cell at a time towards the surface — outward when p is inside, inward when
+     * march a cell at a time towards the surface — outward when p is inside, inward when
      * outside — until the density crosses iso, then bisect within that step. */
     const vec3_t n = vec3_scale(g, -1.0f / gn);
     const float f0 = d - iso;
     const float dir = f0 > 0.0f ? 1.0f : -1.0f;
-    const float step = 0.5f * win->spacing_m;
+    const float step = win->spacing_m;
     int steps = (int)ceilf(reach_m / step);
     if (steps > HAPTICS_MARCH_STEPS)
         steps = HAPTICS_MARCH_STEPS;
@@ -220,7 +220,7 @@ static bool apply_tool_paths(window_buf_t *win, const msg_tool_t *tool, vec3_t f
  * to reach; reach when it does not. */
 static float first_crossing(const window_buf_t *win, vec3_t p, vec3_t u, float iso, float reach)
 {
-    const float step = 0.5f * win->spacing_m;
+    const float step = win->spacing_m;
     int steps = (int)ceilf(reach / step);
     if (steps > HAPTICS_MARCH_STEPS)
         steps = HAPTICS_MARCH_STEPS;

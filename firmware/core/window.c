@@ -49,6 +49,19 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     } else if (w->pending) {
         return PROTO_OK; /* a late copy of the pending window's chunks */
     }
+    /* Finite densities, non-negative finite stiffness: checked chunk by chunk, so no tick pays
+     * for a whole window at once. */
+    const uint32_t n_nodes = (uint32_t)chunk->dims[0] * chunk->dims[1] * chunk->dims[2];
+    const uint16_t count = chunk->sample_count <= PROTO_WINDOW_CHUNK_SAMPLES ? chunk->sample_count
+                                                                             : PROTO_WINDOW_CHUNK_SAMPLES;
+    for (uint16_t k = 0; k < count; k++) {
+        const float v = chunk->samples[k];
+        if (!isfinite(v) || (chunk->first_sample + k >= n_nodes && v < 0.0f)) {
+            w->chunks_refused++;
+            asm_target_back(w);
+            return PROTO_ERR_VALUE;
+        }
+    }
     const proto_err_t e = window_asm_feed(&w->assembler, chunk);
     if (e != PROTO_OK) {
         w->chunks_refused++;
@@ -60,14 +73,6 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     const msg_window_t *h = &w->assembler.head;
     window_buf_t *b = &w->buf[w->active ^ 1u];
     const int32_t n = (int32_t)h->dims[0] * h->dims[1] * h->dims[2];
-    const int32_t total = n * (int32_t)h->channels;
-    for (int32_t i = 0; i < total; i++) {
-        if (!isfinite(b->field[i]) || (i >= n && b->field[i] < 0.0f)) {
-            w->chunks_refused++;
-            asm_target_back(w);
-            return PROTO_ERR_VALUE;
-        }
-    }
     b->version = h->version;
     b->impulse_seq = h->impulse_seq;
     for (int a = 0; a < 3; a++)

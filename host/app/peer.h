@@ -13,7 +13,8 @@
 #include "shared/proto.h"
 
 #define PEER_VERSIONS_KEPT 32u        /* window versions whose layout is remembered */
-#define PEER_CHUNKS_PER_TICK 4u       /* WINDOW chunks sent per millisecond at most */
+#define PEER_CHUNKS_PER_TICK 2u       /* WINDOW chunks sent per millisecond at most (the board
+                                       * decodes two per tick) */
 
 #define PEER_SETTLING_MAX 4u          /* regions the tool left that still settle */
 #define PEER_REST_ACCEL 1e-3f         /* |density acceleration| (1/s²) below which a region rests */

@@ -101,11 +101,12 @@ static void test_surface_distance_finds_the_plane(void **st)
     float dist;
     vec3_t n;
     assert_true(haptics_surface_distance(win, vec3(0.0003f, 0.0001f, -0.002f), 0.5f, 0.005f, &dist, &n));
-    assert_float_equal(dist, 0.002f, 2e-6f);      /* 2 mm inside */
+    /* Found to within the search's resolution, 1/64 cell = 20 µm. */
+    assert_float_equal(dist, 0.002f, 2e-5f);      /* 2 mm inside */
     assert_float_equal(n.z, 1.0f, 1e-4f);         /* outward = +z */
     /* Inner shell at iso 0.75 lies 2.5 mm below the surface (half the band). */
     assert_true(haptics_surface_distance(win, vec3(0, 0, -0.001f), 0.75f, 0.005f, &dist, &n));
-    assert_float_equal(dist, -0.0015f, 2e-6f);
+    assert_float_equal(dist, -0.0015f, 2e-5f);
 }
 
 static void test_iso_surface_rendering_feels_the_inner_shell(void **st)
@@ -126,7 +127,7 @@ static void test_iso_surface_rendering_feels_the_inner_shell(void **st)
     haptics_process(&h, &t, win, vec3(0, 0, -0.003f), vec3(0, 0, 0), false, true, 0.001f, imp, &out);
     assert_true(out.contact);
     assert_float_equal(out.force_n.z, 1000.0f * 0.001f, 0.01f); /* 0.5 mm + tool radius */
-    assert_float_equal(out.potential_j, 0.5f * 1000.0f * 0.001f * 0.001f, 1e-6f);
+    assert_float_equal(out.potential_j, 0.5f * 1000.0f * 0.001f * 0.001f, 2e-5f * 1000.0f * 0.001f);
 }
 
 static void test_friction_holds_the_contact_point_until_the_cone(void **st)
