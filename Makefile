@@ -51,7 +51,7 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-fuzz deps-cross check-freestanding tests-build cross-build
+.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil $(REL)/argil-board check-freestanding
@@ -64,6 +64,9 @@ deps-build:
 
 deps-test:
 	@sh toolchain/install-deps.sh test
+
+deps-bench:
+	@sh toolchain/install-deps.sh bench
 
 deps-fuzz:
 	@sh toolchain/install-deps.sh fuzz
@@ -159,7 +162,8 @@ fuzz: deps-fuzz
 	  if [ $$st != 0 ]; then tail -n 40 $(FZ)/$$t.log; echo "fuzz: $$t FAILED (log: $(FZ)/$$t.log)"; exit 1; fi; \
 	done
 
-bench: all
+bench: deps-bench
+	@$(MAKE) --no-print-directory all
 	@sh tests/bench.sh $(REL)
 
 # ---- cross targets (docs/board.md) ----

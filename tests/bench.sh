@@ -73,6 +73,8 @@ else
     echo "  bench_mesh did not build: skipped"
 fi
 
+echo "  the same 256^3 sphere field in third-party meshers (Debian's python3-skimage, python3-openvdb):"
+/usr/bin/python3 tests/bench/compare_mc.py || echo "  comparison failed to run"
 echo "== host model (host/model): Hua & Qin Tables 1-2 and Ferley et al.'s table, 3 runs"
 cc -O2 -I. tests/bench/bench_model.c "$rel/libargil.a" -lm -o "$tmp/bench_model"
 for i in 1 2 3; do "$tmp/bench_model" >"$tmp/model.$i"; done

@@ -1,9 +1,10 @@
 #!/bin/sh
 # Installs the Debian 12 packages argil needs to build and test, and only the
 # missing ones. Idempotent: a second run installs nothing and says so.
-# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render ...]
+# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render|bench ...]
 #   build: what `make` and `make run` need (includes render); test: + the test tools;
-#   fuzz: + clang/libFuzzer; render: argil view/plot (GLFW, EGL, Mesa, stb, Xvfb).
+#   fuzz: + clang/libFuzzer; render: argil view/plot (GLFW, EGL, Mesa, stb, Xvfb);
+#   bench: + valgrind and the third-party meshers make bench compares against.
 #   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
@@ -17,6 +18,8 @@ RENDER_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-
 # make cross (and the cross tier of make test): aarch64 board daemon + its tests under
 # qemu-user, the Cortex-M image under qemu-system-arm. The :arm64 libraries need Debian's
 # arm64 architecture enabled (done below, once).
+# make bench: callgrind, and scikit-image's and OpenVDB's marching cubes for comparison.
+BENCH_PKGS="valgrind python3-skimage python3-openvdb"
 CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64"
 
 check_only=0
@@ -24,8 +27,8 @@ groups=""
 for a in "$@"; do
     case "$a" in
         --check) check_only=1 ;;
-        build|test|fuzz|cross|render) groups="$groups $a" ;;
-        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render)" >&2; exit 2 ;;
+        build|test|fuzz|cross|render|bench) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render, bench)" >&2; exit 2 ;;
     esac
 done
 [ -n "$groups" ] || groups="build test fuzz cross render"
@@ -36,6 +39,7 @@ for g in $groups; do
         test) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $TEST_PKGS" ;;
         fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $FUZZ_PKGS" ;;
         cross) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $CROSS_PKGS" ;;
+        bench) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $BENCH_PKGS" ;;
     esac
 done
 

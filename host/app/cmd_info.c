@@ -13,9 +13,10 @@
 static void usage_info(FILE *f)
 {
     fprintf(f, "usage: argil info FILE\n\n"
-               "Prints what FILE holds: a model (.argil: grid, iso, material, tool, RBF form), a\n"
-               "mesh or point cloud (.ply .stl .obj .xyz .txt .pts: counts, bounds, normals,\n"
-               "colours, watertightness, volume) or a volume (.nrrd .nhdr: size, spacing, range).\n"
+               "Prints what FILE holds: a model (.argil: grid, iso, material, tool, RBF or octree\n"
+               "B-spline form), a mesh or point cloud (.ply .stl .obj .xyz .txt .pts: counts,\n"
+               "bounds, normals, colours, watertightness, volume) or a volume (.nrrd .nhdr: size,\n"
+               "spacing, range).\n"
                "A file that cannot be read gives one line naming the file, where and why.\n");
 }
 
@@ -54,6 +55,19 @@ int cmd_info(int argc, char **argv)
         if (d.has_rbf)
             printf("  rbf       %u centres (%u bytes), fit error rms %.4g mm, max %.4g mm\n",
                    d.rbf.n, 28 + 16 * d.rbf.n, d.rbf.rms_err_m * 1e3, d.rbf.max_err_m * 1e3);
+        if (d.has_octree) {
+            const octfit_model_t *o = &d.octree;
+            const unsigned long long bytes =
+                40ull + 4ull * o->n_nodes + 4ull * OCTFIT_NCOEF * o->n_leaves;
+            printf("  octree    %u nodes, %u leaves, depth %u, cube %.4g mm at (%.4g, %.4g, %.4g) mm "
+                   "(%llu bytes), ", o->n_nodes, o->n_leaves, o->depth, o->size_m * 1e3,
+                   o->origin_m[0] * 1e3, o->origin_m[1] * 1e3, o->origin_m[2] * 1e3, bytes);
+            if (o->kind == OCTFIT_INTENSITY)
+                printf("intensity error rms %.4g, max %.4g (of the range)\n", o->rms_err,
+                       o->max_err);
+            else
+                printf("fit error rms %.4g mm, max %.4g mm\n", o->rms_err * 1e3, o->max_err * 1e3);
+        }
         argil_doc_free(&d);
         return 0;
     }

@@ -1,5 +1,6 @@
 /* argil mesh: a saved model (.argil) to a mesh file for other tools, at any iso-value and
  * resolution, for the whole model or a box of it, with painted colours. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,8 +24,9 @@ static void usage_mesh(FILE *f)
             "options:\n"
             "  -o OUT          output file: .ply (binary, vertex colours), .stl (binary), .obj\n"
             "  --resolution N  samples along the model's longest axis, 2..1024 (default: the\n"
-            "                  model's own grid). With an RBF form saved in the model it is\n"
-            "                  evaluated directly, otherwise the grid is resampled trilinearly\n"
+            "                  model's own grid). With an octree B-spline or RBF form saved\n"
+            "                  in the model it is evaluated directly, otherwise the grid is\n"
+            "                  resampled trilinearly\n"
             "  --iso V         density level of the surface, 0 < V < 1 (default: the model's)\n"
             "  --region ...    only the box [X0,X1) x [Y0,Y1) x [Z0,Z1) of the model, in metres\n"
             "                  (model space); the piece is closed where the box cuts it\n"
@@ -46,7 +48,8 @@ static int parse_double_arg(const char *opt, const char *v, double lo, double hi
     return 1;
 }
 
-/* Resamples the model on a new grid of about n samples along its longest axis. */
+/* Resamples the model on a new grid of about n samples along its longest axis: from the octree
+ * B-spline or RBF form when the model holds one (as argil fit sampled it), else trilinearly. */
 static argil_err_t resample(const argil_doc_t *d, int n, float **dens, uint8_t **rgb,
                             int32_t dims[3], float *spacing, vec3_t *origin)
 {
@@ -74,7 +77,11 @@ static argil_err_t resample(const argil_doc_t *d, int n, float **dens, uint8_t *
             for (int32_t x = 0; x < dims[0]; x++, i++) {
                 const vec3_t p = vec3(origin->x + *spacing * (float)x, origin->y + *spacing * (float)y,
                                       origin->z + *spacing * (float)z);
-                if (d->has_rbf)
+                if (d->has_octree && d->octree.kind == OCTFIT_INTENSITY)
+                    (*dens)[i] = fminf(1.0f, fmaxf(0.0f, g->iso + octfit_eval(&d->octree, p)));
+                else if (d->has_octree)
+                    (*dens)[i] = grid_profile(octfit_eval(&d->octree, p), g->band_m);
+                else if (d->has_rbf)
                     (*dens)[i] = grid_profile(rbf_eval(&d->rbf, p), g->band_m);
                 else
                     (*dens)[i] = grid_density_at(g, p);

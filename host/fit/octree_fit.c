@@ -80,7 +80,7 @@ argil_err_t octfit_alloc(octfit_model_t *m, uint32_t n_nodes, const uint32_t *ch
             e = ARGIL_ERR_ARG; /* an orphan: parents always come before their children */
         } else if (c == 0) {
             m->leaf_of[i] = m->n_leaves++;
-        } else if (c <= i || c > n_nodes - 8 || depth[i] >= OCTFIT_DEPTH_MAX) {
+        } else if (c <= i || n_nodes < 9 || c > n_nodes - 8 || depth[i] >= OCTFIT_DEPTH_MAX) {
             e = ARGIL_ERR_ARG;
         } else {
             m->leaf_of[i] = UINT32_MAX;

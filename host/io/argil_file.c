@@ -343,8 +343,17 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         io_err(c->err, c->err_len, "%s: out of memory", c->path);
         return ARGIL_ERR_NOMEM;
     }
-    for (uint32_t i = 0; i < n; i++)
+    uint64_t leaves = 0;
+    for (uint32_t i = 0; i < n; i++) {
         child[i] = io_get_u32le(p + 40 + 4 * (size_t)i);
+        leaves += child[i] == 0;
+    }
+    /* The leaves' coefficients must all be in the section before anything is allocated for
+     * them: a declared count never drives an allocation the file cannot back. */
+    if (len != 40u + 4u * (uint64_t)n + 4u * OCTFIT_NCOEF * leaves) {
+        free(child);
+        return af_fail(c, off, "OCTB section length does not match its nodes and leaves");
+    }
     const argil_err_t e = octfit_alloc(&d->octree, n, child, of, of[3]);
     free(child);
     if (e == ARGIL_ERR_NOMEM) {

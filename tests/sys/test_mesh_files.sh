@@ -2,7 +2,8 @@
 # argil fit / mesh / info end to end: a sphere point cloud is fitted (RBF, octree B-spline, without
 # normals, and as a closed STL through its signed distance), meshed to every export format, each
 # file loads in assimp and is watertight, every surface is within 0.5 % (mean) and 2 % (max) of
-# the true sphere, and bad files and options give one clear line.
+# the true sphere, an octree model re-meshed finer comes from its B-splines (and argil info lists
+# the octree), and bad files and options give one clear line.
 set -eu
 bin="$SAN/argil"
 tmp=$(mktemp -d)
@@ -66,8 +67,29 @@ check_sphere() { # model label
 "$bin" fit "$tmp/s.xyz" -o "$tmp/o.argil" --method octree --max-depth 3 --resolution 48 --quiet \
     || fail "octree fit failed"
 grep -q OCTB "$tmp/o.argil" || fail "the octree form is not in the model file"
-"$bin" info "$tmp/o.argil" >/dev/null || fail "info on the octree model failed"
+"$bin" info "$tmp/o.argil" >"$tmp/i" || fail "info on the octree model failed"
+grep -q "octree .* 1 nodes, 1 leaves, depth 0, .* fit error rms" "$tmp/i" || { cat "$tmp/i"; fail "info does not show the octree form"; }
 check_sphere "$tmp/o.argil" "octree fit"
+# a split octree on a coarse 32-sample grid: argil info lists the section, and mesh --resolution
+# evaluates the B-splines, so a finer mesh has more triangles and sits closer to the sphere than
+# the stored grid could give (trilinear resampling of it: mean ~0.06 % of size at 80 samples)
+"$bin" fit "$tmp/s.xyz" -o "$tmp/d.argil" --method octree --max-depth 2 --tolerance 0.00002 \
+    --resolution 32 --quiet || fail "split octree fit failed"
+"$bin" info "$tmp/d.argil" >"$tmp/i" || fail "info on the split octree model failed"
+grep -q "octree .* 9 nodes, 8 leaves, depth 1, cube .* mm (6988 bytes), fit error rms .* mm, max .* mm" "$tmp/i" \
+    || { cat "$tmp/i"; fail "info does not show the split octree form"; }
+for r in 30 80; do
+    "$bin" mesh "$tmp/d.argil" -o "$tmp/d$r.ply" --ascii --resolution $r --quiet || fail "octree mesh at $r"
+    assimp info "$tmp/d$r.ply" >"$tmp/a$r" 2>&1 || { cat "$tmp/a$r"; fail "assimp cannot load the octree mesh at $r"; }
+done
+f30=$(sed -n 's/^Faces: *\([0-9]*\).*/\1/p' "$tmp/a30"); f80=$(sed -n 's/^Faces: *\([0-9]*\).*/\1/p' "$tmp/a80")
+[ -n "$f30" ] && [ -n "$f80" ] && [ "$f30" -gt 0 ] && [ "$f80" -gt "$f30" ] \
+    || fail "octree mesh at 80 has $f80 faces, at 30 $f30 (want more at 80)"
+awk 'NR == 1, /end_header/ { next } NF == 6 { r = sqrt($1 * $1 + $2 * $2 + $3 * $3); d = r - 0.03;
+     if (d < 0) d = -d; s += d; n++; if (d > m) m = d }
+     END { printf "octree resampled at 80: %d vertices, mean %.4f %%, max %.4f %% of size\n", n, 100 * s / n / 0.06, 100 * m / 0.06;
+           exit !(n > 10000 && s / n <= 0.0002 * 0.06 && m <= 0.001 * 0.06) }' "$tmp/d80.ply" \
+    || fail "octree mesh at 80 not evaluated from the B-splines (surface off)"
 # a cloud without normals: PCA + MST orientation, then the fit (auto picks octree above 1000 points)
 awk 'BEGIN { n = 1500; for (i = 0; i < n; i++) { z = 1 - 2 * (i + 0.5) / n; r = sqrt(1 - z * z);
      t = i * 3.14159265 * (3 - sqrt(5)); printf "%.7f %.7f %.7f\n", 0.03 * r * cos(t), 0.03 * r * sin(t), 0.03 * z } }' >"$tmp/p.xyz"

@@ -436,7 +436,13 @@ static size_t octb_payload(uint8_t *p, uint32_t n, uint32_t per_axis, uint32_t k
     for (uint32_t i = 0; i < n; i++)
         io_put_u32le(p + 40 + 4 * i, links[i]);
     size_t len = 40 + 4 * (size_t)n;
-    for (uint32_t i = 0; i < OCTFIT_NCOEF; i++, len += 4)
+    /* One block of coefficients per leaf (a link of 0), at least one. */
+    uint32_t leaves = 0;
+    for (uint32_t i = 0; i < n; i++)
+        leaves += links[i] == 0;
+    if (leaves == 0)
+        leaves = 1;
+    for (uint32_t i = 0; i < leaves * OCTFIT_NCOEF; i++, len += 4)
         io_put_f32le(p + len, coef);
     return len;
 }
@@ -470,7 +476,7 @@ static void test_octb(void **state)
     argil_doc_free(&d);
 
     build_t f;
-    uint8_t g[512], o[1200];
+    uint8_t g[512], o[2400];
     const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
     const uint32_t leaf[2] = {0, 0};
     const struct {
