@@ -295,7 +295,7 @@ static bool sphere_penetration(const window_buf_t *win, vec3_t p, float r, float
 /* Contact of the tool sphere with the iso-surface, through a virtual contact point whose
  * sliding is limited by Coulomb friction. */
 static vec3_t contact_force(haptics_t *h, const msg_tool_t *tool, const window_buf_t *win,
-                            vec3_t p, float *potential_j, bool *contact)
+                            vec3_t p, float friction, float *potential_j, bool *contact)
 {
     *contact = false;
     *potential_j = 0.0f;
@@ -318,12 +318,12 @@ static vec3_t contact_force(haptics_t *h, const msg_tool_t *tool, const window_b
         return vec3(0, 0, 0);
     }
     vec3_t vcp = vec3_add(p, vec3_scale(n, pen));
-    if (h->in_contact && tool->friction > 0.0f) {
+    if (h->in_contact && friction > 0.0f) {
         /* Stick while the old contact point's tangential offset is within μ·pen, else slide
          * to the edge of that cone (Guo et al.: friction by limiting the VCP's motion). */
         vec3_t off = vec3_sub(h->vcp_m, vcp);
         off = vec3_sub(off, vec3_scale(n, vec3_dot(off, n)));
-        const float lim = tool->friction * pen;
+        const float lim = friction * pen;
         const float ol = vec3_norm(off);
         vcp = vec3_add(vcp, ol > lim && ol > 0.0f ? vec3_scale(off, lim / ol) : off);
     }
@@ -455,7 +455,11 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
         break;
     }
 
-    out->force_n = contact_force(h, tool, win, pos_m, &out->potential_j, &out->contact);
+    /* Clay that is being pushed flows: the contact point slides freely while the push tool
+     * works it, so the yield is not felt as stick-slip. */
+    const bool pushing = tool->kind == TOOL_PUSH && hold;
+    out->force_n = contact_force(h, tool, win, pos_m, pushing ? 0.0f : tool->friction,
+                                 &out->potential_j, &out->contact);
     if (tool->kind == TOOL_PUSH && hold && out->contact) {
         /* The clay holds until the contact force reaches its yield force, then flows along
          * the tool's path: eq. 7 with the density met, negative (lower density). */
