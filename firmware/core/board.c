@@ -389,7 +389,7 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
             b->work_m = h.work_m;
             b->work_radius_m = h.work_radius_m;
         }
-        const float reach = b->work_radius_m;
+        const float reach = 0.75f * b->work_radius_m;
         int32_t lo[3], hi[3];
         const float p[3] = {b->work_m.x - w->origin_m.x, b->work_m.y - w->origin_m.y,
                             b->work_m.z - w->origin_m.z};
