@@ -2,6 +2,7 @@
 #include "host/render/telemetry_log.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -71,7 +72,8 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
         char *end;
         errno = 0;
         const double d = strtod(s, &end);
-        if (end == s || *end != '\0' || errno == ERANGE || !isfinite(d)) {
+        if (end == s || *end != '\0' || errno == ERANGE || !isfinite(d) ||
+            (c != COL_T && fabs(d) > FLT_MAX)) {
             snprintf(err, err_len, "%s: line %u: %s is not a finite number: '%.32s'", path,
                      line_no, COL_NAMES[c], s);
             return ARGIL_ERR_PARSE;

@@ -262,6 +262,8 @@ static void test_telemetry_errors_name_the_line(void **state)
                      "line 3: 6 fields where the header has 13");
     expect_csv_error(HEADER "0.001,0,0,6x,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm is not a finite");
     expect_csv_error(HEADER "0.001,0,0,nan,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm");
+    /* Finite as a double but beyond a float (found by fuzz_telemetry). */
+    expect_csv_error(HEADER "0.001,0,0,8e100,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm is not a finite");
     expect_csv_error(HEADER "0.002,0,0,1,0,0,0,0,IDLE,0,0,0,0\n0.001,0,0,1,0,0,0,0,IDLE,0,0,0,0\n",
                      "line 3: time_s goes backwards");
     expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,,0,0,0,0\n", "line 2: state '' is empty");
