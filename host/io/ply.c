@@ -2,6 +2,8 @@
  * Fields are encoded byte by byte, never by copying structs. */
 #include "host/io/ply.h"
 
+#include "host/io/io_util.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -134,26 +136,19 @@ static const char *ply_write_stream(FILE *f, const mesh_t *m, uint8_t *buf)
     }
     if (used > 0 && fwrite(buf, 1, used, f) != used)
         return "fwrite";
-    if (fflush(f) != 0)
-        return "fflush";
-    if (fsync(fileno(f)) != 0)
-        return "fsync";
     return NULL;
 }
 
-/* Best effort: makes the rename itself durable by syncing path's directory. */
-static void ply_sync_dir(const char *path)
+typedef struct {
+    const mesh_t *mesh;
+    uint8_t *buf;
+} ply_write_ctx_t;
+
+/* io_write_atomic's callback: the whole file into f. */
+static const char *ply_write_cb(FILE *f, const void *ctx)
 {
-    const char *slash = strrchr(path, '/');
-    char *dir = slash == NULL ? strdup(".") : strndup(path, (size_t)(slash - path) + 1);
-    if (dir == NULL)
-        return;
-    const int fd = open(dir, O_RDONLY | O_DIRECTORY);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        (void)close(fd);
-    }
-    free(dir);
+    const ply_write_ctx_t *c = ctx;
+    return ply_write_stream(f, c->mesh, c->buf);
 }
 
 argil_err_t ply_write(const char *path, const mesh_t *m, char *err, size_t err_len)
@@ -165,43 +160,14 @@ argil_err_t ply_write(const char *path, const mesh_t *m, char *err, size_t err_l
     argil_err_t e = ply_check_mesh(path, m, err, err_len);
     if (e != ARGIL_OK)
         return e;
-    const size_t plen = strlen(path);
-    char *tmp = malloc(plen + 5);
     uint8_t *buf = malloc(PLY_CHUNK_BYTES);
-    if (tmp == NULL || buf == NULL) {
-        free(tmp);
-        free(buf);
+    if (buf == NULL) {
         ply_err(err, err_len, "ply_write: %s: out of memory", path);
         return ARGIL_ERR_NOMEM;
     }
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".tmp", 5);
-
-    e = ARGIL_ERR_IO;
-    FILE *f = fopen(tmp, "wb");
-    if (f == NULL) {
-        ply_err(err, err_len, "ply_write: fopen(\"%s\") failed: %s", tmp, strerror(errno));
-    } else {
-        const char *failed = ply_write_stream(f, m, buf);
-        const int saved = errno;
-        if (failed != NULL) {
-            (void)fclose(f);
-            (void)remove(tmp);
-            ply_err(err, err_len, "ply_write: %s(\"%s\") failed: %s", failed, tmp,
-                    strerror(saved));
-        } else if (fclose(f) != 0) {
-            ply_err(err, err_len, "ply_write: fclose(\"%s\") failed: %s", tmp, strerror(errno));
-            (void)remove(tmp);
-        } else if (rename(tmp, path) != 0) {
-            ply_err(err, err_len, "ply_write: rename(\"%s\", \"%s\") failed: %s", tmp, path,
-                    strerror(errno));
-            (void)remove(tmp);
-        } else {
-            ply_sync_dir(path);
-            e = ARGIL_OK;
-        }
-    }
-    free(tmp);
+    /* Temp file, fsync, rename, directory sync: a crash never leaves a half file. */
+    const ply_write_ctx_t ctx = {m, buf};
+    e = io_write_atomic(path, ply_write_cb, &ctx, "ply_write", err, err_len);
     free(buf);
     return e;
 }
