@@ -69,35 +69,41 @@ static bool mc_load_layer(mc_work_t *w, int32_t pz, int k)
     return true;
 }
 
+void mc_edge_point(vec3_t origin_m, float spacing_m, float iso, const int32_t p[3], int a,
+                   float d0, float d1, vec3_t g0, vec3_t g1, vec3_t *pos_m, vec3_t *normal)
+{
+    float t = (iso - d0) / (d1 - d0);
+    if (!(t >= MC_T_MIN))
+        t = MC_T_MIN; /* also NaN */
+    if (t > 1.0f - MC_T_MIN)
+        t = 1.0f - MC_T_MIN;
+    const int64_t s0[3] = {p[0] - 1, p[1] - 1, p[2] - 1};
+    float idx[3] = {(float)s0[0], (float)s0[1], (float)s0[2]};
+    idx[a] += t;
+    *pos_m = vec3(origin_m.x + spacing_m * idx[0], origin_m.y + spacing_m * idx[1],
+                  origin_m.z + spacing_m * idx[2]);
+    const vec3_t g = vec3_add(g0, vec3_scale(vec3_sub(g1, g0), t));
+    const float len = vec3_norm(g);
+    if (len > 1e-12f && isfinite(len)) {
+        *normal = vec3_scale(g, -1.0f / len);
+    } else {
+        /* Flat field: fall back to the edge direction from the inside end to the outside end. */
+        const float sgn = d0 > iso ? 1.0f : -1.0f;
+        *normal = vec3(a == 0 ? sgn : 0.0f, a == 1 ? sgn : 0.0f, a == 2 ? sgn : 0.0f);
+    }
+}
+
 /* Creates the vertex on the edge from padded sample p along axis a (densities d0 at p, d1 at
  * the other end, exactly one of them inside). */
 static argil_err_t mc_make_vertex(mc_work_t *w, const int32_t p[3], int a, float d0, float d1,
                                   uint32_t *id)
 {
-    float t = (w->iso - d0) / (d1 - d0);
-    if (!(t >= MC_T_MIN))
-        t = MC_T_MIN; /* also NaN */
-    if (t > 1.0f - MC_T_MIN)
-        t = 1.0f - MC_T_MIN;
     int64_t s0[3] = {p[0] - 1, p[1] - 1, p[2] - 1};
     int64_t s1[3] = {s0[0], s0[1], s0[2]};
     s1[a] += 1;
-    float idx[3] = {(float)s0[0], (float)s0[1], (float)s0[2]};
-    idx[a] += t;
-    const vec3_t pos = vec3(w->origin_m.x + w->spacing_m * idx[0],
-                            w->origin_m.y + w->spacing_m * idx[1],
-                            w->origin_m.z + w->spacing_m * idx[2]);
-    const vec3_t g0 = mc_gradient(w, s0), g1 = mc_gradient(w, s1);
-    const vec3_t g = vec3_add(g0, vec3_scale(vec3_sub(g1, g0), t));
-    const float len = vec3_norm(g);
-    vec3_t n;
-    if (len > 1e-12f && isfinite(len)) {
-        n = vec3_scale(g, -1.0f / len);
-    } else {
-        /* Flat field: fall back to the edge direction from the inside end to the outside end. */
-        const float sgn = d0 > w->iso ? 1.0f : -1.0f;
-        n = vec3(a == 0 ? sgn : 0.0f, a == 1 ? sgn : 0.0f, a == 2 ? sgn : 0.0f);
-    }
+    vec3_t pos, n;
+    mc_edge_point(w->origin_m, w->spacing_m, w->iso, p, a, d0, d1, mc_gradient(w, s0),
+                  mc_gradient(w, s1), &pos, &n);
     return mesh_add_vertex(w->out, pos, n, id);
 }
 

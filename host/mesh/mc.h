@@ -13,6 +13,14 @@
  * a sample sits exactly on the iso-value. */
 #define MC_T_MIN 0.01f
 
+/* The vertex both meshers put on the grid edge from padded sample p (sample p - 1) along axis
+ * a, whose ends hold densities d0 and d1 and central-difference gradients g0 and g1: where the
+ * iso-value crosses (at least MC_T_MIN of the edge from either end, also for NaN) and the unit
+ * outward normal (the edge direction, inside to outside, where the field is flat). One function
+ * so that the slab and block meshers agree bit for bit. */
+void mc_edge_point(vec3_t origin_m, float spacing_m, float iso, const int32_t p[3], int a,
+                   float d0, float d1, vec3_t g0, vec3_t g1, vec3_t *pos_m, vec3_t *normal);
+
 /* Replaces out with the iso-surface of density (x fastest, dims samples, sample (0,0,0) at
  * origin_m): closed, edge-manifold, one vertex per crossed grid edge, triangles CCW seen from
  * outside (density <= iso, which includes every sample beyond the grid), unit outward normals

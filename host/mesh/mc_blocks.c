@@ -239,27 +239,9 @@ static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint
     p1[a] += 1;
     const size_t i0 = mcb_l(j, p[0], p[1], p[2]), i1 = mcb_l(j, p1[0], p1[1], p1[2]);
     const float d0 = b->val[i0], d1 = b->val[i1];
-    float t = (b->iso - d0) / (d1 - d0);
-    if (!(t >= MC_T_MIN))
-        t = MC_T_MIN;
-    if (t > 1.0f - MC_T_MIN)
-        t = 1.0f - MC_T_MIN;
-    const int64_t s0[3] = {p[0] - 1, p[1] - 1, p[2] - 1};
-    float idx[3] = {(float)s0[0], (float)s0[1], (float)s0[2]};
-    idx[a] += t;
-    const vec3_t pos = vec3(b->origin_m.x + b->spacing_m * idx[0],
-                            b->origin_m.y + b->spacing_m * idx[1],
-                            b->origin_m.z + b->spacing_m * idx[2]);
-    const vec3_t g0 = mcb_gradient(j, p), g1 = mcb_gradient(j, p1);
-    const vec3_t g = vec3_add(g0, vec3_scale(vec3_sub(g1, g0), t));
-    const float len = vec3_norm(g);
-    vec3_t n;
-    if (len > 1e-12f && isfinite(len)) {
-        n = vec3_scale(g, -1.0f / len);
-    } else {
-        const float sgn = d0 > b->iso ? 1.0f : -1.0f;
-        n = vec3(a == 0 ? sgn : 0.0f, a == 1 ? sgn : 0.0f, a == 2 ? sgn : 0.0f);
-    }
+    vec3_t pos, n;
+    mc_edge_point(b->origin_m, b->spacing_m, b->iso, p, a, d0, d1, mcb_gradient(j, p),
+                  mcb_gradient(j, p1), &pos, &n);
     argil_err_t e = mcb_grow_vert(k, j->rgb != NULL);
     if (e != ARGIL_OK)
         return e;
