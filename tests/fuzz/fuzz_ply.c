@@ -7,6 +7,7 @@
 #include "host/io/ply.h"
 #include "host/mesh/mesh_check.h"
 #include "tests/fuzz/fuzz_file.h"
+#include "tests/fuzz/fuzz_mesh.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -21,9 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const argil_err_t e = ply_read_mesh(path, &m, err, sizeof(err));
         if (e == ARGIL_OK) {
             /* Whatever was accepted must be a consistent mesh. */
-            for (size_t i = 0; i < 3 * m.n_tri; i++)
-                if (m.tri[i] >= m.n_vert)
-                    abort();
+            fuzz_check_mesh(&m);
             (void)mesh_volume_m3(&m);
         } else if (!fuzz_error_names_file(err, path)) {
             abort(); /* every error names the file */

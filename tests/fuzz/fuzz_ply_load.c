@@ -10,6 +10,7 @@
 
 #include "host/io/mesh_import.h"
 #include "tests/fuzz/fuzz_file.h"
+#include "tests/fuzz/fuzz_mesh.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -24,12 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         bool nrm = false;
         const argil_err_t e = ply_load(path, &m, &nrm, err, sizeof(err));
         if (e == ARGIL_OK) {
-            for (size_t i = 0; i < 3 * m.n_tri; i++)
-                if (m.tri[i] >= m.n_vert)
-                    abort();
-            for (size_t i = 0; i < 3 * m.n_vert; i++)
-                if (!isfinite(m.pos[i]))
-                    abort();
+            fuzz_check_mesh(&m);
         } else if (!fuzz_error_names_file(err, path)) {
             abort(); /* every error is one line naming the file */
         }
