@@ -234,6 +234,74 @@ void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], 
     }
 }
 
+void field_coefs_from(const field_t *f, const float *D, const int32_t slo[3], const int32_t shi[3],
+                      const int32_t clo[3], const int32_t cn[3], float *out, float *tmp)
+{
+    int32_t ns[3];
+    for (int a = 0; a < 3; a++)
+        ns[a] = shi[a] - slo[a];
+    const size_t cx = (size_t)cn[0];
+    float *T1 = tmp, *T2 = T1 + cx * ns[1] * ns[2];
+    memset(T1, 0, sizeof(float) * cx * ns[1] * ns[2]);
+    memset(T2, 0, sizeof(float) * cx * cn[1] * ns[2]);
+    memset(out, 0, sizeof(float) * cx * cn[1] * cn[2]);
+    /* x = Aᵀ d with Aᵀ = A_zᵀ ⊗ A_yᵀ ⊗ A_xᵀ: one axis at a time, scattering each sample's 4 taps */
+    enum { CHUNK = 64 }; /* the x taps of CHUNK samples at a time, used by every row */
+    for (int32_t x0 = 0; x0 < ns[0]; x0 += CHUNK) {
+        const int32_t m = ns[0] - x0 < CHUNK ? ns[0] - x0 : CHUNK;
+        int32_t c0[CHUNK];
+        float w[CHUNK][4];
+        bool inside = true;
+        for (int32_t k = 0; k < m; k++) {
+            c0[k] = field_sample_taps(f, slo[0] + x0 + k, w[k]) - clo[0];
+            inside = inside && c0[k] >= 0 && c0[k] + 4 <= cn[0];
+        }
+        for (size_t r = 0; r < (size_t)ns[1] * ns[2]; r++) {
+            float *dst = T1 + cx * r;
+            const float *src = D + (size_t)ns[0] * r + x0;
+            for (int32_t k = 0; k < m; k++) {
+                float *q = dst + c0[k];
+                if (inside) {
+                    q[0] += w[k][0] * src[k];
+                    q[1] += w[k][1] * src[k];
+                    q[2] += w[k][2] * src[k];
+                    q[3] += w[k][3] * src[k];
+                } else {
+                    for (int j = 0; j < 4; j++)
+                        if (c0[k] + j >= 0 && c0[k] + j < cn[0])
+                            q[j] += w[k][j] * src[k];
+                }
+            }
+        }
+    }
+    for (int32_t z = 0; z < ns[2]; z++)
+        for (int32_t y = 0; y < ns[1]; y++) {
+            float w[4];
+            const int32_t c0 = field_sample_taps(f, slo[1] + y, w) - clo[1];
+            const float *src = T1 + cx * ((size_t)y + (size_t)ns[1] * z);
+            for (int j = 0; j < 4; j++) {
+                if (c0 + j < 0 || c0 + j >= cn[1])
+                    continue;
+                float *dst = T2 + cx * ((size_t)(c0 + j) + (size_t)cn[1] * z);
+                for (size_t i = 0; i < cx; i++)
+                    dst[i] += w[j] * src[i];
+            }
+        }
+    const size_t plane = cx * cn[1];
+    for (int32_t z = 0; z < ns[2]; z++) {
+        float w[4];
+        const int32_t c0 = field_sample_taps(f, slo[2] + z, w) - clo[2];
+        const float *src = T2 + plane * (size_t)z;
+        for (int j = 0; j < 4; j++) {
+            if (c0 + j < 0 || c0 + j >= cn[2])
+                continue;
+            float *dst = out + plane * (size_t)(c0 + j);
+            for (size_t i = 0; i < plane; i++)
+                dst[i] += w[j] * src[i];
+        }
+    }
+}
+
 argil_err_t field_refresh(field_t *f, const int32_t slo[3], const int32_t shi[3])
 {
     int32_t clo[3], chi[3], nc[3], ns[3];
@@ -311,5 +379,108 @@ argil_err_t field_fill(field_t *f, field_sdf_fn sd, void *ctx, vec3_t lo_m, vec3
     sparse_read_box(&f->samp, FS_D, slo, ns, d);
     e = sparse_write_box(&f->samp, FS_REST, slo, ns, d);
     free(d);
+    return e;
+}
+
+#define FIELD_REF_IN (SPARSE_B + 4)        /* coarse coefficients read per block and axis */
+#define FIELD_REF_OUT (2 * SPARSE_B + 4)   /* fine coefficients written per block and axis */
+
+/* One axis of the two-scale relation on a dense box (x fastest): in has n_in[a] points along
+ * axis a starting at coarse index lo_c, out gets 2 n_in - 4 points starting at fine index
+ * 2 lo_c + 2; fixed flags combine by min (fixed only when every parent is). */
+static void field_refine_axis(const float *in, const int32_t dims_in[3], int a, bool flags, float *out)
+{
+    int32_t dims_out[3] = {dims_in[0], dims_in[1], dims_in[2]};
+    dims_out[a] = 2 * dims_in[a] - 4;
+    const size_t st_in[3] = {1, (size_t)dims_in[0], (size_t)dims_in[0] * dims_in[1]};
+    const size_t st_out[3] = {1, (size_t)dims_out[0], (size_t)dims_out[0] * dims_out[1]};
+    for (int32_t z = 0; z < dims_out[2]; z++)
+        for (int32_t y = 0; y < dims_out[1]; y++)
+            for (int32_t x = 0; x < dims_out[0]; x++) {
+                int32_t o[3] = {x, y, z};
+                const int32_t j = o[a] + 2; /* fine index relative to 2 lo_c */
+                const int32_t c = j / 2;    /* coarse parent relative to lo_c */
+                o[a] = 0;
+                const float *b = in + st_in[0] * o[0] + st_in[1] * o[1] + st_in[2] * o[2];
+                const float pm = b[st_in[a] * (c - 1)], p0 = b[st_in[a] * c], pp = b[st_in[a] * (c + 1)];
+                float v;
+                if (flags)
+                    v = (j & 1) ? fminf(p0, pp) : fminf(pm, fminf(p0, pp));
+                else
+                    v = (j & 1) ? 0.5f * (p0 + pp) : 0.125f * (pm + 6.0f * p0 + pp);
+                out[st_out[0] * x + st_out[1] * y + st_out[2] * z] = v;
+            }
+}
+
+argil_err_t field_refine(field_t *f)
+{
+    if (f->ratio % 2 != 0)
+        return ARGIL_ERR_ARG;
+    size_t nkeys = 0;
+    for (size_t i = 0; i < f->coef.cap; i++) {
+        const sparse_block_t *b = &f->coef.slots[i];
+        if (b->data == NULL)
+            continue;
+        for (int a = 0; a < 3; a++)
+            if (b->key[a] > SPARSE_INDEX_MAX / (4 * SPARSE_B) || b->key[a] < -SPARSE_INDEX_MAX / (4 * SPARSE_B))
+                return ARGIL_ERR_ARG;
+        nkeys++;
+    }
+    sparse_t fine;
+    argil_err_t e = sparse_init(&fine, FC_NCH, f->coef.defaults);
+    if (e != ARGIL_OK)
+        return e;
+    /* per coarse block: its coefficients and a ring of 2, refined along x, y, z, written where they
+     * differ from the defaults (neighbouring blocks write the same values where they overlap) */
+    float *buf = malloc(sizeof(float) * 3 * FIELD_REF_OUT * FIELD_REF_OUT * FIELD_REF_OUT);
+    if (buf == NULL) {
+        sparse_free(&fine);
+        return ARGIL_ERR_NOMEM;
+    }
+    float *A = buf, *B = A + FIELD_REF_OUT * FIELD_REF_OUT * FIELD_REF_OUT, *C = B + FIELD_REF_OUT * FIELD_REF_OUT * FIELD_REF_OUT;
+    for (size_t i = 0; i < f->coef.cap && e == ARGIL_OK; i++) {
+        const sparse_block_t *b = &f->coef.slots[i];
+        if (b->data == NULL)
+            continue;
+        int32_t lo[3], flo[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = b->key[a] * SPARSE_B - 2;
+            flo[a] = 2 * lo[a] + 2;
+        }
+        for (int ch = 0; ch < FC_NCH && e == ARGIL_OK; ch++) {
+            const int32_t d0[3] = {FIELD_REF_IN, FIELD_REF_IN, FIELD_REF_IN};
+            const int32_t d1[3] = {FIELD_REF_OUT, FIELD_REF_IN, FIELD_REF_IN};
+            const int32_t d2[3] = {FIELD_REF_OUT, FIELD_REF_OUT, FIELD_REF_IN};
+            const int32_t d3[3] = {FIELD_REF_OUT, FIELD_REF_OUT, FIELD_REF_OUT};
+            sparse_read_box(&f->coef, ch, lo, d0, A);
+            field_refine_axis(A, d0, 0, ch == FC_FIXED, B);
+            field_refine_axis(B, d1, 1, ch == FC_FIXED, C);
+            field_refine_axis(C, d2, 2, ch == FC_FIXED, A);
+            e = sparse_write_box(&fine, ch, flo, d3, A);
+        }
+    }
+    free(buf);
+    size_t nsb = 0;
+    int32_t (*keys)[3] = e == ARGIL_OK ? malloc(sizeof(int32_t[3]) * (f->samp.count + 1)) : NULL;
+    if (keys == NULL) {
+        sparse_free(&fine);
+        return e != ARGIL_OK ? e : ARGIL_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < f->samp.cap; i++)
+        if (f->samp.slots[i].data != NULL)
+            memcpy(keys[nsb++], f->samp.slots[i].key, sizeof(keys[0]));
+    sparse_free(&f->coef);
+    f->coef = fine;
+    f->coef_spacing_m *= 0.5f;
+    f->ratio /= 2;
+    for (int32_t ph = 0; ph < f->ratio; ph++)
+        field_weights((double)ph / (double)f->ratio, f->wtab[ph]);
+    /* d = A p again with the finer basis (equal up to rounding) */
+    for (size_t k = 0; k < nsb && e == ARGIL_OK; k++) {
+        const int32_t slo[3] = {keys[k][0] * SPARSE_B, keys[k][1] * SPARSE_B, keys[k][2] * SPARSE_B};
+        const int32_t shi[3] = {slo[0] + SPARSE_B, slo[1] + SPARSE_B, slo[2] + SPARSE_B};
+        e = field_refresh(f, slo, shi);
+    }
+    free(keys);
     return e;
 }

@@ -88,11 +88,29 @@ argil_err_t field_refresh(field_t *f, const int32_t slo[3], const int32_t shi[3]
 void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],
                         const int32_t slo[3], const int32_t shi[3], float *out, float *tmp);
 
+/* out = Aᵀ D (the transpose of field_samples_from): for every coefficient of the dense box
+ * (first index clo, dims cn, x fastest) the sum of A(s, c) D(s) over the samples s of [slo, shi)
+ * (D x fastest); taps that fall outside the coefficient box are dropped. tmp holds
+ * cn_x*ns_y*ns_z + cn_x*cn_y*ns_z floats. */
+void field_coefs_from(const field_t *f, const float *D, const int32_t slo[3], const int32_t shi[3],
+                      const int32_t clo[3], const int32_t cn[3], float *out, float *tmp);
+
 /* Signed distance callback (m, positive inside) used to build shapes. */
 typedef float (*field_sdf_fn)(void *ctx, vec3_t x_m);
 
 /* Sets every coefficient whose centre lies in [lo_m, hi_m] to the profile of sd (quasi-
  * interpolation), refreshes the samples and makes them the rest shape. */
 argil_err_t field_fill(field_t *f, field_sdf_fn sd, void *ctx, vec3_t lo_m, vec3_t hi_m);
+
+/* Knot insertion at the middle of every knot span (uniform refinement by the two-scale relation
+ * of the cubic B-spline, per axis q_2c = (p_c-1 + 6 p_c + p_c+1) / 8, q_2c+1 = (p_c + p_c+1) / 2):
+ * the knot spacing halves and the field's value is unchanged everywhere (to float rounding).
+ * The samples keep their lattice (the ratio halves, so it must be even) and every sample channel
+ * but d, which is recomputed from the new coefficients; velocities refine like p; a new
+ * coefficient is fixed when all the coefficients it is made from were. band_m stays.
+ * ARGIL_ERR_ARG for an odd ratio or indices that would leave the sparse range (field unchanged);
+ * ARGIL_ERR_NOMEM (unchanged when it happens before the new coefficients replace the old, else
+ * some d may still hold the old values: field_refresh them). */
+argil_err_t field_refine(field_t *f);
 
 #endif

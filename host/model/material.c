@@ -22,6 +22,15 @@ static bool material_box(const field_t *f, float h, vec3_t c, float r, int32_t l
     return true;
 }
 
+/* Closes the open undo step (whatever was changed, even partly, is one step); the first error wins. */
+static argil_err_t material_done(undo_t *u, const field_t *f, argil_err_t e)
+{
+    if (u == NULL)
+        return e;
+    const argil_err_t ec = undo_commit(u, f);
+    return e != ARGIL_OK ? e : ec;
+}
+
 argil_err_t material_paint(field_t *f, int ch, vec3_t centre_m, float radius_m, float amount,
                            material_mode_t mode, undo_t *u)
 {
@@ -41,7 +50,7 @@ argil_err_t material_paint(field_t *f, int ch, vec3_t centre_m, float radius_m, 
     const size_t vol = (size_t)n[0] * n[1] * n[2];
     float *v = malloc(sizeof(float) * vol);
     if (v == NULL)
-        return ARGIL_ERR_NOMEM;
+        return material_done(u, f, ARGIL_ERR_NOMEM);
     sparse_read_box(&f->samp, ch, lo, n, v);
     size_t i = 0;
     for (int32_t z = 0; z < n[2]; z++)
@@ -60,7 +69,7 @@ argil_err_t material_paint(field_t *f, int ch, vec3_t centre_m, float radius_m, 
             }
     e = sparse_write_box(&f->samp, ch, lo, n, v);
     free(v);
-    return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
+    return material_done(u, f, e);
 }
 
 argil_err_t material_fix(field_t *f, vec3_t centre_m, float radius_m, bool fixed, undo_t *u)
@@ -86,7 +95,7 @@ argil_err_t material_fix(field_t *f, vec3_t centre_m, float radius_m, bool fixed
                 if (e == ARGIL_OK && fixed)
                     e = sparse_set(&f->coef, FC_V, c[0], c[1], c[2], 0.0f);
             }
-    return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
+    return material_done(u, f, e);
 }
 
 argil_err_t material_reset_rest(field_t *f, const int32_t slo[3], const int32_t shi[3], undo_t *u)
@@ -106,7 +115,7 @@ argil_err_t material_reset_rest(field_t *f, const int32_t slo[3], const int32_t 
         return e;
     float *v = malloc(sizeof(float) * (size_t)vol);
     if (v == NULL)
-        return ARGIL_ERR_NOMEM;
+        return material_done(u, f, ARGIL_ERR_NOMEM);
     sparse_read_box(&f->samp, FS_D, slo, n, v);
     e = sparse_write_box(&f->samp, FS_REST, slo, n, v); /* elastic → plastic (McDonnell §7.3) */
     for (int64_t i = 0; i < vol; i++)
@@ -114,5 +123,5 @@ argil_err_t material_reset_rest(field_t *f, const int32_t slo[3], const int32_t 
     if (e == ARGIL_OK)
         e = sparse_write_box(&f->samp, FS_RESTLEN, slo, n, v);
     free(v);
-    return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
+    return material_done(u, f, e);
 }

@@ -10,7 +10,11 @@
 #define SOLVER_BOX_MAX ((int64_t)1 << 26)
 /* The separable passes and the spring stencil are simple streaming loops: -O3 vectorises them
  * (gcc's -O2 cost model leaves loops of unknown trip count scalar). */
+#if defined(__GNUC__) && !defined(__clang__)
 #define SOLVER_HOT __attribute__((optimize("O3")))
+#else
+#define SOLVER_HOT /* clang has no per-function optimize attribute (it ignores it, with a warning) */
+#endif
 
 void solver_cfg_default(solver_cfg_t *c)
 {
@@ -39,6 +43,7 @@ void solver_free(solver_t *s)
         free(s->tapt_hi[a]);
     }
     free(s->kdiag);
+    free(s->sdiag);
     free(s->p);
     free(s->p_prev);
     free(s->fixed);
@@ -92,6 +97,7 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
         ok = ok && s->tap_first[a] && s->tap_w[a] && s->kedge[a] && s->tapt_lo[a] && s->tapt_hi[a];
     }
     s->kdiag = calloc(s->nsamp, sizeof(float));
+    s->sdiag = calloc(s->nsamp, sizeof(float));
     s->p = calloc(s->ncoef, sizeof(float));
     s->p_prev = calloc(s->ncoef, sizeof(float));
     s->fixed = calloc(s->ncoef, 1);
@@ -113,7 +119,7 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
     }
     const size_t mid = (size_t)ns[0] * nc[1] * nc[2] + (size_t)ns[0] * ns[1] * nc[2];
     s->w_mid = malloc(mid * sizeof(float));
-    ok = ok && s->kdiag && s->p && s->p_prev && s->fixed && s->mlump && s->dlump && s->d_fixed && s->mass_kg &&
+    ok = ok && s->kdiag && s->sdiag && s->p && s->p_prev && s->fixed && s->mlump && s->dlump && s->d_fixed && s->mass_kg &&
          s->damp_n_s && s->kscale && s->rest && s->force_n && s->w_mid;
     if (!ok) {
         solver_free(s);
@@ -162,41 +168,80 @@ SOLVER_HOT static void solver_apply_A(solver_t *s, const float *restrict x, floa
     }
 }
 
+#define SOLVER_GATHER_MAX 32
+
+/* q = Σ_k w_k src_k over len floats (q += when acc), four inputs a pass: q is written n/4 times,
+ * not n. */
+SOLVER_HOT static void solver_gather(float *restrict q, const float *const *src, const float *w, int n,
+                                     size_t len, bool acc)
+{
+    if (n == 0) {
+        if (!acc)
+            memset(q, 0, sizeof(float) * len);
+        return;
+    }
+    for (int g = 0; g < n; g += 4) {
+        const int m = n - g < 4 ? n - g : 4; /* missing inputs: weight 0 on the first one */
+        const float *restrict s0 = src[g], *restrict s1 = src[g + (m > 1)], *restrict s2 = src[g + 2 * (m > 2)],
+                          *restrict s3 = src[g + 3 * (m > 3)];
+        const float w0 = w[g], w1 = m > 1 ? w[g + 1] : 0.0f, w2 = m > 2 ? w[g + 2] : 0.0f,
+                    w3 = m > 3 ? w[g + 3] : 0.0f;
+        if (g == 0 && !acc)
+            for (size_t i = 0; i < len; i++)
+                q[i] = w0 * s0[i] + w1 * s1[i] + w2 * s2[i] + w3 * s3[i];
+        else
+            for (size_t i = 0; i < len; i++)
+                q[i] += w0 * s0[i] + w1 * s1[i] + w2 * s2[i] + w3 * s3[i];
+    }
+}
+
 /* x = Aᵀ y (coefficients from samples), the transpose of solver_apply_A. */
 SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, float *restrict x)
 {
+    const float *const tw[3] = {s->tap_w[0], s->tap_w[1], s->tap_w[2]};
     const int32_t *nc = s->nc, *ns = s->ns;
     float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
     const size_t plane = (size_t)ns[0] * ns[1];
-    /* gathered per coefficient plane (the plane stays in cache), samples in ascending order: the
-     * same sums as scattering sample by sample */
+    /* gathered per coefficient plane (each output plane written once, four input planes a pass) */
+    const float *gs[SOLVER_GATHER_MAX];
+    float gw[SOLVER_GATHER_MAX];
     for (int32_t c = 0; c < nc[2]; c++) {
-        float *restrict q = T2 + plane * (size_t)c;
-        memset(q, 0, sizeof(float) * plane);
+        float *q = T2 + plane * (size_t)c;
+        int n = 0;
+        bool acc = false;
         for (int32_t k = s->tapt_lo[2][c]; k < s->tapt_hi[2][c]; k++) {
             const int32_t j = c - s->tap_first[2][k];
             if (j < 0 || j > 3)
                 continue;
-            const float w = s->tap_w[2][4 * k + j];
-            const float *restrict src = y + plane * (size_t)k;
-            for (size_t i = 0; i < plane; i++)
-                q[i] += w * src[i];
+            gw[n] = tw[2][4 * k + j];
+            gs[n++] = y + plane * (size_t)k;
+            if (n == SOLVER_GATHER_MAX) {
+                solver_gather(q, gs, gw, n, plane, acc);
+                n = 0;
+                acc = true;
+            }
         }
+        solver_gather(q, gs, gw, n, plane, acc);
     }
     const size_t st = (size_t)ns[0];
     for (int32_t z = 0; z < nc[2]; z++)
         for (int32_t c = 0; c < nc[1]; c++) {
-            float *restrict q = T1 + st * ((size_t)c + (size_t)nc[1] * z);
-            memset(q, 0, sizeof(float) * st);
+            float *q = T1 + st * ((size_t)c + (size_t)nc[1] * z);
+            int n = 0;
+            bool acc = false;
             for (int32_t k = s->tapt_lo[1][c]; k < s->tapt_hi[1][c]; k++) {
                 const int32_t j = c - s->tap_first[1][k];
                 if (j < 0 || j > 3)
                     continue;
-                const float w = s->tap_w[1][4 * k + j];
-                const float *restrict src = T2 + st * ((size_t)k + (size_t)ns[1] * z);
-                for (int32_t i = 0; i < ns[0]; i++)
-                    q[i] += w * src[i];
+                gw[n] = tw[1][4 * k + j];
+                gs[n++] = T2 + st * ((size_t)k + (size_t)ns[1] * z);
+                if (n == SOLVER_GATHER_MAX) {
+                    solver_gather(q, gs, gw, n, st, acc);
+                    n = 0;
+                    acc = true;
+                }
             }
+            solver_gather(q, gs, gw, n, st, acc);
         }
     const size_t rows = (size_t)nc[1] * nc[2];
     memset(x, 0, sizeof(float) * s->ncoef);
@@ -204,7 +249,7 @@ SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, flo
         const float *src = T1 + r * ns[0];
         float *dst = x + r * nc[0];
         for (int32_t i = 0; i < ns[0]; i++) {
-            const float *w = s->tap_w[0] + 4 * i;
+            const float *w = tw[0] + 4 * i;
             float *q = dst + s->tap_first[0][i];
             const float v = src[i];
             q[0] += w[0] * v;
@@ -270,36 +315,54 @@ void solver_material_changed(solver_t *s)
             s->mlump[i] = 1.0e-12f;
 }
 
-/* K e at sample i with every neighbour checked against the array ends. */
-static float solver_K_at(const solver_t *s, const float *e, size_t i)
+/* diag_i e_i - c Σ_a (k_a,i e_{i+a} + k_a,i-a e_{i-a}) at sample i, every neighbour checked
+ * against the array ends. */
+static float solver_K_at(const solver_t *s, const float *diag, float c, const float *e, size_t i)
 {
     const size_t st[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
-    float v = s->kdiag[i] * e[i];
+    float v = 0.0f;
     for (int a = 0; a < 3; a++) {
         if (i + st[a] < s->nsamp)
-            v -= s->kedge[a][i] * e[i + st[a]];
+            v += s->kedge[a][i] * e[i + st[a]];
         if (i >= st[a])
-            v -= s->kedge[a][i - st[a]] * e[i - st[a]];
+            v += s->kedge[a][i - st[a]] * e[i - st[a]];
     }
-    return v;
+    return diag[i] * e[i] - c * v;
 }
 
-/* out = K e on samples: rest springs plus the six neighbour springs (Hua & Qin eq. 6),
- * (K e)_i = kdiag_i e_i - Σ_a k_a,i e_{i+a} - k_a,i-a e_{i-a}; springs across the region's
- * border have k = 0, so only the first and last planes need bounds checks. */
-SOLVER_HOT static void solver_apply_K(const solver_t *s, const float *restrict e, float *restrict out)
+/* out = diag ⊙ e - c Σ neighbour springs: with diag = kdiag and c = 1 this is K e on samples, the
+ * rest springs plus the six neighbour springs (Hua & Qin eq. 6), (K e)_i = kdiag_i e_i -
+ * Σ_a k_a,i e_{i+a} - k_a,i-a e_{i-a}; with diag = sdiag and c = 2 dt² it is the whole sample
+ * operator of eq. 12 in one pass. Springs across the region's border have k = 0, so only the
+ * first and last planes (and within them the first and last rows) need bounds checks. */
+SOLVER_HOT static void solver_apply_Kd(const solver_t *s, const float *restrict diag, float c,
+                                       const float *restrict e, float *restrict out)
 {
     const size_t n = s->nsamp, sy = (size_t)s->ns[0], sz = sy * (size_t)s->ns[1];
-    const size_t lo = sz < n ? sz : n, hi = n > 2 * sz ? n - sz : lo;
-    for (size_t i = 0; i < lo; i++)
-        out[i] = solver_K_at(s, e, i);
-    const float *restrict kd = s->kdiag, *restrict kx = s->kedge[0], *restrict ky = s->kedge[1],
-                          *restrict kz = s->kedge[2];
-    for (size_t i = lo; i < hi; i++)
-        out[i] = kd[i] * e[i] - kx[i] * e[i + 1] - kx[i - 1] * e[i - 1] - ky[i] * e[i + sy] -
-                 ky[i - sy] * e[i - sy] - kz[i] * e[i + sz] - kz[i - sz] * e[i - sz];
-    for (size_t i = hi; i < n; i++)
-        out[i] = solver_K_at(s, e, i);
+    if (n < 2 * sz) { /* a single plane: every neighbour checked */
+        for (size_t i = 0; i < n; i++)
+            out[i] = solver_K_at(s, diag, c, e, i);
+        return;
+    }
+    const float *restrict kx = s->kedge[0], *restrict ky = s->kedge[1], *restrict kz = s->kedge[2];
+    for (size_t i = 0; i < sy; i++) /* first row */
+        out[i] = solver_K_at(s, diag, c, e, i);
+    for (size_t i = sy; i < sz; i++) /* first plane: no neighbour below */
+        out[i] = diag[i] * e[i] - c * (kx[i] * e[i + 1] + kx[i - 1] * e[i - 1] + ky[i] * e[i + sy] +
+                                       ky[i - sy] * e[i - sy] + kz[i] * e[i + sz]);
+    for (size_t i = sz; i < n - sz; i++)
+        out[i] = diag[i] * e[i] - c * (kx[i] * e[i + 1] + kx[i - 1] * e[i - 1] + ky[i] * e[i + sy] +
+                                       ky[i - sy] * e[i - sy] + kz[i] * e[i + sz] + kz[i - sz] * e[i - sz]);
+    for (size_t i = n - sz; i < n - sy; i++) /* last plane: no neighbour above */
+        out[i] = diag[i] * e[i] - c * (kx[i] * e[i + 1] + kx[i - 1] * e[i - 1] + ky[i] * e[i + sy] +
+                                       ky[i - sy] * e[i - sy] + kz[i - sz] * e[i - sz]);
+    for (size_t i = n - sy; i < n; i++) /* last row */
+        out[i] = solver_K_at(s, diag, c, e, i);
+}
+
+static void solver_apply_K(const solver_t *s, const float *e, float *out)
+{
+    solver_apply_Kd(s, s->kdiag, 1.0f, e, out);
 }
 
 void solver_densities(solver_t *s, float *d)
@@ -407,15 +470,14 @@ static void solver_reduce(const solver_t *s, float *y)
             y[i] = 0.0f;
 }
 
-/* y = (2 M~ + dt D~ + 2 dt² K~) x, matrix-free (left side of Hua & Qin eq. 12). */
-SOLVER_HOT static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
+/* y = (2 M~ + dt D~ + 2 dt² K~) x, matrix-free (left side of Hua & Qin eq. 12); sdiag must hold
+ * 2 m + dt D + 2 dt² kdiag for this dt (solver_step_implicit sets it). */
+static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
 {
     float *d = s->w_ns[0], *kd = s->w_ns[1];
-    solver_apply_A(s, x, d);
-    solver_apply_K(s, d, kd);
     const float c2 = 2.0f * dt * dt;
-    for (size_t i = 0; i < s->nsamp; i++)
-        kd[i] = (2.0f * s->mass_kg[i] + dt * s->damp_n_s[i]) * d[i] + c2 * kd[i];
+    solver_apply_A(s, x, d);
+    solver_apply_Kd(s, s->sdiag, c2, d, kd);
     solver_apply_At(s, kd, y);
     for (int32_t r = 0; r < s->nsoft; r++) {
         const solver_row_t *row = &s->soft[r];
@@ -431,6 +493,19 @@ static double solver_dot(const float *a, const float *b, size_t n)
     for (size_t i = 0; i < n; i++)
         v += (double)a[i] * b[i];
     return v;
+}
+
+/* x += alpha q, r -= alpha Sq in one pass; returns |r|² */
+static double solver_cg_update(float *restrict x, float *restrict r, const float *restrict q,
+                               const float *restrict Sq, float alpha, size_t n)
+{
+    double rr = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        x[i] += alpha * q[i];
+        r[i] -= alpha * Sq[i];
+        rr += (double)r[i] * r[i];
+    }
+    return rr;
 }
 
 /* p_prev moved so that (p - p_prev) / dt keeps the velocity when the step changes. */
@@ -475,6 +550,8 @@ argil_err_t solver_step_implicit(solver_t *s)
             ke[i] = c2 * (s->force_n[i] + ke[i]) + 4.0f * s->mass_kg[i] * dA[i] -
                     (2.0f * s->mass_kg[i] - dt * s->damp_n_s[i]) * dB[i];
         solver_apply_At(s, ke, rhs);
+        for (size_t i = 0; i < s->nsamp; i++)
+            s->sdiag[i] = 2.0f * s->mass_kg[i] + dt * s->damp_n_s[i] + c2 * s->kdiag[i];
         for (int32_t k = 0; k < s->nsoft; k++) {
             const solver_row_t *row = &s->soft[k];
             for (int32_t j = 0; j < row->n; j++)
@@ -502,12 +579,7 @@ argil_err_t solver_step_implicit(solver_t *s)
             const double qSq = solver_dot(q, Sq, s->ncoef);
             if (!(qSq > 0.0))
                 break;
-            const double alpha = rr / qSq;
-            for (size_t i = 0; i < s->ncoef; i++) {
-                x[i] += (float)alpha * q[i];
-                r[i] -= (float)alpha * Sq[i];
-            }
-            const double rr_new = solver_dot(r, r, s->ncoef);
+            const double rr_new = solver_cg_update(x, r, q, Sq, (float)(rr / qSq), s->ncoef);
             const double beta = rr_new / rr;
             rr = rr_new;
             for (size_t i = 0; i < s->ncoef; i++)

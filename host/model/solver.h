@@ -59,6 +59,7 @@ typedef struct {
     float k_rest_n, coupling_n;  /* base stiffness of the rest and the neighbour springs */
     float *kedge[3];             /* samples: neighbour spring to +x/+y/+z (derived) */
     float *kdiag;                /* samples: rest spring + the 6 neighbour springs (derived) */
+    float *sdiag;                /* samples: 2 m + dt D + 2 dt² kdiag of the implicit step (derived) */
     solver_row_t *soft, *hard;
     int32_t nsoft, nhard, soft_cap, hard_cap;
     solver_cfg_t cfg;

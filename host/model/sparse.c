@@ -5,11 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-int32_t sparse_block_of(int32_t i)
-{
-    return i >= 0 ? i / SPARSE_B : -((-i + SPARSE_B - 1) / SPARSE_B);
-}
-
 static int32_t sparse_local(int32_t i)
 {
     return i - sparse_block_of(i) * SPARSE_B;

@@ -32,8 +32,11 @@ typedef struct {
 argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults);
 void sparse_free(sparse_t *s);
 
-/* Floor division of a lattice index by SPARSE_B, and the index within the block. */
-int32_t sparse_block_of(int32_t i);
+/* Floor division of a lattice index by SPARSE_B (inline: the tools call it per coefficient). */
+static inline int32_t sparse_block_of(int32_t i)
+{
+    return i >= 0 ? i / SPARSE_B : -((-i + SPARSE_B - 1) / SPARSE_B);
+}
 
 /* The block holding key, or NULL. */
 sparse_block_t *sparse_find(const sparse_t *s, const int32_t key[3]);

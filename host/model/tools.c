@@ -25,6 +25,8 @@ void tool_params_default(tool_params_t *p, tool_action_t action)
     p->stamp.n = 0.3f;
     p->depth_m = 0.0f;
     p->alpha = -1.0f;
+    p->fit = TOOL_FIT_QUASI;
+    p->fit_iters = 6;
 }
 
 void tool_pose_at(tool_pose_t *pose, vec3_t pos_m)
@@ -157,9 +159,21 @@ static bool tool_shape_ok(const tool_shape_t *t)
     }
 }
 
+/* True for the actions whose per-point rule needs only the old value and the signed distance,
+ * so it applies to samples as well as to coefficients (the least-squares fit needs that). */
+static bool tool_action_lsq_ok(tool_action_t a)
+{
+    return a == TOOL_CARVE || a == TOOL_ADD || a == TOOL_TOOTHPASTE || a == TOOL_SOFT_ERASE ||
+           a == TOOL_STAMP || a == TOOL_CONTACT;
+}
+
 static bool tool_params_ok(const tool_params_t *p)
 {
     const tool_stamp_t *s = &p->stamp;
+    if (p->fit != TOOL_FIT_QUASI &&
+        (p->fit != TOOL_FIT_LSQ || !tool_action_lsq_ok(p->action) || p->fit_iters < 1 ||
+         p->fit_iters > TOOL_FIT_ITERS_MAX))
+        return false;
     return (unsigned)p->action <= TOOL_CONTACT && isfinite(p->strength) && p->strength >= 0.0f &&
            isfinite(p->depth_m) && isfinite(p->alpha) && isfinite(p->rgb[0]) && isfinite(p->rgb[1]) &&
            isfinite(p->rgb[2]) && vec3_isfinite(p->mirror_origin_m) && (p->mirror >> 3) == 0 &&
@@ -304,20 +318,158 @@ static argil_err_t tool_store_samples(field_t *f, const int32_t key[3], const in
                 float *d = &b->data[FS_D * SPARSE_BN + li], *r = &b->data[FS_REST * SPARSE_BN + li];
                 if (memcmp(d, &dnew[i], sizeof(float)) == 0)
                     continue;
-                const float rnew = *r + (dnew[i] - *d);
-                if (u != NULL) {
+                if (u != NULL) { /* one 12-byte change: undo_note_drest recomputes the rest alike */
                     const int32_t ijk[3] = {lo[0] + x, lo[1] + y, lo[2] + z};
-                    argil_err_t e = undo_note(u, UNDO_STORE_SAMP, FS_D, ijk, *d, dnew[i]);
-                    if (e == ARGIL_OK && memcmp(r, &rnew, sizeof(float)) != 0)
-                        e = undo_note(u, UNDO_STORE_SAMP, FS_REST, ijk, *r, rnew);
+                    const argil_err_t e = undo_note_drest(u, ijk, *d, dnew[i], *r);
                     if (e != ARGIL_OK)
                         return e;
                 }
+                *r = *r + (dnew[i] - *d); /* the edit is plastic: the rest shape moves with it */
                 *d = dnew[i];
-                *r = rnew;
                 (*nchanged)++;
             }
     return ARGIL_OK;
+}
+
+/* Marks the sample blocks coefficient c reaches: samples ((c-2)R, (c+2)R) per axis. */
+static void tool_mark_reach(const int32_t c[3], int32_t R, const int32_t klo[3], const int32_t kn[3],
+                            uint8_t *mark)
+{
+    int32_t k0[3], k1[3];
+    for (int a = 0; a < 3; a++) {
+        k0[a] = sparse_block_of((c[a] - 2) * R + 1) - klo[a];
+        k1[a] = sparse_block_of((c[a] + 2) * R - 1) - klo[a];
+        k0[a] = k0[a] < 0 ? 0 : k0[a];
+        k1[a] = k1[a] >= kn[a] ? kn[a] - 1 : k1[a];
+    }
+    for (int32_t kz = k0[2]; kz <= k1[2]; kz++)
+        for (int32_t ky = k0[1]; ky <= k1[1]; ky++)
+            for (int32_t kx = k0[0]; kx <= k1[0]; kx++)
+                mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)] = 1;
+}
+
+/* The boxes of one application: coefficients read [clo, clo+cn), free [blo, blo+bn), samples
+ * [slo, shi), sample blocks [klo, klo+kn). */
+typedef struct {
+    const int32_t *clo, *cn, *blo, *bn, *slo, *shi, *klo, *kn;
+} tool_box_t;
+
+static double tool_dot(const float *a, const float *b, size_t n)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; i++)
+        v += (double)a[i] * b[i];
+    return v;
+}
+
+/* Zeroes every coefficient of the C box outside the free box. */
+static void tool_mask_free(const tool_box_t *B, float *x)
+{
+    int32_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = B->blo[a] - B->clo[a];
+        hi[a] = lo[a] + B->bn[a];
+    }
+    const size_t row = (size_t)B->cn[0];
+    for (int32_t z = 0; z < B->cn[2]; z++)
+        for (int32_t y = 0; y < B->cn[1]; y++) {
+            float *r = x + row * ((size_t)y + (size_t)B->cn[1] * z);
+            if (z < lo[2] || z >= hi[2] || y < lo[1] || y >= hi[1]) {
+                memset(r, 0, sizeof(float) * row);
+                continue;
+            }
+            memset(r, 0, sizeof(float) * (size_t)lo[0]);
+            memset(r + hi[0], 0, sizeof(float) * (row - (size_t)hi[0]));
+        }
+}
+
+/* Hua & Qin §6.2 least-squares fit: the free coefficients minimise Σ_s (A p - d_target)² over the
+ * samples they reach, d_target = the action applied to each sample's old density; CGLS from the
+ * quasi-interpolated values (the change list on entry), whose result replaces the change list. */
+static argil_err_t tool_fit_lsq(field_t *f, const tool_union_t *U, const tool_params_t *p, float bound,
+                                const tool_box_t *B, const float *C, uint32_t *ch_ci, float *ch_after,
+                                size_t *nch, uint8_t *mark)
+{
+    int32_t sn[3];
+    size_t ns = 1, nc = 1;
+    for (int a = 0; a < 3; a++) {
+        sn[a] = B->shi[a] - B->slo[a];
+        ns *= (size_t)sn[a];
+        nc *= (size_t)B->cn[a];
+    }
+    const size_t ntA = (size_t)sn[0] * B->cn[1] * B->cn[2] + (size_t)sn[0] * sn[1] * B->cn[2];
+    const size_t ntT = (size_t)B->cn[0] * sn[1] * sn[2] + (size_t)B->cn[0] * B->cn[1] * sn[2];
+    float *buf = malloc(sizeof(float) * (3 * ns + 3 * nc + (ntA > ntT ? ntA : ntT)));
+    if (buf == NULL)
+        return ARGIL_ERR_NOMEM;
+    float *r = buf, *q = r + ns, *dt = q + ns, *P = dt + ns, *g = P + nc, *dir = g + nc, *tmp = dir + nc;
+    memcpy(P, C, sizeof(float) * nc);
+    for (size_t k = 0; k < *nch; k++)
+        P[ch_ci[k]] = ch_after[k];
+    /* targets: the action applied to the samples' old densities */
+    field_samples_from(f, C, B->clo, B->cn, B->slo, B->shi, dt, tmp);
+    size_t i = 0;
+    for (int32_t z = 0; z < sn[2]; z++)
+        for (int32_t y = 0; y < sn[1]; y++)
+            for (int32_t x = 0; x < sn[0]; x++, i++) {
+                const int32_t s[3] = {B->slo[0] + x, B->slo[1] + y, B->slo[2] + z};
+                const vec3_t xs = field_sample_pos(f, s);
+                const float sd = tool_union_sd(U, xs);
+                if (sd != -INFINITY && !tool_coef_fixed_point(p->action, dt[i]))
+                    dt[i] = tool_action_coef(f, p, bound, dt[i], sd, xs, NULL);
+            }
+    /* CGLS on A_F p_F = d_target - A_X p_X */
+    field_samples_from(f, P, B->clo, B->cn, B->slo, B->shi, r, tmp);
+    for (i = 0; i < ns; i++)
+        r[i] = dt[i] - r[i];
+    field_coefs_from(f, r, B->slo, B->shi, B->clo, B->cn, g, tmp);
+    tool_mask_free(B, g);
+    memcpy(dir, g, sizeof(float) * nc);
+    double gamma = tool_dot(g, g, nc);
+    for (int32_t it = 0; it < p->fit_iters && gamma > 0.0; it++) {
+        field_samples_from(f, dir, B->clo, B->cn, B->slo, B->shi, q, tmp);
+        const double qq = tool_dot(q, q, ns);
+        if (!(qq > 0.0))
+            break;
+        const float alpha = (float)(gamma / qq);
+        for (i = 0; i < nc; i++)
+            P[i] += alpha * dir[i];
+        for (i = 0; i < ns; i++)
+            r[i] -= alpha * q[i];
+        field_coefs_from(f, r, B->slo, B->shi, B->clo, B->cn, g, tmp);
+        tool_mask_free(B, g);
+        const double gn = tool_dot(g, g, nc);
+        const float beta = (float)(gn / gamma);
+        gamma = gn;
+        for (i = 0; i < nc; i++)
+            dir[i] = g[i] + beta * dir[i];
+    }
+    /* the fitted coefficients become the change list */
+    *nch = 0;
+    size_t nk = 1;
+    for (int a = 0; a < 3; a++)
+        nk *= (size_t)B->kn[a];
+    memset(mark, 0, nk);
+    const size_t sy = (size_t)B->cn[0], sz = sy * B->cn[1];
+    argil_err_t e = ARGIL_OK;
+    for (int32_t z = 0; z < B->bn[2]; z++)
+        for (int32_t y = 0; y < B->bn[1]; y++)
+            for (int32_t x = 0; x < B->bn[0]; x++) {
+                const int32_t c[3] = {B->blo[0] + x, B->blo[1] + y, B->blo[2] + z};
+                const size_t ci = (size_t)(c[0] - B->clo[0]) + sy * (size_t)(c[1] - B->clo[1]) +
+                                  sz * (size_t)(c[2] - B->clo[2]);
+                if (!isfinite(P[ci]))
+                    e = ARGIL_ERR_NONFINITE;
+                if (memcmp(&P[ci], &C[ci], sizeof(float)) == 0 || e != ARGIL_OK)
+                    continue;
+                ch_ci[*nch] = (uint32_t)ci;
+                ch_after[(*nch)++] = P[ci];
+                tool_mark_reach(c, f->ratio, B->klo, B->kn, mark);
+            }
+    free(buf);
+    if (e != ARGIL_OK)
+        *nch = 0;
+    return e;
 }
 
 /* Coefficient actions: new coefficients over [blo, bhi) from one read of the box (plus the ring
@@ -378,20 +530,14 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
                     continue;
                 ch_ci[nch] = (uint32_t)ci;
                 ch_after[nch++] = pnew;
-                /* sample blocks this coefficient reaches: samples ((c-2)R, (c+2)R) per axis */
-                int32_t k0[3], k1[3];
-                for (int a = 0; a < 3; a++) {
-                    k0[a] = sparse_block_of((c[a] - 2) * R + 1) - klo[a];
-                    k1[a] = sparse_block_of((c[a] + 2) * R - 1) - klo[a];
-                    k0[a] = k0[a] < 0 ? 0 : k0[a];
-                    k1[a] = k1[a] >= kn[a] ? kn[a] - 1 : k1[a];
-                }
-                for (int32_t kz = k0[2]; kz <= k1[2]; kz++)
-                    for (int32_t ky = k0[1]; ky <= k1[1]; ky++)
-                        for (int32_t kx = k0[0]; kx <= k1[0]; kx++)
-                            mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)] = 1;
+                tool_mark_reach(c, R, klo, kn, mark);
             }
         }
+    if (p->fit == TOOL_FIT_LSQ && nch > 0) {
+        const tool_box_t B = {clo, cn, blo, bn, slo, shi, klo, kn};
+        if ((e = tool_fit_lsq(f, U, p, bound, &B, C, ch_ci, ch_after, &nch, mark)) != ARGIL_OK)
+            goto out;
+    }
     if (stats != NULL) {
         stats->coefs_visited += nb;
         stats->coefs_changed += nch;
@@ -481,13 +627,14 @@ static argil_err_t tool_apply_union(field_t *f, const tool_union_t *U, const too
         const size_t n = (size_t)vol;
         float *buf = malloc(sizeof(float) * n * 4);
         if (buf == NULL)
-            return ARGIL_ERR_NOMEM;
-        float *d = buf + 3 * n;
-        for (int c = 0; c < 3; c++)
+            e = ARGIL_ERR_NOMEM;
+        float *d = buf != NULL ? buf + 3 * n : NULL;
+        for (int c = 0; c < 3 && buf != NULL; c++)
             sparse_read_box(&f->samp, FS_R + c, blo, bn, buf + (size_t)c * n);
-        sparse_read_box(&f->samp, FS_D, blo, bn, d);
+        if (buf != NULL)
+            sparse_read_box(&f->samp, FS_D, blo, bn, d);
         size_t i = 0;
-        for (int32_t z = 0; z < bn[2]; z++)
+        for (int32_t z = 0; z < bn[2] && buf != NULL; z++)
             for (int32_t y = 0; y < bn[1]; y++)
                 for (int32_t x = 0; x < bn[0]; x++, i++) {
                     const int32_t s[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
@@ -507,7 +654,11 @@ static argil_err_t tool_apply_union(field_t *f, const tool_union_t *U, const too
         free(buf);
         if (stats != NULL)
             stats->samples_refreshed += n;
-        return e == ARGIL_OK && u != NULL ? undo_commit(u, f) : e;
+        if (u != NULL) { /* whatever was done, even partly, is one undo step */
+            const argil_err_t ec = undo_commit(u, f);
+            e = e != ARGIL_OK ? e : ec;
+        }
+        return e;
     }
     return tool_apply_coefs(f, U, p, blo, bhi, u, stats);
 }

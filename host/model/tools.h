@@ -59,6 +59,15 @@ typedef enum {
     TOOL_CONTACT           /* Zhang et al. §3: h = f + β g, g = α (f_tool - c) */
 } tool_action_t;
 
+/* How an application turns the tool into coefficients. QUASI (the default, fastest): each
+ * coefficient takes the action's value at its own centre (quasi-interpolation). LSQ (Hua & Qin
+ * §6.2): the coefficients of the tool's box are fitted in the least-squares sense to the
+ * tool-modified samples, min Σ_s (A p - d_target)², by fit_iters CGLS iterations from the
+ * quasi-interpolated start, matrix-free with the separable A and Aᵀ; the ring of coefficients
+ * around the box stays. LSQ serves carve, add, toothpaste, soft erase, stamp and contact. */
+typedef enum { TOOL_FIT_QUASI = 0, TOOL_FIT_LSQ } tool_fit_t;
+#define TOOL_FIT_ITERS_MAX 32
+
 /* Ferley Fig. 11-12 deformation function parameters: def(0) = -1, def(s) = 0 with slope k,
  * def(s + m) = n (the bulge) with slope 0, def(s + m + r) = 0; C1, cubic pieces. */
 typedef struct {
@@ -74,6 +83,8 @@ typedef struct {
     float alpha;           /* Zhang contact: < 0 dents, > 0 bulges */
     uint32_t mirror;       /* bit a: also apply mirrored across the plane axis a = mirror_origin */
     vec3_t mirror_origin_m;
+    tool_fit_t fit;        /* TOOL_FIT_QUASI (default) or TOOL_FIT_LSQ */
+    int32_t fit_iters;     /* LSQ: CGLS iterations, 1..TOOL_FIT_ITERS_MAX (default 6) */
 } tool_params_t;
 
 typedef struct {

@@ -13,34 +13,45 @@
 
 #define UNDO_STORE_COEF 0
 #define UNDO_STORE_SAMP 1
+#define UNDO_STORE_DREST 2   /* a sample's density and rest moved together (plastic edit) */
 
+/* A run of changes at consecutive x indices of one store and channel, starting at ijk; it is
+ * followed in the journal by n (before, after) float pairs: 16 B + 8 B per change; for
+ * UNDO_STORE_DREST by n (d before, d after, rest before) triples: 16 B + 12 B per change. */
 typedef struct {
     uint8_t store, ch;
+    uint16_t n;
     int32_t ijk[3];
-    float before, after;
-} undo_entry_t;
+} undo_run_t;
 
+/* One step: a contiguous stretch [off, off + len) of the ring (modulo its size). */
 typedef struct {
-    undo_entry_t *e;
-    size_t n;
+    size_t off, len;
+    size_t n;                 /* changes held */
 } undo_step_t;
 
 typedef struct {
-    undo_step_t *steps;
+    uint8_t *ring;            /* the journal: mapped and faulted in once, reused as a ring */
+    size_t ring_cap;          /* bytes; the budget, or more after one step larger than it */
+    undo_step_t *steps;       /* oldest first; consecutive in the ring */
     size_t nsteps;            /* steps held (done + redoable) */
     size_t done;              /* steps currently applied; steps[done..nsteps) can be redone */
     size_t cap;
-    size_t bytes, budget_bytes;
+    size_t bytes, budget_bytes; /* bytes held by the steps */
     bool open;                /* between undo_begin and undo_commit */
     int32_t clo[3], cdims[3], slo[3], sdims[3];
     uint32_t cmask, smask;    /* channels snapshotted */
     float *snap;
     size_t snap_cap;
-    undo_entry_t *pend;       /* entries noted by the editor during the open step */
-    size_t npend, pend_cap;
+    undo_step_t cur;          /* the open step */
+    undo_run_t run;           /* its last run, header not yet written */
+    size_t run_off;           /* where that header goes */
 } undo_t;
 
-void undo_init(undo_t *u, size_t budget_bytes);
+/* An empty journal whose ring of budget_bytes is mapped and faulted in now, so that recording
+ * a step never waits on a first-touch page fault. ARGIL_ERR_NOMEM (the journal then grows on
+ * demand instead). */
+argil_err_t undo_init(undo_t *u, size_t budget_bytes);
 void undo_free(undo_t *u);
 
 /* Snapshots the channels in cmask (coefficients, box [clo, chi)) and smask (samples, [slo, shi))
@@ -49,12 +60,21 @@ argil_err_t undo_begin(undo_t *u, const field_t *f, const int32_t clo[3], const 
                        uint32_t cmask, const int32_t slo[3], const int32_t shi[3], uint32_t smask);
 
 /* Adds one change the editor made itself (instead of a snapshotted box) to the open step; each
- * point must be noted at most once per step and not also lie in a snapshotted channel.
- * ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
+ * point must be noted at most once per step and not also lie in a snapshotted channel. Changes
+ * noted in increasing x along a row share one run header. store is UNDO_STORE_COEF or
+ * UNDO_STORE_SAMP (else ARGIL_ERR_ARG). ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
 argil_err_t undo_note(undo_t *u, int store, int ch, const int32_t ijk[3], float before, float after);
 
+/* Notes one sample whose density went from d_before to d_after while its rest density moved by
+ * the same amount from rest_before (rest_before + (d_after - d_before), the plastic edit of the
+ * tools): 12 B instead of two 8 B changes; redo recomputes the rest with that same expression.
+ * ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
+argil_err_t undo_note_drest(undo_t *u, const int32_t ijk[3], float d_before, float d_after, float rest_before);
+
 /* Records what changed since undo_begin as one step (none when nothing changed), drops the redo
- * steps, then the oldest steps while over budget. ARGIL_ERR_STATE without undo_begin. */
+ * steps, then the oldest steps while over budget; the newest step is always kept, even when it
+ * alone is larger than the budget. Oldest steps may already be dropped while the open step
+ * grows. ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
 argil_err_t undo_commit(undo_t *u, const field_t *f);
 
 /* Reverts / re-applies one step; ARGIL_ERR_EMPTY when there is none. Changed blocks become dirty. */

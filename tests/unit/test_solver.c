@@ -222,8 +222,14 @@ static float push_displacement(float stiff_scale)
 {
     field_t f;
     make_ball(&f);
-    if (stiff_scale != 1.0f)
-        assert_int_equal(material_paint(&f, FS_STIFF, vec3(0, 0, 0), 1.0f, stiff_scale, MATERIAL_SCALE, NULL), ARGIL_OK);
+    if (stiff_scale != 1.0f) { /* exactly stiff_scale on every sample the window below sees */
+        const int32_t slo[3] = {-8, -20, -20}, sdims[3] = {40, 40, 40};
+        float *k = malloc(sizeof(float) * 40 * 40 * 40);
+        for (size_t i = 0; i < 40 * 40 * 40; i++)
+            k[i] = stiff_scale;
+        assert_int_equal(sparse_write_box(&f.samp, FS_STIFF, slo, sdims, k), ARGIL_OK);
+        free(k);
+    }
     float x0 = 0.0f;
     for (float x = 0.0f; x < 0.1f; x += 0.0002f)
         if (field_eval(&f, vec3(x, 0, 0), NULL) < f.iso) {
