@@ -46,8 +46,10 @@ typedef enum {
     MSG_IMPULSE = 4,
     MSG_WINDOW = 5,
     MSG_TOOL = 6,
-    MSG_FAULT = 7
+    MSG_FAULT = 7,
+    MSG_RT_STATS = 8
 } msg_type_t;
+#define MSG_TYPE_LAST MSG_RT_STATS
 
 typedef enum { PROTO_ROLE_BOARD = 1, PROTO_ROLE_HOST = 2 } proto_role_t;
 
@@ -186,6 +188,26 @@ typedef struct {
     uint32_t detail;
 } msg_fault_t;
 
+#define PROTO_RT_HIST_BINS 12u      /* histogram bins of RT_STATS (firmware/core/rt_stats.h) */
+
+/* RT_STATS: board → host once a second (and when the board stops): the fast loop's deadline
+ * statistics since it started. All times in ns. */
+typedef struct {
+    uint64_t time_us;        /* board clock */
+    uint32_t ticks;          /* ticks measured */
+    uint32_t period_ns;      /* loop period, > 0 */
+    uint32_t wake_min_ns;    /* wake-up latency: min ≤ mean ≤ max */
+    uint32_t wake_mean_ns;
+    uint32_t wake_max_ns;
+    uint32_t compute_min_ns; /* compute time of a tick: min ≤ mean ≤ max */
+    uint32_t compute_mean_ns;
+    uint32_t compute_max_ns;
+    uint32_t overruns;       /* ticks whose latency + compute passed the period; ≤ ticks */
+    uint32_t worst_streak;   /* longest run of overruns; ≤ overruns */
+    uint32_t wake_hist[PROTO_RT_HIST_BINS];    /* wake-up latency histogram; sums to ticks */
+    uint32_t compute_hist[PROTO_RT_HIST_BINS]; /* compute time histogram; sums to ticks */
+} msg_rt_stats_t;
+
 typedef struct {
     uint8_t type;            /* msg_type_t */
     uint32_t seq;            /* from the frame header */
@@ -197,6 +219,7 @@ typedef struct {
         msg_window_t window;
         msg_tool_t tool;
         msg_fault_t fault;
+        msg_rt_stats_t rt_stats;
     } u;
 } proto_msg_t;
 
@@ -232,6 +255,11 @@ void window_asm_init(window_asm_t *a, float *storage, uint32_t capacity);
  * Returns PROTO_ERR_CHUNK when the chunk disagrees with its siblings or does not fit; a
  * disagreeing sibling abandons that version (it never completes; the next version restarts). */
 proto_err_t window_asm_feed(window_asm_t *a, const msg_window_t *chunk);
+
+/* window_asm_feed for a chunk that proto_decode returned with PROTO_OK: the same result
+ * without repeating the decoder's checks of its fields and samples (the board's 1 kHz tick
+ * decodes up to two chunks). Any other chunk must go through window_asm_feed. */
+proto_err_t window_asm_feed_decoded(window_asm_t *a, const msg_window_t *chunk);
 
 /* True once every chunk of the current version has arrived. */
 bool window_asm_complete(const window_asm_t *a);

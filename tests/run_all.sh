@@ -3,6 +3,9 @@
 #   N passed, N failed
 # Usage: tests/run_all.sh SAN_BUILD_DIR REL_BUILD_DIR
 set -u
+# Tests that want a display make their own (xvfb-run); without this, every other `argil sculpt`
+# would open a window on the caller's display and run at real-time pace.
+unset DISPLAY WAYLAND_DISPLAY
 san=$1
 rel=$2
 passed=0

@@ -1,14 +1,16 @@
 #!/bin/sh
 # Installs the Debian 12 packages argil needs to build and test, and only the
 # missing ones. Idempotent: a second run installs nothing and says so.
-# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render|bench ...]
+# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render|bench|hil ...]
 #   build: what `make` and `make run` need (includes render); test: + the test tools;
 #   fuzz: + clang/libFuzzer; render: argil view/plot (GLFW, EGL, Mesa, stb, Xvfb);
 #   bench: + valgrind and the third-party meshers make bench compares against.
+#   hil: qemu and the tools put into the HIL VM (the kernel debs are fetched, not installed).
 #   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
-BUILD_PKGS="make gcc libc6-dev libgpiod-dev" # the build (libgpiod 1.6: argil-board's GPIO lines)
+BUILD_PKGS="make gcc libc6-dev libgpiod-dev libusb-1.0-0-dev" # the build (libgpiod 1.6: argil-board's GPIO lines;
+# libusb: its header for the host's USB link, the library itself is opened with dlopen at run time)
 TEST_PKGS="libcmocka-dev assimp-utils valgrind" # unit-test runner; a third-party mesh reader; callgrind (+ valgrind/callgrind.h) for make bench
 FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
 # argil view / argil plot (docs/render.md): headers at build time (GL, EGL, GLFW, stb's PNG
@@ -20,6 +22,9 @@ RENDER_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-
 # arm64 architecture enabled (done below, once).
 # make bench: callgrind, and scikit-image's and OpenVDB's marching cubes for comparison.
 BENCH_PKGS="valgrind python3-skimage python3-openvdb"
+# make hil (hil/README.md): qemu boots Debian's kernel; busybox-static, can-utils and gpiod go
+# into its initramfs; cpio packs it, kmod's depmod/modprobe resolve the module closure.
+HIL_PKGS="qemu-system-x86 busybox-static cpio kmod can-utils gpiod xz-utils"
 CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64"
 
 check_only=0
@@ -27,8 +32,8 @@ groups=""
 for a in "$@"; do
     case "$a" in
         --check) check_only=1 ;;
-        build|test|fuzz|cross|render|bench) groups="$groups $a" ;;
-        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render, bench)" >&2; exit 2 ;;
+        build|test|fuzz|cross|render|bench|hil) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render, bench, hil)" >&2; exit 2 ;;
     esac
 done
 [ -n "$groups" ] || groups="build test fuzz cross render"
@@ -40,6 +45,7 @@ for g in $groups; do
         fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $FUZZ_PKGS" ;;
         cross) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $CROSS_PKGS" ;;
         bench) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $BENCH_PKGS" ;;
+        hil) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $HIL_PKGS" ;;
     esac
 done
 

@@ -290,9 +290,9 @@ static void *fast_loop(void *arg)
                                                                                     : 0xFFFFFFFFu)
                                              : 0u;
         const uint32_t compute_ns = board_run_tick(d->board, &d->io, d->hal);
-        /* The core sees the whole tick, release to done, so a late wake counts as overrun. */
-        const uint64_t used = (uint64_t)wake_ns + compute_ns;
-        d->io.prev_compute_ns = used > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)used;
+        /* The core sees the whole tick, release to done (wake-up latency + compute), so a late
+         * wake counts as overrun; it records both in its RT_STATS for the host. */
+        d->io.prev_wake_ns = wake_ns;
         (void)rt_stats_add(&d->rt, wake_ns, compute_ns, period_ns);
         if (drives_bus_unrecoverable(&d->board->drives, &d->board->cfg.drives)) {
             snprintf(d->loop_err, sizeof(d->loop_err),
@@ -317,6 +317,16 @@ static void *fast_loop(void *arg)
     drives_shutdown(&d->board->drives, &tx);
     (void)hal_linux_can_flush(d->hal, &tx);
     hal_gpio_write(d->hal, 0);
+    /* A last RT_STATS for the host, so it sees the whole run (the link thread drains its ring
+     * after the stop). */
+    static proto_msg_t rt_msg;
+    static uint8_t rt_frame[PROTO_FRAME_MAX];
+    size_t rt_len = 0;
+    board_rt_stats_msg(d->board, &rt_msg);
+    if (proto_encode(&rt_msg, d->board->tx_seq, rt_frame, sizeof(rt_frame), &rt_len) == PROTO_OK) {
+        d->board->tx_seq++;
+        (void)hal_link_send(d->hal, rt_frame, rt_len);
+    }
     publish(d);
     atomic_store(&d->stop, true);
     return NULL;

@@ -6,6 +6,15 @@
 
 #include "shared/gpio_lines.h"
 
+/* Empties the box of nodes with pending impulses. */
+static void impulse_box_clear(board_t *b)
+{
+    for (int a = 0; a < 3; a++) {
+        b->impulse_lo[a] = INT32_MAX;
+        b->impulse_hi[a] = -1;
+    }
+}
+
 void board_cfg_default(board_cfg_t *cfg)
 {
     memset(cfg, 0, sizeof(*cfg));
@@ -13,6 +22,7 @@ void board_cfg_default(board_cfg_t *cfg)
     cfg->max_force_n = 3.3f;
     cfg->impulse_period_us = 5000u;
     cfg->heartbeat_period_us = 10000u;
+    cfg->rt_stats_period_us = 1000000u;
     cfg->swap_fade_ticks = 20u;
     cfg->contact_damping_n_s_per_m = 0.5f;
     cfg->contact_damping_s = 0.0025f;
@@ -35,7 +45,8 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
 {
     if (cfg->tick_us < 100u || cfg->tick_us > 10000u || !(cfg->max_force_n > 0.0f) ||
         !isfinite(cfg->max_force_n) || cfg->impulse_period_us == 0 ||
-        cfg->heartbeat_period_us == 0 || !(cfg->velocity_filter > 0.0f) ||
+        cfg->heartbeat_period_us == 0 || cfg->rt_stats_period_us == 0 ||
+        !(cfg->velocity_filter > 0.0f) ||
         cfg->velocity_filter > 1.0f || cfg->swap_fade_ticks > 10000u || !(cfg->contact_damping_n_s_per_m >= 0.0f) || !(cfg->contact_damping_s >= 0.0f) ||
         cfg->io_delay_ticks < 1u || cfg->io_delay_ticks > PASSIVITY_DELAY_MAX ||
         !(cfg->slew_n_per_s > 0.0f) || !(cfg->pc_max_damping_n_s_per_m >= 0.0f) || !(cfg->pc_deadband_j >= 0.0f) ||
@@ -51,13 +62,17 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     b->tool_valid = false;
     memset(b->impulse_ns, 0, sizeof(b->impulse_ns));
     b->impulse_pending = false;
+    impulse_box_clear(b);
     b->impulse_seq = 0;
     b->tx_seq = 0;
     b->time_us = 0;
     b->since_impulse_us = 0;
     b->since_heartbeat_us = 0;
+    b->since_rt_stats_us = 0;
+    rt_stats_init(&b->rt);
     b->hello_due = true;
     b->fault_reported = false;
+    b->arm_pending_us = 0;
     b->wdog_level = false;
     b->host_window_version = 0;
     b->host_impulse_ack = 0;
@@ -79,6 +94,13 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     b->sculpting = false;
     memset(&b->stats, 0, sizeof(b->stats));
     return ARGIL_OK;
+}
+
+void board_rt_stats_msg(const board_t *b, proto_msg_t *m)
+{
+    memset(m, 0, sizeof(*m));
+    m->type = MSG_RT_STATS;
+    rt_stats_to_msg(&b->rt, b->cfg.tick_us * 1000u, b->time_us, &m->u.rt_stats);
 }
 
 vec3_t board_device_to_model(const board_t *b, vec3_t device_m)
@@ -136,8 +158,10 @@ static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
         b->stats.link_frames_rx++;
         switch (m->type) {
         case MSG_HELLO:
-            if (m->u.hello.role == PROTO_ROLE_HOST)
+            if (m->u.hello.role == PROTO_ROLE_HOST) {
                 b->hello_due = true;
+                b->fault_reported = false; /* a (re)connected host learns a latched fault too */
+            }
             break;
         case MSG_HEARTBEAT:
             ev->heartbeat = true;
@@ -149,7 +173,7 @@ static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
                 ev->disarm = true;
             break;
         case MSG_WINDOW: {
-            const proto_err_t we = window_feed(&b->window, &m->u.window);
+            const proto_err_t we = window_feed_decoded(&b->window, &m->u.window);
             if (we == PROTO_ERR_VALUE)
                 ev->nonfinite = true;
             if (we != PROTO_OK) {
@@ -193,14 +217,6 @@ static bool sense_tool(board_t *b)
     return vec3_isfinite(b->pos_m) && vec3_isfinite(b->vel_m_s);
 }
 
-/* Model-space position of window node i. */
-static vec3_t node_position(const window_buf_t *w, uint32_t i)
-{
-    const int32_t nx = w->dims[0], ny = w->dims[1];
-    const int32_t k = (int32_t)i;
-    return window_node_pos(w, k % nx, (k / nx) % ny, k / (nx * ny));
-}
-
 /* Remembers a sent impulse until a window from the host includes it. */
 static void log_impulse(board_t *b, uint32_t seq, vec3_t pos_m, float impulse_ns)
 {
@@ -235,30 +251,59 @@ static void reapply_impulses(board_t *b, window_buf_t *w)
     }
 }
 
-/* Sends the accumulated impulses of the active window, at most BOARD_IMPULSE_FRAMES_MAX frames. */
+/* Lists, in node order, up to cap nodes of the box [lo, hi] with a nonzero impulse; *more
+ * tells whether the box holds further ones. */
+static uint32_t gather_impulses(const board_t *b, const window_buf_t *w, const int32_t lo[3],
+                                const int32_t hi[3], uint32_t *nodes, uint32_t cap, bool *more)
+{
+    uint32_t n = 0;
+    *more = false;
+    for (int32_t z = lo[2]; z <= hi[2]; z++) {
+        for (int32_t y = lo[1]; y <= hi[1]; y++) {
+            const int32_t base = w->dims[0] * (y + w->dims[1] * z);
+            const float *row = b->impulse_ns + base;
+            for (int32_t x = lo[0]; x <= hi[0]; x++) {
+                if (row[x] == 0.0f)
+                    continue;
+                if (n == cap) {
+                    *more = true;
+                    return n;
+                }
+                nodes[n++] = (uint32_t)(base + x);
+            }
+        }
+    }
+    return n;
+}
+
+/* Sends the accumulated impulses of the active window in node order, at most
+ * BOARD_IMPULSE_FRAMES_MAX frames; only the box that received impulses is scanned. */
 static void flush_impulses(board_t *b, board_out_t *out)
 {
     const window_buf_t *w = window_active(&b->window);
     if (!w || !b->impulse_pending)
         return;
     proto_msg_t *const m = &b->scratch;
-    const int32_t n = w->dims[0] * w->dims[1] * w->dims[2];
-    int32_t i = 0;
+    int32_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = b->impulse_lo[a] < 0 ? 0 : b->impulse_lo[a];
+        hi[a] = b->impulse_hi[a] > w->dims[a] - 1 ? w->dims[a] - 1 : b->impulse_hi[a];
+    }
+    uint32_t nodes[BOARD_IMPULSE_FRAMES_MAX * PROTO_IMPULSE_MAX];
     bool left = false;
-    for (uint32_t frame = 0; frame < BOARD_IMPULSE_FRAMES_MAX && i < n; frame++) {
+    const uint32_t count = gather_impulses(b, w, lo, hi, nodes,
+                                           BOARD_IMPULSE_FRAMES_MAX * PROTO_IMPULSE_MAX, &left);
+    const int32_t nx = w->dims[0], nxy = w->dims[0] * w->dims[1];
+    for (uint32_t at = 0; at < count;) {
         m->type = MSG_IMPULSE;
         m->u.impulse.window_version = w->version;
         m->u.impulse.impulse_seq = b->impulse_seq + 1u;
         m->u.impulse.count = 0;
-        for (; i < n && m->u.impulse.count < PROTO_IMPULSE_MAX; i++) {
-            if (b->impulse_ns[i] != 0.0f) {
-                proto_impulse_t *e = &m->u.impulse.entries[m->u.impulse.count++];
-                e->node = (uint32_t)i;
-                e->impulse_ns = b->impulse_ns[i];
-            }
+        for (uint32_t k = at; k < count && m->u.impulse.count < PROTO_IMPULSE_MAX; k++) {
+            proto_impulse_t *e = &m->u.impulse.entries[m->u.impulse.count++];
+            e->node = nodes[k];
+            e->impulse_ns = b->impulse_ns[nodes[k]];
         }
-        if (m->u.impulse.count == 0)
-            break;
         const size_t before = out->link_tx_len;
         send(b, out, m);
         if (out->link_tx_len == before) {
@@ -268,15 +313,17 @@ static void flush_impulses(board_t *b, board_out_t *out)
         }
         b->impulse_seq++;
         for (uint16_t k = 0; k < m->u.impulse.count; k++) {
-            const uint32_t node = m->u.impulse.entries[k].node;
-            log_impulse(b, b->impulse_seq, node_position(w, node), b->impulse_ns[node]);
+            const int32_t node = (int32_t)m->u.impulse.entries[k].node;
+            const int32_t z = node / nxy, y = (node - z * nxy) / nx;
+            log_impulse(b, b->impulse_seq, window_node_pos(w, node - y * nx - z * nxy, y, z),
+                        b->impulse_ns[node]);
             b->impulse_ns[node] = 0.0f;
         }
+        at += m->u.impulse.count;
     }
-    for (; i < n && !left; i++)
-        if (b->impulse_ns[i] != 0.0f)
-            left = true;
     b->impulse_pending = left;
+    if (!left)
+        impulse_box_clear(b);
 }
 
 /* LED pattern per state: off idle, slow blink armed, on active, fast blink fault/e-stop. */
@@ -342,8 +389,11 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     b->stats.ticks++;
     b->time_us += dt_us;
 
-    /* Deadline accounting for the previous tick. */
-    const bool overrun = in->prev_compute_ns > dt_us * 1000u;
+    /* Deadline accounting for the previous tick: late wake-up plus compute past the period. */
+    const uint64_t prev_used_ns = (uint64_t)in->prev_wake_ns + in->prev_compute_ns;
+    const bool overrun = prev_used_ns > dt_us * 1000u;
+    if (b->stats.ticks > 1u)
+        (void)rt_stats_add(&b->rt, in->prev_wake_ns, in->prev_compute_ns, dt_us * 1000u);
     if (overrun)
         b->stats.deadline_misses++;
     if (in->prev_compute_ns > b->stats.worst_compute_ns)
@@ -354,8 +404,16 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     if (in->can_rx)
         drives_receive(&b->drives, in->can_rx);
     receive_link(b, in, &ev);
-    if (ev.arm)
+    if (ev.arm) {
         drives_clear_emcy(&b->drives);
+        /* Re-arm after a drive trip: reset the drives' faults (power stays off) and let the
+         * ARM wait, bounded, for DRIVE_FAULT_N to come back; never while the e-stop is down. */
+        const bool latched = b->safety.state == SAFETY_FAULT || b->safety.state == SAFETY_IDLE;
+        if (latched && (in->gpio_in & GPIO_IN_ESTOP_N) != 0) {
+            drives_request_fault_reset(&b->drives, BOARD_REARM_WAIT_US);
+            b->arm_pending_us = BOARD_REARM_WAIT_US;
+        }
+    }
 
     /* Swap a complete window in at this tick boundary, once its predecessor's impulses are out. */
     if (window_pending(&b->window) && !b->impulse_pending) {
@@ -375,13 +433,20 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     /* 3-4. Force mapping and the local window step. */
     window_buf_t *w = window_active_mut(&b->window);
     const bool btn1 = (in->gpio_in & GPIO_IN_STYLUS_BTN1) != 0;
-    haptics_out_t h = {vec3(0, 0, 0), 0.0f, false, false, false, vec3(0, 0, 0), 0.0f};
+    haptics_out_t h = {vec3(0, 0, 0), 0.0f, false, false, false, vec3(0, 0, 0), 0.0f,
+                       {INT32_MAX, INT32_MAX, INT32_MAX}, {-1, -1, -1}};
     if (w && b->tool_valid && b->have_tip && !nonfinite) {
         haptics_process(&b->haptics, &b->tool, w, b->pos_m, b->vel_m_s, btn1,
                         safety_may_sculpt(&b->safety), dt_s, b->impulse_ns, &h);
         if (h.sculpting) {
             b->impulse_pending = true;
             b->settle_left = BOARD_SETTLE_TICKS;
+        }
+        for (int a = 0; a < 3; a++) {
+            if (h.touched_lo[a] < b->impulse_lo[a])
+                b->impulse_lo[a] = h.touched_lo[a];
+            if (h.touched_hi[a] > b->impulse_hi[a])
+                b->impulse_hi[a] = h.touched_hi[a];
         }
         /* Step the springs only in a box around where the tool works the clay — the nodes
          * its forces reach — the board's own physical window (Hua & Qin §6.3). */
@@ -443,7 +508,7 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     si.drive_emcy = drives_any_emcy(&b->drives);
     si.window_ready = w != 0 && b->tool_valid && b->have_tip;
     si.host_heartbeat = ev.heartbeat;
-    si.arm_request = ev.arm;
+    si.arm_request = ev.arm || b->arm_pending_us > 0;
     si.disarm_request = ev.disarm;
     si.nonfinite = nonfinite;
     si.force_limit_exceeded = false;
@@ -452,6 +517,9 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     si.velocity_limit_exceeded =
         b->cfg.max_velocity_m_s > 0.0f && vec3_norm(b->vel_m_s) > b->cfg.max_velocity_m_s;
     const float scale = safety_process(&b->safety, &b->cfg.safety, &si, dt_us);
+    const bool waiting = b->safety.state == SAFETY_FAULT || b->safety.state == SAFETY_IDLE;
+    b->arm_pending_us = (waiting && !ev.disarm && b->arm_pending_us > dt_us)
+                            ? b->arm_pending_us - dt_us : 0;
 
     const vec3_t f = nonfinite ? vec3(0, 0, 0) : shape_force(b, &h, scale, dt_s);
     b->force_n = f;
@@ -538,6 +606,13 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
         m->u.heartbeat.command = PROTO_CMD_NONE;
         send(b, out, m);
         b->since_heartbeat_us = 0;
+    }
+    b->since_rt_stats_us += dt_us;
+    if (b->since_rt_stats_us >= b->cfg.rt_stats_period_us) {
+        board_rt_stats_msg(b, m);
+        send(b, out, m);
+        b->stats.rt_stats_sent++;
+        b->since_rt_stats_us = 0;
     }
     const window_buf_t *aw = window_active(&b->window);
     m->type = MSG_TELEMETRY;

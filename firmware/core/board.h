@@ -12,6 +12,7 @@
 #include "drives.h"
 #include "haptics.h"
 #include "passivity.h"
+#include "rt_stats.h"
 #include "safety.h"
 #include "shared/arm_kin.h"
 #include "shared/canopen.h"
@@ -24,11 +25,16 @@
 #define BOARD_SUBSTEPS_MAX 8u          /* adaptive step halving: at most 3 halvings */
 #define BOARD_SETTLE_TICKS 100u        /* the window's springs run this long after the last push */
 
+/* How long a host's ARM waits in FAULT/IDLE for the drives' fault reset to clear a drive trip
+ * (EMCY, DRIVE_FAULT_N low); the fault causes are re-checked every tick meanwhile. */
+#define BOARD_REARM_WAIT_US 500000u
+
 typedef struct {
     uint32_t tick_us;                  /* loop period (1000 at 1 kHz) */
     float max_force_n;                 /* hard limit on the force to the hand (3.3 N) */
     uint32_t impulse_period_us;        /* how often impulses go to the host (5 ms) */
     uint32_t heartbeat_period_us;      /* board heartbeat (10 ms) */
+    uint32_t rt_stats_period_us;       /* RT_STATS to the host (1 s) */
     uint32_t swap_fade_ticks;          /* a window swap's force step fades in over about this
                                         * many ticks: Guo et al.'s exponential weighted average
                                         * with α = 1 − 1/ticks (0: no fade) */
@@ -56,6 +62,8 @@ typedef struct {
     const uint8_t *link_rx;            /* whole frames from the host, back to back */
     size_t link_rx_len;
     uint32_t prev_compute_ns;          /* measured compute time of the previous tick */
+    uint32_t prev_wake_ns;             /* its wake-up latency (0 when the caller does not
+                                        * sleep on a clock, as in the lockstep simulation) */
 } board_in_t;
 
 typedef struct {
@@ -76,6 +84,7 @@ typedef struct {
     uint32_t impulses_reapplied;       /* unacknowledged impulses carried into a new window */
     uint32_t impulse_log_overflow;     /* sent impulses forgotten before the host acknowledged them */
     uint32_t max_substeps;             /* most spring sub-steps one tick needed */
+    uint32_t rt_stats_sent;            /* RT_STATS frames sent */
     float peak_force_n;
     proto_err_t last_link_error;
 } board_stats_t;
@@ -90,13 +99,18 @@ typedef struct {
     bool tool_valid;
     float impulse_ns[ARGIL_WINDOW_SAMPLES_MAX]; /* accumulated ∫f dt per active window node */
     bool impulse_pending;
+    int32_t impulse_lo[3];             /* node box [lo, hi] holding every nonzero impulse_ns */
+    int32_t impulse_hi[3];             /* … (lo > hi: none); the flush scans only this box */
     uint32_t impulse_seq;
     uint32_t tx_seq;
     uint64_t time_us;
     uint32_t since_impulse_us;
     uint32_t since_heartbeat_us;
+    uint32_t since_rt_stats_us;
+    rt_stats_t rt;                     /* every previous tick's latency and compute time */
     bool hello_due;
     bool fault_reported;
+    uint32_t arm_pending_us;           /* the host's ARM waits this long for drive faults to clear */
     bool wdog_level;
     uint32_t host_window_version;      /* newest version the host says it sent */
     uint32_t host_impulse_ack;         /* newest impulse batch the host says it applied */
@@ -130,6 +144,10 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg);
 
 /* Runs one tick. Never blocks; bounded work. */
 void board_tick(board_t *b, const board_in_t *in, board_out_t *out);
+
+/* The RT_STATS message of the ticks so far (the board sends one every rt_stats_period_us;
+ * a daemon may send one more when it stops). */
+void board_rt_stats_msg(const board_t *b, proto_msg_t *m);
 
 /* Model-space tool position from a device-space tip under the current tool transform. */
 vec3_t board_device_to_model(const board_t *b, vec3_t device_m);

@@ -18,6 +18,7 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     in.link_rx = io->link_rx;
     in.link_rx_len = hal_link_receive(hal, io->link_rx, sizeof(io->link_rx));
     in.prev_compute_ns = io->prev_compute_ns;
+    in.prev_wake_ns = io->prev_wake_ns;
     board_tick(b, &in, &io->out);
     if (hal_can_send(hal, &io->out.can_tx) != ARGIL_OK)
         io->can_tx_errors++;

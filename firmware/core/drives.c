@@ -32,6 +32,7 @@ void drives_init(drives_t *dr)
     dr->frames_unknown = 0;
     dr->bus = CAN_BUS_ACTIVE;
     dr->bus_state_us = 0;
+    dr->fault_reset_left_us = 0;
     dr->bus_off_events = 0;
     dr->bus_passive_events = 0;
     dr->bus_restarts = 0;
@@ -126,8 +127,11 @@ void drives_receive(drives_t *dr, const can_batch_t *rx)
 }
 
 /* The controlword that moves a drive one step towards the wanted power state. */
-static uint16_t next_controlword(cia402_state_t s, bool want_enabled, uint16_t prev)
+static uint16_t next_controlword(cia402_state_t s, bool want_enabled, bool reset_faults,
+                                 uint16_t prev)
 {
+    if (!want_enabled && reset_faults && s == CIA402_FAULT)
+        return prev == CIA402_CW_FAULT_RESET ? CIA402_CW_DISABLE_VOLTAGE : CIA402_CW_FAULT_RESET;
     if (!want_enabled) {
         return (s == CIA402_OPERATION_ENABLED) ? CIA402_CW_QUICK_STOP : CIA402_CW_DISABLE_VOLTAGE;
     }
@@ -156,6 +160,7 @@ void drives_process(drives_t *dr, const drives_cfg_t *cfg, bool want_enabled,
     can_frame_t f;
     if (dr->bus_state_us < 0xFFFFFFFFu - dt_us)
         dr->bus_state_us += dt_us;
+    dr->fault_reset_left_us = dr->fault_reset_left_us > dt_us ? dr->fault_reset_left_us - dt_us : 0;
     for (int j = 0; j < ARGIL_DRIVES; j++) {
         drive_link_t *d = &dr->d[j];
         if (d->heartbeat_age_us < 0xFFFFFFFFu - dt_us)
@@ -171,7 +176,8 @@ void drives_process(drives_t *dr, const drives_cfg_t *cfg, bool want_enabled,
     }
     for (int j = 0; j < ARGIL_DRIVES; j++) {
         drive_link_t *d = &dr->d[j];
-        dr->controlword[j] = next_controlword(d->power, want_enabled, dr->controlword[j]);
+        dr->controlword[j] = next_controlword(d->power, want_enabled,
+                                             dr->fault_reset_left_us > 0, dr->controlword[j]);
         const bool may_push = want_enabled && d->power == CIA402_OPERATION_ENABLED;
         const int16_t tq = may_push ? torque_permille[j] : 0;
         if (d->nmt == NMT_STATE_OPERATIONAL && dr->bus != CAN_BUS_OFF) {
@@ -284,4 +290,9 @@ const char *drives_bus_state_name(can_bus_state_t s)
     case CAN_BUS_OFF: return "bus-off";
     }
     return "?";
+}
+
+void drives_request_fault_reset(drives_t *dr, uint32_t for_us)
+{
+    dr->fault_reset_left_us = for_us;
 }

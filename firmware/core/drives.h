@@ -62,6 +62,7 @@ typedef struct {
     uint32_t bus_passive_events;
     uint32_t bus_restarts;
     uint32_t error_frames;
+    uint32_t fault_reset_left_us;    /* while > 0, drives in FAULT get fault resets even off */
 } drives_t;
 
 void drives_cfg_default(drives_cfg_t *cfg);
@@ -84,6 +85,11 @@ void drives_shutdown(drives_t *dr, can_batch_t *tx);
 
 /* Clears latched EMCY flags (the host re-armed). */
 void drives_clear_emcy(drives_t *dr);
+
+/* For the next for_us: a drive in FAULT gets the CiA 402 fault reset (bit 7 edges) even while
+ * the drives are to stay off, so a drive that tripped (EMCY, DRIVE_FAULT_N low) can clear and
+ * the host's re-arm can succeed. Power is never enabled by this. */
+void drives_request_fault_reset(drives_t *dr, uint32_t for_us);
 
 bool drives_all_enabled(const drives_t *dr);
 bool drives_heartbeat_lost(const drives_t *dr, const drives_cfg_t *cfg);

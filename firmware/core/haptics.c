@@ -47,8 +47,7 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
     for (int k = 1; k <= steps; k++) {
         const float t = dir * step * (float)k;
         float dk;
-        vec3_t gk;
-        if (!window_sample(win, vec3_add(p_m, vec3_scale(n, t)), &dk, &gk))
+        if (!window_density(win, vec3_add(p_m, vec3_scale(n, t)), &dk))
             break;
         if ((dk - iso) * f0 <= 0.0f) {
             t_out = t;
@@ -65,8 +64,7 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
     for (int k = 0; k < HAPTICS_BISECT_STEPS; k++) {
         const float t = 0.5f * (t_in + t_out);
         float dk;
-        vec3_t gk;
-        if (!window_sample(win, vec3_add(p_m, vec3_scale(n, t)), &dk, &gk))
+        if (!window_density(win, vec3_add(p_m, vec3_scale(n, t)), &dk))
             break;
         if ((dk - iso) * f0 > 0.0f)
             t_in = t;
@@ -92,8 +90,9 @@ float haptics_beta(beta_filter_t filter, float dist_m, float radius_m)
     return 0.0f;
 }
 
-/* Shortest distance from q to the segment [a, b]; with cylindrical β, to its infinite line. */
-static float segment_distance(vec3_t q, vec3_t a, vec3_t b, bool line)
+/* Squared shortest distance from q to the segment [a, b]; with cylindrical β, to its
+ * infinite line. */
+static float segment_distance2(vec3_t q, vec3_t a, vec3_t b, bool line)
 {
     const vec3_t ab = vec3_sub(b, a);
     const float len2 = vec3_dot(ab, ab);
@@ -102,14 +101,33 @@ static float segment_distance(vec3_t q, vec3_t a, vec3_t b, bool line)
         if (t < 0.0f) t = 0.0f;
         if (t > 1.0f) t = 1.0f;
     }
-    return vec3_norm(vec3_sub(q, vec3_add(a, vec3_scale(ab, t))));
+    const vec3_t d = vec3_sub(q, vec3_add(a, vec3_scale(ab, t)));
+    return vec3_dot(d, d);
+}
+
+/* Distance from v to the interval [lo, hi] (0 inside). */
+static inline float box_gap(float v, float lo, float hi)
+{
+    return v < lo ? lo - v : (v > hi ? v - hi : 0.0f);
+}
+
+/* Grows the box of nodes that received impulses this tick by [lo, hi]. */
+static void touch_box(haptics_out_t *out, const int32_t lo[3], const int32_t hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        if (lo[k] < out->touched_lo[k])
+            out->touched_lo[k] = lo[k];
+        if (hi[k] > out->touched_hi[k])
+            out->touched_hi[k] = hi[k];
+    }
 }
 
 /* Spreads impulse j (N·s on the density axis) over the nodes within radius of the segment
  * [a, b] with the filter β (for a short path: the corners of the cells it crosses, and their
  * neighbours when the radius is larger than a cell). Returns true when any node received it. */
 static bool spread_segment(window_buf_t *win, beta_filter_t filter, vec3_t a, vec3_t b,
-                           float radius_m, float j, float dt_s, float *impulse_ns)
+                           float radius_m, float j, float dt_s, float *impulse_ns,
+                           haptics_out_t *out)
 {
     if (!(j != 0.0f) || !isfinite(j))
         return false;
@@ -128,12 +146,32 @@ static bool spread_segment(window_buf_t *win, beta_filter_t filter, vec3_t a, ve
         if (hi[k] > win->dims[k] - 1) hi[k] = win->dims[k] - 1;
     }
     const bool line = filter == BETA_CYLINDRICAL && vec3_norm(vec3_sub(b, a)) > 1e-9f;
+    /* Nodes whose squared distance is beyond this are outside β's support (sqrt(d²) ≥ r even
+     * after rounding): skipped before the square root and β. */
+    const float cull2 = r * r * 1.0001f;
+    /* A node is at least as far from the segment as from the segment's bounding box: rows and
+     * nodes whose distance to that box is beyond the support are skipped before the exact
+     * distance (not for the cylindrical filter's infinite line). */
+    const float box_lo[3] = {fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)};
+    const float box_hi[3] = {fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)};
     bool any = false;
     for (int32_t z = lo[2]; z <= hi[2]; z++) {
         for (int32_t y = lo[1]; y <= hi[1]; y++) {
+            const vec3_t row = window_node_pos(win, 0, y, z);
+            const float dy = box_gap(row.y, box_lo[1], box_hi[1]);
+            const float dz = box_gap(row.z, box_lo[2], box_hi[2]);
+            const float dyz2 = dy * dy + dz * dz;
+            if (!line && !(dyz2 < cull2))
+                continue;
             for (int32_t x = lo[0]; x <= hi[0]; x++) {
                 const vec3_t q = window_node_pos(win, x, y, z);
-                const float beta = haptics_beta(filter, segment_distance(q, a, b, line), r);
+                const float dx = box_gap(q.x, box_lo[0], box_hi[0]);
+                if (!line && !(dx * dx + dyz2 < cull2))
+                    continue;
+                const float d2 = segment_distance2(q, a, b, line);
+                if (!(d2 < cull2))
+                    continue;
+                const float beta = haptics_beta(filter, sqrtf(d2), r);
                 if (beta <= 0.0f)
                     continue;
                 const int32_t i = window_index(win, x, y, z);
@@ -143,16 +181,19 @@ static bool spread_segment(window_buf_t *win, beta_filter_t filter, vec3_t a, ve
             }
         }
     }
+    if (any)
+        touch_box(out, lo, hi);
     return any;
 }
 
 /* Hua & Qin eq. 7 for one path a → b: f = sign · α · l · s, spread by β. */
 static bool apply_path(window_buf_t *win, const msg_tool_t *tool, vec3_t a, vec3_t b, float s,
-                       float sign, float radius_m, float dt_s, float *impulse_ns)
+                       float sign, float radius_m, float dt_s, float *impulse_ns,
+                       haptics_out_t *out)
 {
     const float l = vec3_norm(vec3_sub(b, a));
     return spread_segment(win, (beta_filter_t)tool->filter, a, b, radius_m,
-                          sign * tool->alpha * l * s, dt_s, impulse_ns);
+                          sign * tool->alpha * l * s, dt_s, impulse_ns, out);
 }
 
 /* How far from its reference point a tool's paths and their β reach. */
@@ -170,7 +211,8 @@ static float tool_reach(const msg_tool_t *tool, const window_buf_t *win)
 /* The paths a tool's shape sweeps this tick, each applied with eq. 7. s < 0 means "use the
  * density met at each path's midpoint". */
 static bool apply_tool_paths(window_buf_t *win, const msg_tool_t *tool, vec3_t from, vec3_t to,
-                             float s_fixed, float sign, float dt_s, float *impulse_ns)
+                             float s_fixed, float sign, float dt_s, float *impulse_ns,
+                             haptics_out_t *out)
 {
     vec3_t u = vec3(tool->axis[0], tool->axis[1], tool->axis[2]);
     int nu = 1, nv = 1;
@@ -206,11 +248,10 @@ static bool apply_tool_paths(window_buf_t *win, const msg_tool_t *tool, vec3_t f
             const vec3_t a = vec3_add(from, off), b = vec3_add(to, off);
             float s = s_fixed;
             if (s < 0.0f) {
-                vec3_t g;
-                if (!window_sample(win, vec3_scale(vec3_add(a, b), 0.5f), &s, &g))
+                if (!window_density(win, vec3_scale(vec3_add(a, b), 0.5f), &s))
                     continue;
             }
-            any |= apply_path(win, tool, a, b, s, sign, radius, dt_s, impulse_ns);
+            any |= apply_path(win, tool, a, b, s, sign, radius, dt_s, impulse_ns, out);
         }
     }
     return any;
@@ -228,14 +269,13 @@ static float first_crossing(const window_buf_t *win, vec3_t p, vec3_t u, float i
     for (int k = 1; k <= steps; k++) {
         const float t = k == steps ? reach : step * (float)k;
         float d;
-        vec3_t g;
-        if (!window_sample(win, vec3_add(p, vec3_scale(u, t)), &d, &g))
+        if (!window_density(win, vec3_add(p, vec3_scale(u, t)), &d))
             return reach;
         if (d >= iso) {
             float t_in = t;
             for (int b = 0; b < HAPTICS_BISECT_STEPS; b++) {
                 const float m = 0.5f * (t_in + t_out);
-                if (!window_sample(win, vec3_add(p, vec3_scale(u, m)), &d, &g))
+                if (!window_density(win, vec3_add(p, vec3_scale(u, m)), &d))
                     break;
                 if (d >= iso)
                     t_in = m;
@@ -262,8 +302,7 @@ static bool sphere_penetration(const window_buf_t *win, vec3_t p, float r, float
                                       {D, -D, -D}, {-D, D, D}, {-D, D, -D}, {-D, -D, D},
                                       {-D, -D, -D}};
     float d0;
-    vec3_t g0;
-    if (!window_sample(win, p, &d0, &g0))
+    if (!window_density(win, p, &d0))
         return false;
     if (d0 >= iso) {
         /* The centre itself is in the clay: fall back to the gradient line. */
@@ -380,6 +419,10 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
     out->yielding = false;
     out->work_m = pos_m;
     out->work_radius_m = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        out->touched_lo[k] = INT32_MAX;
+        out->touched_hi[k] = -1;
+    }
     if (!win) {
         h->prev_valid = false;
         h->grabbing = false;
@@ -393,9 +436,8 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
     const bool hold = button && sculpt_allowed;
     if (hold && !h->grabbing) {
         float d;
-        vec3_t g;
         h->grab_pos_m = pos_m;
-        h->grab_density = window_sample(win, pos_m, &d, &g) ? d : 0.0f;
+        h->grab_density = window_density(win, pos_m, &d) ? d : 0.0f;
         if (h->grab_density < win->iso)
             h->grab_density = win->iso;
     }
@@ -406,8 +448,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
         if (hold) {
             /* The host removes the material; the hand feels a drag proportional to density. */
             float d;
-            vec3_t g;
-            if (window_sample(win, pos_m, &d, &g))
+            if (window_density(win, pos_m, &d))
                 out->force_n = vec3_scale(vel_m_s, -CARVE_DRAG_N_S_PER_M * d);
             h->in_contact = false;
             return;
@@ -418,7 +459,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
             /* Raise density along the path with the grabbed density (eq. 7, positive); feel a
              * spring back to the grab point. */
             out->sculpting = apply_tool_paths(win, tool, prev, pos_m, h->grab_density, 1.0f,
-                                              dt_s, impulse_ns);
+                                              dt_s, impulse_ns, out);
             out->work_m = pos_m;
             out->work_radius_m = tool_reach(tool, win);
             const vec3_t s = vec3_sub(pos_m, h->grab_pos_m);
@@ -440,7 +481,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
             out->potential_j = 0.5f * k * vec3_dot(s, s);
             out->sculpting = spread_segment(win, (beta_filter_t)tool->filter, h->grab_pos_m,
                                             h->grab_pos_m, tool->radius_m, tension_n * dt_s, dt_s,
-                                            impulse_ns);
+                                            impulse_ns, out);
             out->work_m = h->grab_pos_m;
             out->work_radius_m = tool->radius_m;
             h->in_contact = false;
@@ -471,7 +512,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
             const vec3_t front = vec3_scale(out->force_n, -tool->radius_m / fn);
             out->sculpting = apply_tool_paths(win, tool, vec3_add(prev, front),
                                               vec3_add(pos_m, front), -1.0f, -1.0f, dt_s,
-                                              impulse_ns);
+                                              impulse_ns, out);
             out->work_m = vec3_add(pos_m, front);
             out->work_radius_m = tool_reach(tool, win);
         }

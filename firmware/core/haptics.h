@@ -8,6 +8,7 @@
 #define ARGIL_HAPTICS_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "shared/proto.h"
 #include "shared/vec3.h"
@@ -36,6 +37,8 @@ typedef struct {
     bool yielding;             /* push: the contact force reached the yield force */
     vec3_t work_m;             /* where the sculpting forces went (centre of the nodes touched) */
     float work_radius_m;       /* … and how far from there */
+    int32_t touched_lo[3];     /* node box [lo, hi] that received impulses this tick; */
+    int32_t touched_hi[3];     /* … empty when lo > hi on any axis */
 } haptics_out_t;
 
 void haptics_init(haptics_t *h);

@@ -6,6 +6,8 @@
 
 #include <stdint.h>
 
+#include "shared/proto.h"
+
 #define RT_HIST_BINS 12u
 /* Upper edges of the histogram bins in µs; the last bin holds everything above 10 ms. */
 #define RT_HIST_EDGES_US {5u, 10u, 20u, 50u, 100u, 200u, 500u, 1000u, 2000u, 5000u, 10000u, 0u}
@@ -36,5 +38,10 @@ uint32_t rt_series_mean_ns(const rt_series_t *s);
 
 /* Upper edge of histogram bin i in µs; 0 for the open last bin. */
 uint32_t rt_hist_edge_us(uint32_t i);
+
+/* The RT_STATS message of s (docs/protocol.md): min, mean and max are 0 while no tick was
+ * recorded, so the message is always valid for a period_ns > 0. */
+void rt_stats_to_msg(const rt_stats_t *s, uint32_t period_ns, uint64_t time_us,
+                     msg_rt_stats_t *m);
 
 #endif

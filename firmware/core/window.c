@@ -36,7 +36,8 @@ window_buf_t *window_active_mut(window_t *w)
     return b->valid ? b : 0;
 }
 
-proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
+/* window_feed, with the chunk's own checks skipped when it came from proto_decode. */
+static proto_err_t feed(window_t *w, const msg_window_t *chunk, bool decoded)
 {
     const window_buf_t *cur = window_active(w);
     if (cur && chunk->version <= cur->version) {
@@ -49,29 +50,32 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     } else if (w->pending) {
         return PROTO_OK; /* a late copy of the pending window's chunks */
     }
-    /* Finite densities, non-negative finite stiffness: checked chunk by chunk, so no tick pays
-     * for a whole window at once. */
-    const uint32_t n_nodes = (uint32_t)chunk->dims[0] * chunk->dims[1] * chunk->dims[2];
-    const uint16_t count = chunk->sample_count <= PROTO_WINDOW_CHUNK_SAMPLES ? chunk->sample_count
-                                                                             : PROTO_WINDOW_CHUNK_SAMPLES;
-    for (uint16_t k = 0; k < count; k++) {
-        const float v = chunk->samples[k];
-        if (!isfinite(v) || (chunk->first_sample + k >= n_nodes && v < 0.0f)) {
-            w->chunks_refused++;
-            asm_target_back(w);
-            return PROTO_ERR_VALUE;
-        }
-    }
-    const proto_err_t e = window_asm_feed(&w->assembler, chunk);
+    /* window_asm_feed checks the chunk (finite densities, finite non-negative stiffness:
+     * chunk by chunk, so no tick pays for a whole window at once). A non-finite or negative
+     * sample refuses the window being assembled. */
+    const proto_err_t e = decoded ? window_asm_feed_decoded(&w->assembler, chunk)
+                                  : window_asm_feed(&w->assembler, chunk);
     if (e != PROTO_OK) {
         w->chunks_refused++;
+        if (e == PROTO_ERR_VALUE)
+            asm_target_back(w);
         return e;
+    }
+    /* What window_swap would do for the whole window, done chunk by chunk so no tick pays for
+     * it at once: the back buffer's springs start at rest (rest = density, no velocity, no
+     * force) on the nodes whose densities this chunk carried. */
+    window_buf_t *b = &w->buf[w->active ^ 1u];
+    const uint32_t n_nodes = (uint32_t)chunk->dims[0] * chunk->dims[1] * chunk->dims[2];
+    for (uint32_t k = 0; k < chunk->sample_count && chunk->first_sample + k < n_nodes; k++) {
+        const uint32_t i = chunk->first_sample + k;
+        b->rest[i] = b->field[i];
+        b->velocity[i] = 0.0f;
+        b->force[i] = 0.0f;
     }
     if (!window_asm_complete(&w->assembler))
         return PROTO_OK;
 
     const msg_window_t *h = &w->assembler.head;
-    window_buf_t *b = &w->buf[w->active ^ 1u];
     const int32_t n = (int32_t)h->dims[0] * h->dims[1] * h->dims[2];
     b->version = h->version;
     b->impulse_seq = h->impulse_seq;
@@ -101,6 +105,16 @@ proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
     return PROTO_OK;
 }
 
+proto_err_t window_feed(window_t *w, const msg_window_t *chunk)
+{
+    return feed(w, chunk, false);
+}
+
+proto_err_t window_feed_decoded(window_t *w, const msg_window_t *chunk)
+{
+    return feed(w, chunk, true);
+}
+
 bool window_pending(const window_t *w)
 {
     return w->pending;
@@ -112,46 +126,41 @@ void window_swap(window_t *w)
         return;
     w->active ^= 1u;
     window_buf_t *b = &w->buf[w->active];
-    const int32_t n = window_nodes(b);
-    memcpy(b->rest, b->density, (size_t)n * sizeof(float));
-    memset(b->velocity, 0, (size_t)n * sizeof(float));
-    memset(b->force, 0, (size_t)n * sizeof(float));
+    /* rest, velocity and force were set as the chunks arrived (window_feed). */
     b->valid = true;
     w->buf[w->active ^ 1u].valid = false;
     w->pending = false;
     asm_target_back(w);
 }
 
-int32_t window_index(const window_buf_t *b, int32_t x, int32_t y, int32_t z)
-{
-    if (x < 0 || y < 0 || z < 0 || x >= b->dims[0] || y >= b->dims[1] || z >= b->dims[2])
-        return -1;
-    return x + b->dims[0] * (y + b->dims[1] * z);
-}
-
-vec3_t window_node_pos(const window_buf_t *b, int32_t x, int32_t y, int32_t z)
-{
-    return vec3(b->origin_m.x + (float)x * b->spacing_m, b->origin_m.y + (float)y * b->spacing_m,
-                b->origin_m.z + (float)z * b->spacing_m);
-}
-
-bool window_sample(const window_buf_t *b, vec3_t p_m, float *density, vec3_t *gradient)
+/* Cell of p_m and the position within it: the corner's linear index in *i0 and the fractions
+ * in t[3]; false outside the window. */
+static bool window_cell(const window_buf_t *b, vec3_t p_m, int32_t *i0, float t[3])
 {
     const float inv = 1.0f / b->spacing_m;
     const float u[3] = {(p_m.x - b->origin_m.x) * inv, (p_m.y - b->origin_m.y) * inv,
                         (p_m.z - b->origin_m.z) * inv};
     int32_t c[3];
-    float t[3];
     for (int a = 0; a < 3; a++) {
         if (!(u[a] >= 0.0f) || u[a] > (float)(b->dims[a] - 1))
             return false;
-        c[a] = (int32_t)floorf(u[a]);
+        c[a] = (int32_t)u[a]; /* u ≥ 0: truncation is the floor */
         if (c[a] > b->dims[a] - 2)
             c[a] = b->dims[a] - 2;
         t[a] = u[a] - (float)c[a];
     }
+    *i0 = c[0] + b->dims[0] * c[1] + b->dims[0] * b->dims[1] * c[2];
+    return true;
+}
+
+bool window_sample(const window_buf_t *b, vec3_t p_m, float *density, vec3_t *gradient)
+{
+    int32_t i0;
+    float t[3];
+    if (!window_cell(b, p_m, &i0, t))
+        return false;
+    const float inv = 1.0f / b->spacing_m;
     const int32_t sy = b->dims[0], sz = b->dims[0] * b->dims[1];
-    const int32_t i0 = c[0] + sy * c[1] + sz * c[2];
     const float *d = b->density;
     const float d000 = d[i0], d100 = d[i0 + 1], d010 = d[i0 + sy], d110 = d[i0 + sy + 1];
     const float d001 = d[i0 + sz], d101 = d[i0 + sz + 1], d011 = d[i0 + sz + sy],
@@ -168,6 +177,25 @@ bool window_sample(const window_buf_t *b, vec3_t p_m, float *density, vec3_t *gr
     const float gy = (x10 - x00) + tz * ((x11 - x01) - (x10 - x00));
     const float gz = y1 - y0;
     *gradient = vec3(gx * inv, gy * inv, gz * inv);
+    return true;
+}
+
+bool window_density(const window_buf_t *b, vec3_t p_m, float *density)
+{
+    int32_t i0;
+    float t[3];
+    if (!window_cell(b, p_m, &i0, t))
+        return false;
+    const int32_t sy = b->dims[0], sz = b->dims[0] * b->dims[1];
+    const float *d = b->density;
+    const float tx = t[0], ty = t[1], tz = t[2];
+    /* The same operations, in the same order, as window_sample's density. */
+    const float x00 = d[i0] + tx * (d[i0 + 1] - d[i0]);
+    const float x10 = d[i0 + sy] + tx * (d[i0 + sy + 1] - d[i0 + sy]);
+    const float x01 = d[i0 + sz] + tx * (d[i0 + sz + 1] - d[i0 + sz]);
+    const float x11 = d[i0 + sz + sy] + tx * (d[i0 + sz + sy + 1] - d[i0 + sz + sy]);
+    const float y0 = x00 + ty * (x10 - x00), y1 = x01 + ty * (x11 - x01);
+    *density = y0 + tz * (y1 - y0);
     return true;
 }
 

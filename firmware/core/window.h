@@ -49,17 +49,29 @@ window_buf_t *window_active_mut(window_t *w);
  * PROTO_ERR_VALUE (non-finite samples: the window is refused). */
 proto_err_t window_feed(window_t *w, const msg_window_t *chunk);
 
+/* window_feed for a chunk proto_decode accepted (PROTO_OK): its checks are not repeated. */
+proto_err_t window_feed_decoded(window_t *w, const msg_window_t *chunk);
+
 /* True when a complete window waits to be swapped in. */
 bool window_pending(const window_t *w);
 
-/* Makes the pending window active (call at a tick boundary); its springs start at rest. */
+/* Makes the pending window active (call at a tick boundary); its springs start at rest (set up
+ * chunk by chunk by window_feed, so the swap itself only flips the buffers). */
 void window_swap(window_t *w);
 
 /* Trilinear density and its gradient (1/m) at a model-space point; false outside the window. */
 bool window_sample(const window_buf_t *b, vec3_t p_m, float *density, vec3_t *gradient);
 
+/* window_sample's density alone (bit for bit the same value), without the gradient. */
+bool window_density(const window_buf_t *b, vec3_t p_m, float *density);
+
 /* Linear index of sample (x,y,z), or -1 outside. */
-int32_t window_index(const window_buf_t *b, int32_t x, int32_t y, int32_t z);
+static inline int32_t window_index(const window_buf_t *b, int32_t x, int32_t y, int32_t z)
+{
+    if (x < 0 || y < 0 || z < 0 || x >= b->dims[0] || y >= b->dims[1] || z >= b->dims[2])
+        return -1;
+    return x + b->dims[0] * (y + b->dims[1] * z);
+}
 
 /* Stiffness of the density spring at node i (per-node when the host sent it). */
 static inline float window_node_stiffness(const window_buf_t *b, int32_t i)
@@ -74,7 +86,11 @@ static inline int32_t window_nodes(const window_buf_t *b)
 }
 
 /* Model-space position of sample (x,y,z). */
-vec3_t window_node_pos(const window_buf_t *b, int32_t x, int32_t y, int32_t z);
+static inline vec3_t window_node_pos(const window_buf_t *b, int32_t x, int32_t y, int32_t z)
+{
+    return vec3(b->origin_m.x + (float)x * b->spacing_m, b->origin_m.y + (float)y * b->spacing_m,
+                b->origin_m.z + (float)z * b->spacing_m);
+}
 
 /* Distance (m) from p to the nearest face of the window; negative outside. */
 float window_edge_distance_m(const window_buf_t *b, vec3_t p_m);

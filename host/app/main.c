@@ -8,6 +8,7 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/commands.h"
+#include "host/app/sculpt_window.h"
 #include "host/app/session.h"
 
 static volatile sig_atomic_t g_stop;
@@ -31,6 +32,8 @@ static const struct {
     {"info", cmd_info, "describe a model, mesh, point cloud or volume file"},
     {"plot", cmd_plot, "draw a session's telemetry.csv as a PNG chart (see 'argil plot --help')"},
     {"view", cmd_view, "render a mesh to a PNG or show it in a window (see 'argil view --help')"},
+    {"connect", cmd_connect, "a live session with a board over USB, UDP or sim (see 'argil connect --help')"},
+    {"recover", cmd_recover, "restore an unfinished session from its journal (see 'argil recover --help')"},
 };
 
 static void usage_main(FILE *f)
@@ -54,8 +57,8 @@ static void usage_sculpt(FILE *f)
             "same script always gives the same files.\n"
             "\n"
             "options:\n"
-            "  --device sim    the device to sculpt with (sim: the simulated arm; USB and UDP\n"
-            "                  boards come with the host-application work)\n"
+            "  --device sim    the simulated arm, in lockstep (the only device here; a real\n"
+            "                  board over USB or UDP: 'argil connect --device usb|udp:H:P')\n"
             "  --script FILE   the session script (default scripts/default.scn; format in\n"
             "                  docs/script.md)\n"
             "  --out DIR       where to write final.ply, telemetry.csv and session.scn\n"
@@ -66,9 +69,26 @@ static void usage_sculpt(FILE *f)
             "  --screenshot FILE.png\n"
             "                  afterwards, render the final clay with the tool where it ended\n"
             "                  (as 'argil view DIR/final.ply --telemetry DIR/telemetry.csv')\n"
+            "  --autosave-s S  journal every edit into DIR/journal.log and make it durable within\n"
+            "                  S seconds (default 1; docs/files.md); a clean end removes it,\n"
+            "                  after a crash 'argil recover DIR' restores the model\n"
+            "  --checkpoint-s S  rotate the journal onto a new snapshot every S simulated s (60)\n"
+            "  --no-journal    no autosave journal\n"
+            "  --discard-journal\n"
+            "                  start even though DIR holds an unfinished session's journal,\n"
+            "                  deleting it\n"
             "  --no-deadline-fault\n"
             "                  count deadline misses but do not fault on a streak of them\n"
             "                  (for profiling under valgrind, where every tick overruns)\n"
+            "  live window (when DISPLAY is set; docs/render.md):\n"
+            "  --headless      no window even with a display (the files are the same either way)\n"
+            "  --fast          run the session as fast as it can instead of in real time\n"
+            "  --mouse         no script: sculpt with the mouse until the window is closed\n"
+            "  --screenshot-every MS\n"
+            "                  write DIR/frames/frame_<simulated ms>.png every MS simulated ms\n"
+            "  --input FILE    scripted keys and mouse for the window (tests, demos)\n"
+            "  --linger S      keep the window S seconds after the session ends (default 2)\n"
+            "  --width W, --height H  window size in pixels (default 1024 x 768)\n"
             "  -h, --help      this text\n");
 }
 
@@ -77,7 +97,11 @@ int cmd_sculpt(int argc, char **argv)
     session_opts_t o;
     session_opts_default(&o);
     int quiet = 0;
+    bool discard_journal = false;
     const char *screenshot = NULL;
+    sculpt_window_opts_t wo;
+    sculpt_window_opts_default(&wo);
+    bool headless = false;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -88,6 +112,63 @@ int cmd_sculpt(int argc, char **argv)
             quiet = 1;
         } else if (strcmp(a, "--no-deadline-fault") == 0) {
             o.deadline_faults = false;
+        } else if (strcmp(a, "--no-journal") == 0) {
+            o.journal = false;
+        } else if (strcmp(a, "--discard-journal") == 0) {
+            discard_journal = true;
+        } else if (strcmp(a, "--autosave-s") == 0 || strcmp(a, "--checkpoint-s") == 0) {
+            char *end = NULL;
+            const double sec = v ? strtod(v, &end) : 0.0;
+            if (!v || *end != '\0' || !(sec >= 0.001 && sec <= 3600.0)) {
+                fprintf(stderr, "argil sculpt: %s needs seconds in 0.001..3600 (see --help)\n", a);
+                return 2;
+            }
+            i++;
+            *(a[2] == 'a' ? &o.autosave_s : &o.checkpoint_s) = (float)sec;
+        } else if (strcmp(a, "--debug-journal-dump") == 0) {
+            /* Tests: --debug-journal-dump N FILE.argil writes the model as of journal record N
+             * and ends the session there (tests/sys/test_crash_recovery.sh). */
+            char *end = NULL;
+            const unsigned long rec = v ? strtoul(v, &end, 10) : 0;
+            if (!v || *end != '\0' || rec < 1 || rec > 0xffffffffUL || i + 2 >= argc) {
+                fprintf(stderr, "argil sculpt: --debug-journal-dump needs a record number >= 1 "
+                                "and a file\n");
+                return 2;
+            }
+            o.debug_dump_record = (uint32_t)rec;
+            o.debug_dump_path = argv[i + 2];
+            i += 2;
+        } else if (strcmp(a, "--headless") == 0 || strcmp(a, "--fast") == 0 ||
+                   strcmp(a, "--mouse") == 0) {
+            *(a[2] == 'h' ? &headless : a[2] == 'f' ? &wo.fast : &wo.mouse) = true;
+        } else if (strcmp(a, "--screenshot-every") == 0 || strcmp(a, "--linger") == 0) {
+            char *end = NULL;
+            const double x = v ? strtod(v, &end) : 0.0;
+            const double hi = a[2] == 's' ? 3.6e6 : 3600.0;
+            if (!v || *end != '\0' || !(x >= 0.0 && x <= hi)) {
+                fprintf(stderr, "argil sculpt: %s needs a number 0..%g (see --help)\n", a, hi);
+                return 2;
+            }
+            i++;
+            if (a[2] == 's')
+                wo.screenshot_every_s = x * 1e-3;
+            else
+                wo.linger_s = x;
+        } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0) {
+            char *end = NULL;
+            const long px = v ? strtol(v, &end, 10) : 0;
+            if (!v || *end != '\0' || px < 64 || px > 8192) {
+                fprintf(stderr, "argil sculpt: %s needs pixels 64..8192 (see --help)\n", a);
+                return 2;
+            }
+            i++;
+            *(a[2] == 'w' ? &wo.width : &wo.height) = (int)px;
+        } else if (strcmp(a, "--input") == 0) {
+            if (!v) {
+                fprintf(stderr, "argil sculpt: --input needs a file (see --help)\n");
+                return 2;
+            }
+            wo.input_path = argv[++i];
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--script") == 0 ||
                    strcmp(a, "--out") == 0 || strcmp(a, "--window") == 0 ||
                    strcmp(a, "--screenshot") == 0) {
@@ -99,9 +180,9 @@ int cmd_sculpt(int argc, char **argv)
             if (strcmp(a, "--device") == 0) {
                 if (strcmp(v, "sim") != 0) {
                     fprintf(stderr,
-                            "argil sculpt: device '%s' is not available in this build; only "
-                            "'sim' (the simulated arm) is\n",
-                            v);
+                            "argil sculpt: device '%s': a scripted session runs on 'sim' (the "
+                            "simulated arm); for a board use 'argil connect --device %s'\n",
+                            v, v);
                     return 2;
                 }
             } else if (strcmp(a, "--script") == 0) {
@@ -125,16 +206,51 @@ int cmd_sculpt(int argc, char **argv)
             return 2;
         }
     }
+    if (o.journal) {
+        const int offer = recover_offer(o.out_dir, discard_journal, isatty(STDIN_FILENO) != 0);
+        if (offer >= 0)
+            return offer;
+    }
     o.progress = !quiet && isatty(STDERR_FILENO);
     o.stop = &g_stop;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     session_summary_t s;
     char err[1024] = "";
-    const argil_err_t rc = session_run(&o, &s, err, sizeof(err));
+    /* The live window when there is a display (headless otherwise: the same files). */
+    const char *display = getenv("DISPLAY");
+    const bool live = !headless && display != NULL && display[0] != '\0';
+    if (!live && (wo.mouse || wo.input_path || wo.screenshot_every_s > 0.0)) {
+        fprintf(stderr, "argil sculpt: %s needs the window: a display (DISPLAY) and no "
+                        "--headless\n",
+                wo.mouse ? "--mouse" : wo.input_path ? "--input" : "--screenshot-every");
+        return 2;
+    }
+    char frames_dir[4096];
+    snprintf(frames_dir, sizeof(frames_dir), "%s/frames", o.out_dir ? o.out_dir : ".");
+    wo.frames_dir = wo.screenshot_every_s > 0.0 ? frames_dir : NULL;
+    wo.screenshot_path = screenshot;
+    wo.report = !quiet;
+    bool window_failed = false;
+    argil_err_t rc = ARGIL_ERR_STATE;
+    if (live) {
+        rc = sculpt_window_run(&o, &wo, &s, &window_failed, err, sizeof(err));
+        if (window_failed) {
+            if (wo.mouse) {
+                fprintf(stderr, "argil sculpt: %s\n", err);
+                return 1;
+            }
+            fprintf(stderr, "argil sculpt: %s; running without a window\n", err);
+        } else {
+            screenshot = NULL; /* the window wrote it */
+        }
+    }
+    if (!live || window_failed)
+        rc = session_run(&o, &s, err, sizeof(err));
     if (!quiet && s.board_ticks > 0) {
         const double vb = s.volume_before_m3 * 1e6, va = s.volume_after_m3 * 1e6;
-        printf("argil: session %s on the simulated arm%s\n", o.script_path,
+        printf("argil: session %s on the simulated arm%s\n",
+               wo.mouse ? "sculpted with the mouse" : o.script_path,
                s.interrupted ? " (interrupted: files hold the clay as it was then)" : "");
         printf("  simulated time      %.3f s (%u board ticks at %u Hz)\n", s.sim_seconds,
                s.board_ticks, s.tick_hz);
@@ -142,6 +258,14 @@ int cmd_sculpt(int argc, char **argv)
                s.worst_compute_ns / 1000.0, 1000000u / s.tick_hz, s.deadline_misses);
         printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time)\n",
                s.median_compute_ns / 1000u, s.p99_compute_ns / 1000u);
+        if (s.rt_stats_frames > 0)
+            printf("  board RT stats      %u reports, last over %u ticks: wake-up latency "
+                   "min/mean/max %.1f/%.1f/%.1f us, compute %.1f/%.1f/%.1f us, %u overruns "
+                   "(worst streak %u)\n",
+                   s.rt_stats_frames, s.rt.ticks, s.rt.wake_min_ns / 1000.0,
+                   s.rt.wake_mean_ns / 1000.0, s.rt.wake_max_ns / 1000.0,
+                   s.rt.compute_min_ns / 1000.0, s.rt.compute_mean_ns / 1000.0,
+                   s.rt.compute_max_ns / 1000.0, s.rt.overruns, s.rt.worst_streak);
         printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
                (double)s.force_limit_n);
         printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,
@@ -154,9 +278,18 @@ int cmd_sculpt(int argc, char **argv)
                s.fault_code ? ", last fault: " : "",
                s.fault_code ? safety_fault_name((fault_code_t)s.fault_code) : "");
         if (o.out_dir)
-            printf("  files               %s/final.ply, %s/telemetry.csv (%u rows), "
-                   "%s/session.scn\n",
-                   o.out_dir, o.out_dir, s.telemetry_rows, o.out_dir);
+            printf("  files               %s/final.ply, %s/telemetry.csv (%u rows)%s%s%s\n",
+                   o.out_dir, o.out_dir, s.telemetry_rows, wo.mouse ? "" : ", ",
+                   wo.mouse ? "" : o.out_dir, wo.mouse ? "" : "/session.scn");
+        if (s.journal_records > 0)
+            printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u checkpoints, "
+                   "%.1f ms of work; removed at this clean end\n",
+                   s.journal_records, (double)s.journal_bytes / 1024.0, s.journal_syncs,
+                   s.journal_checkpoints, s.journal_real_s * 1e3);
+        if (s.journal_stray_records > 0)
+            printf("  journal WARNING     %u edits found outside the solver's dirty box (a bug in "
+                   "an edit path; journaled anyway)\n",
+                   s.journal_stray_records);
     }
     if (rc != ARGIL_OK) {
         fprintf(stderr, "argil sculpt: %s\n", err);

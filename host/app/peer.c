@@ -153,6 +153,10 @@ void peer_receive(peer_t *p, const uint8_t *bytes, size_t len)
             p->stats.faults++;
             p->stats.last_fault_code = m->u.fault.code;
             break;
+        case MSG_RT_STATS:
+            p->last_rt = m->u.rt_stats;
+            p->stats.rt_stats_frames++;
+            break;
         default:
             break;
         }

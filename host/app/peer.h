@@ -51,6 +51,7 @@ typedef struct {
     uint32_t solves;
     uint32_t faults;
     uint16_t last_fault_code;
+    uint32_t rt_stats_frames;         /* RT_STATS frames received */
     double impulse_total_ns;          /* Σ|J| applied */
 } peer_stats_t;
 
@@ -65,6 +66,7 @@ typedef struct {
     bool board_seen;
     msg_telemetry_t last_tm;
     bool have_tm;
+    msg_rt_stats_t last_rt;           /* the board's newest deadline statistics (RT_STATS) */
     msg_tool_t tool;
     bool tool_dirty;
     bool want_armed;

@@ -8,12 +8,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "firmware/core/board_hal.h"
 #include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
+#include "host/io/journal.h"
 #include "host/io/ply.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
@@ -36,6 +38,12 @@ void session_opts_default(session_opts_t *o)
     o->settle_s = 2.0f;
     o->deadline_faults = true;
     o->stop = NULL;
+    o->hook = NULL;
+    o->journal = true;
+    o->autosave_s = 1.0f;
+    o->checkpoint_s = 60.0f;
+    o->debug_dump_record = 0;
+    o->debug_dump_path = NULL;
 }
 
 /* Everything a session owns; large, so it lives on the heap. */
@@ -54,6 +62,9 @@ typedef struct {
     uint8_t rx[HAL_SIM_LINK_BYTES];
     vec3_t model_offset_m;             /* model = device + offset (scale 1) */
     uint32_t compute_hist_us[COMPUTE_HIST_BINS]; /* tick compute times, 1 µs bins */
+    journal_t journal;                 /* autosave journal (when journaling) */
+    bool journaling;
+    uint32_t journal_solves;           /* peer solves already looked at by the journal */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -184,6 +195,55 @@ static void progress(const session_opts_t *o, double t_s, double total_s)
     fflush(stderr);
 }
 
+static double clock_s(clockid_t id)
+{
+    struct timespec ts;
+    clock_gettime(id, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* Journal: after a solve step, one record of what it changed; durable within autosave_s. Sets
+ * *stop_now once the debug dump of record debug_dump_record is written. */
+static argil_err_t journal_step(session_t *s, const session_opts_t *opts, double t_s,
+                                session_summary_t *sum, bool *stop_now, char *err, size_t err_len)
+{
+    /* Only a solve step (100 Hz) changes the field, inside the peer's dirty box (the box the
+     * re-mesher relies on too; the window hook may clear it, but only after this call). The
+     * clocks are read here only: on some virtual machines every read is a system call. */
+    if (s->peer.stats.solves == s->journal_solves)
+        return ARGIL_OK;
+    s->journal_solves = s->peer.stats.solves;
+    const double real0_s = clock_s(CLOCK_MONOTONIC);
+    const uint64_t wall_ms = (uint64_t)(clock_s(CLOCK_REALTIME) * 1e3);
+    journal_box_t box;
+    for (int a = 0; a < 3; a++) {
+        box.lo[a] = s->peer.dirty_lo[a];
+        box.hi[a] = s->peer.dirty_hi[a];
+    }
+    bool appended = false;
+    argil_err_t e = journal_record(&s->journal, &s->grid, &box, s->journal.seq + 1u, t_s,
+                                   real0_s, wall_ms, &appended, err, err_len);
+    if (e == ARGIL_OK && journal_sync_due(&s->journal, t_s, real0_s)) {
+        /* Before each write, the whole grid: a change outside the dirty box still gets saved
+         * (and counted: there should be none). */
+        bool stray = false;
+        e = journal_record(&s->journal, &s->grid, NULL, s->journal.seq + 1u, t_s, real0_s,
+                           wall_ms, &stray, err, err_len);
+        sum->journal_stray_records += stray;
+        appended = appended || stray;
+    }
+    if (e == ARGIL_OK && appended && opts->debug_dump_record == s->journal.seq &&
+        opts->debug_dump_path) {
+        e = journal_write_model(&s->journal, s->grid.density, s->journal.seq,
+                                opts->debug_dump_path, err, err_len);
+        *stop_now = true;
+    }
+    if (e == ARGIL_OK)
+        e = journal_tick(&s->journal, t_s, real0_s, err, err_len);
+    sum->journal_real_s += clock_s(CLOCK_MONOTONIC) - real0_s;
+    return e;
+}
+
 argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char *err,
                         size_t err_len)
 {
@@ -202,9 +262,11 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     char csv_tmp[4096] = "", csv_path[4096] = "", path[4096];
     script_init(&s->script);
 
-    rc = script_load(&s->script, opts->script_path, err, err_len);
-    if (rc != ARGIL_OK)
-        goto done;
+    if (opts->script_path) {
+        rc = script_load(&s->script, opts->script_path, err, err_len);
+        if (rc != ARGIL_OK)
+            goto done;
+    }
 
     /* The device and the board. */
     sim_params_default(&s->sim_params);
@@ -270,12 +332,25 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
                         "contact,sculpting\n");
     }
 
+    if (opts->out_dir && opts->journal) {
+        journal_cfg_t jcfg;
+        journal_cfg_default(&jcfg);
+        jcfg.autosave_s = opts->autosave_s;
+        jcfg.checkpoint_s = opts->checkpoint_s;
+        rc = journal_open(&s->journal, opts->out_dir, &s->grid, &jcfg, 0.0,
+                          clock_s(CLOCK_MONOTONIC), err, err_len);
+        if (rc != ARGIL_OK)
+            goto done;
+        s->journaling = true;
+    }
+
     /* The lockstep loop. */
     const uint32_t dt_us = bcfg.tick_us;
     const float dt_s = (float)dt_us * 1e-6f;
     const double script_s = script_duration_s(&s->script);
     const double total_s = opts->settle_s + script_s + SESSION_TAIL_S;
-    const uint64_t max_ticks = (uint64_t)(total_s / dt_s) + 1u;
+    const bool hold_open = opts->hook && opts->hook->hold_open;
+    const uint64_t max_ticks = hold_open ? UINT64_MAX : (uint64_t)(total_s / dt_s) + 1u;
     bool started = false, finished = false;
     double started_at_s = 0.0, finished_at_s = 0.0;
     peer_request_arm(&s->peer);
@@ -298,7 +373,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             finished = true;
             finished_at_s = t_s;
         }
-        if (finished && t_s - finished_at_s >= SESSION_TAIL_S)
+        if (finished && t_s - finished_at_s >= SESSION_TAIL_S && !hold_open)
             break;
         if (opts->stop && *opts->stop) {
             sum->interrupted = true;
@@ -339,6 +414,17 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
         peer_tick(&s->peer, dt_us);
+        if (s->journaling) {
+            bool stop_now = false;
+            rc = journal_step(s, opts, (double)(tick + 1u) * dt_s, sum, &stop_now, err, err_len);
+            if (rc != ARGIL_OK || stop_now)
+                break;
+        }
+        if (opts->hook) {
+            session_frame_t f = {(double)(tick + 1u) * dt_s, started, finished, &s->peer,
+                                 &s->player, s->model_offset_m};
+            opts->hook->on_tick(opts->hook->ctx, &f);
+        }
         if (tick % 1000u == 0)
             progress(opts, t_s, total_s);
     }
@@ -352,6 +438,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->tick_hz = 1000000u / dt_us;
     sum->worst_compute_ns = s->board.stats.worst_compute_ns;
     sum->deadline_misses = s->board.stats.deadline_misses;
+    sum->rt_stats_frames = s->peer.stats.rt_stats_frames;
+    sum->rt = s->peer.last_rt;
     sum->median_compute_ns = hist_percentile_us(s->compute_hist_us, 0.5) * 1000u;
     sum->p99_compute_ns = hist_percentile_us(s->compute_hist_us, 0.99) * 1000u;
     sum->peak_force_n = s->board.stats.peak_force_n;
@@ -396,14 +484,31 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             rc = ARGIL_ERR_IO;
         }
         snprintf(path, sizeof(path), "%s/session.scn", opts->out_dir);
-        if (copy_file(opts->script_path, path, ferr, sizeof(ferr)) != ARGIL_OK &&
-            rc == ARGIL_OK) {
+        if (opts->script_path &&
+            copy_file(opts->script_path, path, ferr, sizeof(ferr)) != ARGIL_OK && rc == ARGIL_OK) {
             snprintf(err, err_len, "%s", ferr);
             rc = ARGIL_ERR_IO;
         }
     }
 
+    /* A clean end: the outputs are whole, so the journal is no longer needed. */
+    if (s->journaling) {
+        sum->journal_records = s->journal.stats.records;
+        sum->journal_syncs = s->journal.stats.syncs;
+        sum->journal_checkpoints = s->journal.stats.checkpoints;
+        sum->journal_bytes = s->journal.stats.bytes;
+        if (rc == ARGIL_OK || rc == ARGIL_ERR_STATE) {
+            char jerr[512];
+            if (journal_finish(&s->journal, jerr, sizeof(jerr)) != ARGIL_OK && rc == ARGIL_OK) {
+                snprintf(err, err_len, "%s", jerr);
+                rc = ARGIL_ERR_IO;
+            }
+        }
+    }
+
 done:
+    if (s->journaling)
+        journal_close(&s->journal);
     if (s->csv) {
         fclose(s->csv);
         unlink(csv_tmp);

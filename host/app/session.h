@@ -10,16 +10,44 @@
 #include <signal.h>
 #include <stdint.h>
 
+#include "host/app/peer.h"
+#include "host/app/script.h"
 #include "shared/argil_err.h"
 
+/* What a per-tick hook sees of the running session (e.g. the live window, docs/render.md). */
 typedef struct {
-    const char *script_path;
+    double t_s;                   /* simulated time at the end of this tick */
+    bool active;                  /* the board has become ACTIVE (the script is playing) */
+    bool script_done;             /* every script command has finished */
+    peer_t *peer;                 /* grid, telemetry, tool, window; the hook may clear
+                                   * peer->dirty_lo/hi (they only record what to re-mesh) */
+    script_player_t *player;      /* the hook may change tool, filter and params (setting
+                                   * params_changed: the same path as script commands) and,
+                                   * once script_done, the hand (pos_m, vel_m_s, buttons) */
+    vec3_t model_offset_m;        /* model = device + offset */
+} session_frame_t;
+
+typedef struct {
+    void (*on_tick)(void *ctx, session_frame_t *f);  /* called after every board tick */
+    void *ctx;
+    bool hold_open;               /* after the script, keep running until *stop */
+} session_hook_t;
+
+typedef struct {
+    const char *script_path;      /* NULL: no script (the hook drives the hand) */
     const char *out_dir;          /* NULL: write nothing */
     int window_edge;              /* 16 or 32 */
     bool progress;                /* a progress line on stderr */
     float settle_s;               /* time allowed for the board to become ACTIVE */
     bool deadline_faults;         /* an overrun streak faults the board (off only for profiling) */
     volatile sig_atomic_t *stop;  /* set (e.g. by SIGINT) to end early and keep what was made */
+    const session_hook_t *hook;   /* NULL: none; a hook that changes nothing changes no result */
+    /* Autosave journal in out_dir (host/io/journal.h, docs/files.md). */
+    bool journal;                 /* on by default; removed again at a clean end */
+    float autosave_s;             /* records become durable within this (sim or real) time */
+    float checkpoint_s;           /* rotation onto a new base snapshot, simulated seconds */
+    uint32_t debug_dump_record;   /* tests: at journal record N (1-based; 0 = never) write the */
+    const char *debug_dump_path;  /* model as of it to this .argil and end the session */
 } session_opts_t;
 
 typedef struct {
@@ -30,6 +58,8 @@ typedef struct {
     uint32_t median_compute_ns;   /* of every tick, 1 µs resolution */
     uint32_t p99_compute_ns;
     uint32_t deadline_misses;
+    uint32_t rt_stats_frames;     /* RT_STATS reports the host received from the board */
+    msg_rt_stats_t rt;            /* the newest one (wake-up latency, compute, overruns) */
     float peak_force_n;
     float force_limit_n;
     double volume_before_m3;
@@ -44,6 +74,12 @@ typedef struct {
     uint32_t link_errors;
     uint32_t telemetry_rows;
     bool interrupted;             /* ended early through opts->stop */
+    uint32_t journal_records;     /* edit steps journaled */
+    uint32_t journal_syncs;       /* write + fdatasync rounds */
+    uint32_t journal_checkpoints; /* rotations onto a new base snapshot */
+    uint64_t journal_bytes;       /* record bytes appended */
+    uint32_t journal_stray_records; /* changes found outside the peer's dirty box (should be 0) */
+    double journal_real_s;        /* wall time spent diffing, appending and syncing */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);

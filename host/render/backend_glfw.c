@@ -27,7 +27,8 @@
     X(glfwGetCursorPos)                                                                          \
     X(glfwGetMouseButton)                                                                        \
     X(glfwGetKey)                                                                                \
-    X(glfwSetScrollCallback)
+    X(glfwSetScrollCallback)                                                                     \
+    X(glfwSetKeyCallback)
 
 
 #define GLFW_FIELD(name) __typeof__(&name) name;
@@ -63,6 +64,16 @@ static argil_err_t fail(glfw_window_t *w, const char *what, char *err, size_t er
     snprintf(err, err_len, "OpenGL window (GLFW): %s%s%s", what, why ? ": " : "", why ? why : "");
     glfw_window_close(w);
     return ARGIL_ERR_STATE;
+}
+
+static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
+{
+    (void)win;
+    (void)scancode;
+    (void)mods;
+    glfw_window_t *w = g_scroll_window;
+    if (w != NULL && (action == GLFW_PRESS || action == GLFW_REPEAT) && w->n_keys < GLFW_KEYS_QUEUED)
+        w->keys[w->n_keys++] = key;
 }
 
 argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visible, int samples,
@@ -112,6 +123,7 @@ argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visib
     f->glfwSwapInterval(1);
     g_scroll_window = w;
     f->glfwSetScrollCallback(win, on_scroll);
+    f->glfwSetKeyCallback(win, on_key);
     const argil_err_t rc = gl_api_load(gl, glfw_get_proc, f, err, err_len);
     if (rc != ARGIL_OK) {
         glfw_window_close(w);
@@ -127,6 +139,19 @@ void glfw_window_poll(glfw_window_t *w, glfw_input_t *in)
     in->left_down = f->glfwGetMouseButton(w->window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     f->glfwGetCursorPos(w->window, &in->cursor_x, &in->cursor_y);
     in->escape = f->glfwGetKey(w->window, GLFW_KEY_ESCAPE) == GLFW_PRESS;
+    in->right_down = f->glfwGetMouseButton(w->window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+    in->shift = f->glfwGetKey(w->window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                f->glfwGetKey(w->window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+}
+
+bool glfw_window_take_key(glfw_window_t *w, int *key)
+{
+    if (w->n_keys == 0)
+        return false;
+    *key = w->keys[0];
+    w->n_keys--;
+    memmove(w->keys, w->keys + 1, w->n_keys * sizeof(w->keys[0]));
+    return true;
 }
 
 double glfw_window_take_scroll(glfw_window_t *w)

@@ -9,17 +9,23 @@
 #include "host/render/gl_api.h"
 #include "shared/argil_err.h"
 
+#define GLFW_KEYS_QUEUED 32     /* key presses kept between two polls; more are dropped */
+
 typedef struct {
     void *lib;          /* dlopen handle of libglfw.so.3 */
     void *window;       /* GLFWwindow */
     void *fns;          /* the GLFW entry points (backend-private) */
     double scroll_y;    /* wheel steps accumulated since the last glfw_window_take_scroll */
+    int keys[GLFW_KEYS_QUEUED]; /* keys pressed (or repeated) since the last glfw_window_take_key */
+    unsigned n_keys;
 } glfw_window_t;
 
 typedef struct {
     bool left_down;     /* left mouse button held */
     double cursor_x, cursor_y;  /* pixels from the top-left corner */
     bool escape;        /* Esc pressed */
+    bool right_down;    /* right mouse button held */
+    bool shift;         /* either Shift key held */
 } glfw_input_t;
 
 /* Opens a width × height window (hidden when !visible) with a current GL 3.3 core context,
@@ -30,6 +36,9 @@ argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visib
 
 /* Processes pending events and returns the mouse and keyboard state. */
 void glfw_window_poll(glfw_window_t *w, glfw_input_t *in);
+
+/* Takes the oldest key pressed since the last poll (a GLFW_KEY_* code); false when none. */
+bool glfw_window_take_key(glfw_window_t *w, int *key);
 
 /* Returns the wheel steps since the last call (positive: away from the person). */
 double glfw_window_take_scroll(glfw_window_t *w);

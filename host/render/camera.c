@@ -135,3 +135,24 @@ void camera_matrices(const camera_t *c, float aspect, float view[16], float proj
     proj[11] = -1.0f;
     proj[14] = 2.0f * zf * zn / (zn - zf);
 }
+
+void camera_ray(const camera_t *c, double x, double y, int width, int height, vec3_t *origin_m,
+                vec3_t *dir)
+{
+    /* View space: eye at the origin looking down −z; model = Rᵀ · view + centre. */
+    const float *r = c->rot;
+    const float aspect = height > 0 ? (float)width / (float)height : 1.0f;
+    const float t = tanf(0.5f * c->fov_y_rad);
+    const float nx = width > 0 ? (float)(2.0 * x / width - 1.0) : 0.0f;
+    const float ny = height > 0 ? (float)(1.0 - 2.0 * y / height) : 0.0f;
+    const float v_eye[3] = {0.0f, 0.0f, c->dist_m};
+    const float v_dir[3] = {nx * t * aspect, ny * t, -1.0f};
+    float e[3], d[3];
+    for (int k = 0; k < 3; k++) {
+        e[k] = r[0 * 3 + k] * v_eye[0] + r[1 * 3 + k] * v_eye[1] + r[2 * 3 + k] * v_eye[2];
+        d[k] = r[0 * 3 + k] * v_dir[0] + r[1 * 3 + k] * v_dir[1] + r[2 * 3 + k] * v_dir[2];
+    }
+    *origin_m = vec3_add(c->center_m, vec3(e[0], e[1], e[2]));
+    const vec3_t dv = vec3(d[0], d[1], d[2]);
+    *dir = vec3_scale(dv, 1.0f / vec3_norm(dv));
+}

@@ -29,6 +29,11 @@ void camera_zoom(camera_t *c, double steps);
 /* Rotates the model by yaw about the view's up axis, then pitch about its right axis (radians). */
 void camera_orbit(camera_t *c, float yaw_rad, float pitch_rad);
 
+/* The model-space ray (eye position, unit direction) through pixel (x, y) from the top-left of
+ * a width × height view. */
+void camera_ray(const camera_t *c, double x, double y, int width, int height, vec3_t *origin_m,
+                vec3_t *dir);
+
 /* Fills column-major 4×4 view and projection matrices for a view of the given aspect ratio. */
 void camera_matrices(const camera_t *c, float aspect, float view[16], float proj[16]);
 

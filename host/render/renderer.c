@@ -154,6 +154,12 @@ static unsigned link_program(const gl_api_t *gl, const char *vs_src, const char 
 }
 
 /* A unit UV sphere whose positions are also its normals. */
+unsigned renderer_program(const gl_api_t *gl, const char *vs_src, const char *fs_src,
+                          char *err, size_t err_len)
+{
+    return link_program(gl, vs_src, fs_src, err, err_len);
+}
+
 static argil_err_t make_sphere(renderer_t *r)
 {
     const gl_api_t *gl = r->gl;

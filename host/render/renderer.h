@@ -69,6 +69,10 @@ void renderer_draw(const renderer_t *r, const render_scene_t *s, int width, int 
 /* Deletes every GL object; the context must still be current. */
 void renderer_free(renderer_t *r);
 
+/* Compiles and links a vertex + fragment program; 0 with the first line of the log in err. */
+unsigned renderer_program(const gl_api_t *gl, const char *vs_src, const char *fs_src,
+                          char *err, size_t err_len);
+
 /* An offscreen frame: a multisampled colour + depth framebuffer resolved into a plain one. */
 typedef struct {
     const gl_api_t *gl;

@@ -98,6 +98,18 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
         return x->time_us == y->time_us && x->code == y->code && x->state == y->state &&
                x->detail == y->detail;
     }
+    case MSG_RT_STATS: {
+        const msg_rt_stats_t *x = &a->u.rt_stats, *y = &b->u.rt_stats;
+        return x->time_us == y->time_us && x->ticks == y->ticks &&
+               x->period_ns == y->period_ns && x->wake_min_ns == y->wake_min_ns &&
+               x->wake_mean_ns == y->wake_mean_ns && x->wake_max_ns == y->wake_max_ns &&
+               x->compute_min_ns == y->compute_min_ns &&
+               x->compute_mean_ns == y->compute_mean_ns &&
+               x->compute_max_ns == y->compute_max_ns && x->overruns == y->overruns &&
+               x->worst_streak == y->worst_streak &&
+               memcmp(x->wake_hist, y->wake_hist, sizeof x->wake_hist) == 0 &&
+               memcmp(x->compute_hist, y->compute_hist, sizeof x->compute_hist) == 0;
+    }
     default:
         return 0;
     }
@@ -107,6 +119,18 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
  * proto.c's own checks: the ranges of docs/protocol.md. */
 static void check_ranges(const proto_msg_t *m)
 {
+    if (m->type == MSG_RT_STATS) {
+        const msg_rt_stats_t *r = &m->u.rt_stats;
+        uint64_t wake = 0, comp = 0;
+        for (size_t i = 0; i < PROTO_RT_HIST_BINS; i++) {
+            wake += r->wake_hist[i];
+            comp += r->compute_hist[i];
+        }
+        check(r->period_ns > 0u && wake == r->ticks && comp == r->ticks);
+        check(r->wake_min_ns <= r->wake_mean_ns && r->wake_mean_ns <= r->wake_max_ns);
+        check(r->compute_min_ns <= r->compute_mean_ns && r->compute_mean_ns <= r->compute_max_ns);
+        check(r->worst_streak <= r->overruns && r->overruns <= r->ticks);
+    }
     if (m->type == MSG_WINDOW) {
         const msg_window_t *w = &m->u.window;
         check(w->channels >= 1u && w->channels <= PROTO_WINDOW_CHANNELS_MAX);

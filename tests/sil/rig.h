@@ -37,11 +37,17 @@ typedef struct {
     can_batch_t last_from_board;
     uint8_t rx[HAL_SIM_LINK_BYTES];
     uint32_t ms;
+    /* Optional: every frame the host's peer sends goes here instead of straight to the link
+     * (tests/sil/test_faults.c loses, delays, duplicates and reorders them). NULL: direct. */
+    bool (*link_hook)(void *hook_ctx, const uint8_t *f, size_t len);
+    void *link_hook_ctx;
 } rig_t;
 
 static inline bool rig_send(void *ctx, const uint8_t *f, size_t len)
 {
     rig_t *r = ctx;
+    if (r->link_hook)
+        return r->link_hook(r->link_hook_ctx, f, len);
     return hal_sim_host_send(&r->hal, f, len) == ARGIL_OK;
 }
 

@@ -160,6 +160,40 @@ static void test_drive_fault_reaches_fault_state(void **st)
     rig_free(r);
 }
 
+static void test_host_receives_the_boards_rt_stats_every_second(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new(0.8f);
+    assert_true(rig_until_active(r, 1000) > 0);
+    /* some work: the tool goes to the clay and back */
+    rig_move(r, vec3(0, 0, 0.031f), 500);
+    rig_move(r, vec3(0, 0, 0.045f), 500);
+    while (r->board.stats.ticks < 3500u)
+        rig_tick(r);
+    const msg_rt_stats_t *rt = &r->peer.last_rt;
+    /* one report per second of board time, each decoded by the host's peer */
+    assert_int_equal(r->peer.stats.rt_stats_frames, 3);
+    assert_int_equal(r->board.stats.rt_stats_sent, 3);
+    /* the newest covers every tick up to its send: within one period of the board's count */
+    assert_true(rt->ticks + 1000u >= r->board.stats.ticks);
+    assert_true(rt->ticks <= r->board.stats.ticks);
+    assert_int_equal(rt->ticks, 2999u); /* sent in tick 3000, recording ticks 1 … 2999 */
+    assert_int_equal(rt->period_ns, 1000000u);
+    assert_true(rt->time_us == 3000000u);
+    /* lockstep: the loop never sleeps late; compute times are real and well under 1 ms */
+    assert_int_equal(rt->wake_max_ns, 0u);
+    assert_int_equal(rt->wake_hist[0], rt->ticks);
+    assert_true(rt->compute_min_ns <= rt->compute_mean_ns);
+    assert_true(rt->compute_mean_ns <= rt->compute_max_ns);
+    assert_true(rt->compute_max_ns > 0u);
+    uint64_t sum = 0;
+    for (uint32_t i = 0; i < PROTO_RT_HIST_BINS; i++)
+        sum += rt->compute_hist[i];
+    assert_true(sum == rt->ticks);
+    assert_int_equal(rt->overruns, r->board.rt.overruns);
+    rig_free(r);
+}
+
 static void test_garbage_on_the_link_is_refused_not_fatal(void **st)
 {
     (void)st;
@@ -191,6 +225,7 @@ int main(void)
         cmocka_unit_test(test_host_lost_fades_force_within_20ms),
         cmocka_unit_test(test_drive_fault_reaches_fault_state),
         cmocka_unit_test(test_garbage_on_the_link_is_refused_not_fatal),
+        cmocka_unit_test(test_host_receives_the_boards_rt_stats_every_second),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -27,7 +27,7 @@ expect_error() { # expected-status expected-text args...
 expect_error 2 "unknown command 'frobnicate'" frobnicate
 expect_error 2 "unknown option '--bogus'" sculpt --bogus
 expect_error 2 "needs a value" sculpt --script
-expect_error 2 "device 'usb' is not available" sculpt --device usb
+expect_error 2 "device 'usb': a scripted session runs on 'sim'" sculpt --device usb
 expect_error 2 "--window must be" sculpt --window 99
 expect_error 1 "$tmp/none.scn: cannot open" sculpt --script "$tmp/none.scn" --out "$tmp/o1"
 printf 'tool push\nmove 0 0 abc 1\n' >"$tmp/bad.scn"

@@ -234,11 +234,46 @@ static void test_shutdown_frames(void **st)
     assert_int_equal(node, 3);
 }
 
+/* A drive that tripped while the power is off (FAULT, DRIVE_FAULT_N low) gets fault resets for
+ * exactly the requested window and nothing that could enable it; afterwards it is left alone. */
+static void test_fault_reset_while_off_is_bounded(void **st)
+{
+    (void)st;
+    drives_t dr;
+    drives_cfg_default(&cfg);
+    drives_init(&dr);
+    heartbeat_all(&dr, NMT_STATE_OPERATIONAL);
+    status_all(&dr, CIA402_FAULT);
+    can_batch_t tx = {0};
+    uint16_t cw;
+    int16_t tq;
+    drives_process(&dr, &cfg, false, torque, 1000, &tx);
+    assert_true(rpdo_of(&tx, 1, &cw, &tq));
+    assert_int_equal(cw, CIA402_CW_DISABLE_VOLTAGE); /* no reset unless asked */
+    drives_request_fault_reset(&dr, 5000);          /* 5 ticks of 1 ms */
+    int resets = 0, others = 0;
+    for (int k = 0; k < 12; k++) {
+        tx.n = 0;
+        drives_process(&dr, &cfg, false, torque, 1000, &tx);
+        assert_true(rpdo_of(&tx, 3, &cw, &tq));
+        assert_int_equal(tq, 0);
+        if (cw == CIA402_CW_FAULT_RESET)
+            resets++;
+        else if (cw != CIA402_CW_DISABLE_VOLTAGE)
+            others++; /* shutdown / switch on / enable would be a defect */
+        if (k >= 5)
+            assert_int_equal(cw, CIA402_CW_DISABLE_VOLTAGE);
+    }
+    assert_int_equal(others, 0);
+    assert_true(resets >= 2); /* rising edges of bit 7 alternate with 0 */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nmt_start_then_power_walk),
         cmocka_unit_test(test_quick_stop_and_fault_reset),
+        cmocka_unit_test(test_fault_reset_while_off_is_bounded),
         cmocka_unit_test(test_heartbeat_consumer_150ms),
         cmocka_unit_test(test_emcy_latched_and_classified),
         cmocka_unit_test(test_bus_passive_off_and_recovery),

@@ -78,6 +78,22 @@ static const uint8_t golden_fault[31] = {
     0x40, 0x4b, 0x4c, 0x00, 0x00, 0x00, 0x00, 0x00, 0x03, 0x00, 0x05, 0xef,
     0xbe, 0xad, 0xde, 0xd3, 0xeb, 0xe8, 0xcf,
 };
+static const uint8_t golden_rt_stats[160] = {
+    0x41, 0x52, 0x47, 0x4c, 0x01, 0x08, 0x90, 0x00, 0x08, 0x00, 0x00, 0x00,
+    0xc0, 0xc6, 0x2d, 0x00, 0x00, 0x00, 0x00, 0x00, 0xb8, 0x0b, 0x00, 0x00,
+    0x40, 0x42, 0x0f, 0x00, 0xb0, 0x04, 0x00, 0x00, 0x34, 0x21, 0x00, 0x00,
+    0xa0, 0x56, 0x09, 0x00, 0x04, 0x10, 0x00, 0x00, 0x00, 0x64, 0x00, 0x00,
+    0xd0, 0x12, 0x13, 0x00, 0x03, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00,
+    0x34, 0x08, 0x00, 0x00, 0x80, 0x02, 0x00, 0x00, 0x96, 0x00, 0x00, 0x00,
+    0x3c, 0x00, 0x00, 0x00, 0x1e, 0x00, 0x00, 0x00, 0x0c, 0x00, 0x00, 0x00,
+    0x05, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x0a, 0x00, 0x00, 0x00, 0xc4, 0x09, 0x00, 0x00,
+    0x90, 0x01, 0x00, 0x00, 0x3c, 0x00, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00,
+    0x06, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x03, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0xaf, 0xde, 0x44, 0xb6,
+};
 
 #define WINDOW_SAMPLES_32 (32u * 32u * 32u)
 #define ARRAY_MAX (PROTO_WINDOW_CHANNELS_MAX * ARGIL_WINDOW_SAMPLES_MAX)
@@ -260,6 +276,23 @@ static void assert_msg_equal(const proto_msg_t *a, const proto_msg_t *b)
         assert_int_equal(a->u.fault.state, b->u.fault.state);
         assert_int_equal(a->u.fault.detail, b->u.fault.detail);
         break;
+    case MSG_RT_STATS:
+        assert_true(a->u.rt_stats.time_us == b->u.rt_stats.time_us);
+        assert_int_equal(a->u.rt_stats.ticks, b->u.rt_stats.ticks);
+        assert_int_equal(a->u.rt_stats.period_ns, b->u.rt_stats.period_ns);
+        assert_int_equal(a->u.rt_stats.wake_min_ns, b->u.rt_stats.wake_min_ns);
+        assert_int_equal(a->u.rt_stats.wake_mean_ns, b->u.rt_stats.wake_mean_ns);
+        assert_int_equal(a->u.rt_stats.wake_max_ns, b->u.rt_stats.wake_max_ns);
+        assert_int_equal(a->u.rt_stats.compute_min_ns, b->u.rt_stats.compute_min_ns);
+        assert_int_equal(a->u.rt_stats.compute_mean_ns, b->u.rt_stats.compute_mean_ns);
+        assert_int_equal(a->u.rt_stats.compute_max_ns, b->u.rt_stats.compute_max_ns);
+        assert_int_equal(a->u.rt_stats.overruns, b->u.rt_stats.overruns);
+        assert_int_equal(a->u.rt_stats.worst_streak, b->u.rt_stats.worst_streak);
+        assert_memory_equal(a->u.rt_stats.wake_hist, b->u.rt_stats.wake_hist,
+                            sizeof a->u.rt_stats.wake_hist);
+        assert_memory_equal(a->u.rt_stats.compute_hist, b->u.rt_stats.compute_hist,
+                            sizeof a->u.rt_stats.compute_hist);
+        break;
     default:
         fail_msg("unexpected type %d", a->type);
     }
@@ -373,6 +406,27 @@ static proto_msg_t golden_msg(uint8_t type)
         m.u.fault.state = 5;
         m.u.fault.detail = 0xDEADBEEFu;
         break;
+    case MSG_RT_STATS: {
+        static const uint32_t wake[PROTO_RT_HIST_BINS] = {2100, 640, 150, 60, 30, 12,
+                                                          5,    2,   1,   0,  0,  0};
+        static const uint32_t comp[PROTO_RT_HIST_BINS] = {0, 10, 2500, 400, 60, 20,
+                                                          6, 1,  3,    0,   0,  0};
+        msg_rt_stats_t *r = &m.u.rt_stats;
+        r->time_us = 3000000u;
+        r->ticks = 3000u;
+        r->period_ns = 1000000u;
+        r->wake_min_ns = 1200u;
+        r->wake_mean_ns = 8500u;
+        r->wake_max_ns = 612000u;
+        r->compute_min_ns = 4100u;
+        r->compute_mean_ns = 25600u;
+        r->compute_max_ns = 1250000u;
+        r->overruns = 3u;
+        r->worst_streak = 2u;
+        memcpy(r->wake_hist, wake, sizeof wake);
+        memcpy(r->compute_hist, comp, sizeof comp);
+        break;
+    }
     default:
         break;
     }
@@ -579,6 +633,13 @@ static void test_golden_fault_frame_matches_the_spec(void **state)
     check_golden(MSG_FAULT, golden_fault, sizeof golden_fault);
 }
 
+static void test_golden_rt_stats_frame_matches_the_spec(void **state)
+{
+    (void)state;
+    check_golden(MSG_RT_STATS, golden_rt_stats, sizeof golden_rt_stats);
+}
+
+
 /* ---- round trips ---- */
 
 static void test_every_message_type_survives_a_round_trip_at_its_extremes(void **state)
@@ -747,7 +808,8 @@ static void test_unknown_message_types_are_refused(void **state)
 {
     (void)state;
     assert_int_equal(decode_patched_u8(golden_fault, sizeof golden_fault, 5, 0), PROTO_ERR_TYPE);
-    assert_int_equal(decode_patched_u8(golden_fault, sizeof golden_fault, 5, 8), PROTO_ERR_TYPE);
+    assert_int_equal(decode_patched_u8(golden_fault, sizeof golden_fault, 5, MSG_TYPE_LAST + 1),
+                     PROTO_ERR_TYPE);
     assert_int_equal(decode_patched_u8(golden_fault, sizeof golden_fault, 5, 0xFF),
                      PROTO_ERR_TYPE);
 }
@@ -775,6 +837,7 @@ static void test_payload_length_that_does_not_fit_the_type_is_refused(void **sta
         { golden_telemetry, sizeof golden_telemetry },
         { golden_tool, sizeof golden_tool },
         { golden_fault, sizeof golden_fault },
+        { golden_rt_stats, sizeof golden_rt_stats },
     };
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++) {
         uint16_t plen = (uint16_t)(fixed[i].len - PROTO_HEADER_SIZE - PROTO_CRC_SIZE);
@@ -954,7 +1017,7 @@ static void test_encoder_refuses_what_the_decoder_would_refuse(void **state)
     proto_msg_t m = golden_msg(MSG_FAULT);
     m.type = 0;
     assert_int_equal(encode_err(&m), PROTO_ERR_TYPE);
-    m.type = MSG_FAULT + 1;
+    m.type = MSG_TYPE_LAST + 1;
     assert_int_equal(encode_err(&m), PROTO_ERR_TYPE);
 
     m = golden_msg(MSG_HELLO);
@@ -1679,6 +1742,79 @@ static void test_window_larger_than_the_storage_is_refused(void **state)
     assert_int_equal(window_asm_feed(&a, &c), PROTO_ERR_CHUNK);
 }
 
+/* RT_STATS payload offsets (docs/protocol.md). */
+#define RT_AT(off) (PROTO_HEADER_SIZE + (off))
+
+static void test_rt_stats_fields_that_contradict_each_other_are_refused(void **state)
+{
+    (void)state;
+    const uint8_t *g = golden_rt_stats;
+    const size_t n = sizeof golden_rt_stats;
+    /* period 0 */
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(12), 0u), PROTO_ERR_VALUE);
+    /* wake: min > mean, mean > max; compute: the same */
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(16), 8501u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(20), 612001u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(28), 25601u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(32), 1250001u), PROTO_ERR_VALUE);
+    /* the edges of each rule are accepted: min = mean = max */
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(16), 8500u), PROTO_OK);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(20), 612000u), PROTO_OK);
+    /* more overruns than ticks; a worst streak longer than the overruns */
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(40), 3001u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(44), 4u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(44), 3u), PROTO_OK);
+    /* a histogram that does not sum to the ticks: wake bin 0, compute bin 11, ticks */
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(48), 2101u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(48 + 4 * 23), 1u), PROTO_ERR_VALUE);
+    assert_int_equal(decode_patched_u32(g, n, RT_AT(8), 2999u), PROTO_ERR_VALUE);
+    /* counts whose sum wraps a u32 round to the ticks: still refused (the sum is 64-bit) */
+    uint8_t f[sizeof golden_rt_stats];
+    memcpy(f, g, n);
+    put_u32(f + RT_AT(48), 2101u);
+    put_u32(f + RT_AT(48 + 4 * 11), 0xFFFFFFFFu);
+    reseal(f, 144u);
+    assert_int_equal(decode_err(f, n), PROTO_ERR_VALUE);
+    /* the wrong payload length for the type */
+    assert_int_equal(decode_resized(g, n, 143u), PROTO_ERR_PAYLOAD);
+    assert_int_equal(decode_resized(g, n, 145u), PROTO_ERR_PAYLOAD);
+    /* the encoder refuses the same */
+    proto_msg_t m = golden_msg(MSG_RT_STATS);
+    m.u.rt_stats.compute_hist[0] = 1u;
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    m = golden_msg(MSG_RT_STATS);
+    m.u.rt_stats.period_ns = 0u;
+    assert_int_equal(encode_err(&m), PROTO_ERR_VALUE);
+    /* an empty record (no tick measured yet) is valid: all zeros but the period */
+    memset(&m.u.rt_stats, 0, sizeof m.u.rt_stats);
+    m.u.rt_stats.period_ns = 250000u;
+    assert_int_equal(round_trip(&m), 12u + 144u + 4u);
+}
+
+static void test_decoded_chunk_assembles_the_same_without_repeated_checks(void **state)
+{
+    (void)state;
+    proto_msg_t m;
+    size_t used = 0;
+    assert_int_equal(proto_decode(golden_window2, sizeof golden_window2, &m, &used), PROTO_OK);
+    static float a_store[16], b_store[16];
+    window_asm_t a, b;
+    window_asm_init(&a, a_store, 16);
+    window_asm_init(&b, b_store, 16);
+    assert_int_equal(window_asm_feed(&a, &m.u.window), PROTO_OK);
+    assert_int_equal(window_asm_feed_decoded(&b, &m.u.window), PROTO_OK);
+    assert_true(window_asm_complete(&a) && window_asm_complete(&b));
+    assert_memory_equal(a_store, b_store, sizeof a_store);
+    assert_float_equal(b_store[15], 350.5f, 0.0f);
+    /* the assembly's own rules still hold: an older version is refused, a larger window too */
+    msg_window_t older = m.u.window;
+    older.version = 8u;
+    assert_int_equal(window_asm_feed_decoded(&b, &older), PROTO_ERR_CHUNK);
+    window_asm_t c;
+    window_asm_init(&c, b_store, 15);
+    assert_int_equal(window_asm_feed_decoded(&c, &m.u.window), PROTO_ERR_CHUNK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1691,6 +1827,9 @@ int main(void)
         cmocka_unit_test(test_golden_two_channel_window_frame_matches_the_spec),
         cmocka_unit_test(test_golden_tool_frame_matches_the_spec),
         cmocka_unit_test(test_golden_fault_frame_matches_the_spec),
+        cmocka_unit_test(test_golden_rt_stats_frame_matches_the_spec),
+        cmocka_unit_test(test_decoded_chunk_assembles_the_same_without_repeated_checks),
+        cmocka_unit_test(test_rt_stats_fields_that_contradict_each_other_are_refused),
         cmocka_unit_test(test_every_message_type_survives_a_round_trip_at_its_extremes),
         cmocka_unit_test(test_wrong_magic_is_refused_as_soon_as_four_bytes_arrive),
         cmocka_unit_test(test_frame_shorter_than_its_header_is_truncated),

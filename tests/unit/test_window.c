@@ -201,6 +201,61 @@ static void test_contact_force_pushes_out_with_stiffness(void **st)
     }
 }
 
+static void test_swapped_window_starts_at_rest_over_a_used_buffer(void **st)
+{
+    (void)st;
+    static float s[EDGE * EDGE * EDGE];
+    const int32_t n = EDGE * EDGE * EDGE;
+    fill(s, 0, 0.01f);
+    load(s, 1);
+    /* the first buffer is used: springs moved, forces pending */
+    window_buf_t *b = window_active_mut(win);
+    for (int32_t i = 0; i < n; i++) {
+        b->rest[i] = 0.25f;
+        b->velocity[i] = 3.0f;
+        b->force[i] = -7.0f;
+    }
+    fill(s, 1, 0);
+    load(s, 2);  /* into the other buffer */
+    fill(s, 0, 0.008f);
+    load(s, 3);  /* back into the used one: chunk by chunk it must be reset */
+    b = window_active_mut(win);
+    assert_int_equal(b->version, 3);
+    assert_memory_equal(b->density, s, sizeof(s));
+    assert_memory_equal(b->rest, s, sizeof(s));
+    for (int32_t i = 0; i < n; i++) {
+        assert_float_equal(b->velocity[i], 0.0f, 0.0f);
+        assert_float_equal(b->force[i], 0.0f, 0.0f);
+    }
+}
+
+static void test_density_alone_equals_the_sampled_density_bit_for_bit(void **st)
+{
+    (void)st;
+    static float s[EDGE * EDGE * EDGE];
+    fill(s, 0, 0.009f);
+    load(s, 1);
+    const window_buf_t *b = window_active(win);
+    const float ext = (EDGE - 1) * H;
+    int inside = 0;
+    for (int k = 0; k < 4000; k++) {
+        /* points over and a little beyond the window, on an irregular lattice */
+        const vec3_t p = vec3(b->origin_m.x - 0.05f * ext + 1.1f * ext * (float)((k * 37) % 101) / 100.0f,
+                              b->origin_m.y - 0.05f * ext + 1.1f * ext * (float)((k * 53) % 89) / 88.0f,
+                              b->origin_m.z - 0.05f * ext + 1.1f * ext * (float)((k * 71) % 97) / 96.0f);
+        float d1 = -1.0f, d2 = -2.0f;
+        vec3_t g;
+        const bool in1 = window_sample(b, p, &d1, &g);
+        const bool in2 = window_density(b, p, &d2);
+        assert_int_equal(in1, in2);
+        if (in1) {
+            assert_memory_equal(&d1, &d2, sizeof d1);
+            inside++;
+        }
+    }
+    assert_true(inside > 2000 && inside < 4000); /* both inside and outside were tried */
+}
+
 static void test_push_lowers_density_and_records_impulses(void **st)
 {
     (void)st;
@@ -216,6 +271,7 @@ static void test_push_lowers_density_and_records_impulses(void **st)
     haptics_out_t out;
     float d0, d1;
     vec3_t g;
+    int32_t box_lo[3] = {EDGE, EDGE, EDGE}, box_hi[3] = {-1, -1, -1};
     window_sample(b, vec3(0, 0, -0.002f), &d0, &g);
     /* Press 3 mm into the clay over 60 ticks with the button held, stepping the springs. */
     for (int i = 0; i <= 60; i++) {
@@ -223,6 +279,10 @@ static void test_push_lowers_density_and_records_impulses(void **st)
                         imp, &out);
         if (i > 0)
             assert_true(out.sculpting); /* the first tick has no path yet */
+        for (int a = 0; a < 3; a++) {
+            box_lo[a] = out.touched_lo[a] < box_lo[a] ? out.touched_lo[a] : box_lo[a];
+            box_hi[a] = out.touched_hi[a] > box_hi[a] ? out.touched_hi[a] : box_hi[a];
+        }
         spring_field_t f = {{EDGE, EDGE, EDGE}, b->density, b->rest, b->velocity, b->force, NULL};
         const int32_t lo[3] = {0, 0, 0}, hi[3] = {EDGE, EDGE, EDGE};
         springs_step(&f, &b->material, lo, hi, 0.001f);
@@ -243,6 +303,18 @@ static void test_push_lowers_density_and_records_impulses(void **st)
     }
     assert_true(total < 0.0);
     assert_true(touched > 8); /* spread by β over more than one cell's corners */
+    /* every node that received an impulse lies in the reported box (the board flushes only
+     * that box), and the box is not the whole window */
+    for (int i = 0; i < EDGE * EDGE * EDGE; i++) {
+        if (imp[i] == 0.0f)
+            continue;
+        const int x = i % EDGE, y = (i / EDGE) % EDGE, z = i / (EDGE * EDGE);
+        assert_true(x >= box_lo[0] && x <= box_hi[0]);
+        assert_true(y >= box_lo[1] && y <= box_hi[1]);
+        assert_true(z >= box_lo[2] && z <= box_hi[2]);
+    }
+    assert_true((box_hi[0] - box_lo[0] + 1) * (box_hi[1] - box_lo[1] + 1) *
+                    (box_hi[2] - box_lo[2] + 1) < EDGE * EDGE * EDGE / 2);
     /* Without the button nothing is sculpted. */
     memset(imp, 0, sizeof(imp));
     haptics_process(&h, &t, b, vec3(0, 0, -0.004f), vec3(0, 0, 0), false, true, 0.001f, imp, &out);
@@ -259,6 +331,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_gradient_matches_finite_differences, setup, teardown),
         cmocka_unit_test_setup_teardown(test_contact_force_pushes_out_with_stiffness, setup, teardown),
         cmocka_unit_test_setup_teardown(test_push_lowers_density_and_records_impulses, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_swapped_window_starts_at_rest_over_a_used_buffer, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_density_alone_equals_the_sampled_density_bit_for_bit, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,694 @@
+/* argil connect: a live session with a board over the host link. A link thread only moves
+ * frames between the transport and two lock-free rings; the solver thread (this command's
+ * main thread) runs the host's protocol peer on the global clay, records telemetry and prints
+ * a status line; Ctrl-C ends it and the clay is written like `argil sculpt` writes it. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "firmware/core/safety.h"
+#include "firmware/core/spsc_ring.h"
+#include "host/app/commands.h"
+#include "host/app/peer.h"
+#include "host/io/argil_file.h"
+#include "host/io/ply.h"
+#include "host/link/link.h"
+#include "host/mesh/mc.h"
+#include "host/mesh/mesh_check.h"
+#include "host/model/grid.h"
+#include "shared/arm_kin.h"
+#include "sim/sim_device.h"
+
+#define CONNECT_RX_RING_BYTES (1u << 20)  /* ~1 s of board traffic if the solver stalls */
+#define CONNECT_TX_RING_BYTES (1u << 18)
+#define CONNECT_HELLO_PERIOD_US 100000u   /* HELLO again until the board answers */
+#define CONNECT_REARM_PERIOD_US 100000u
+#define CONNECT_GRID_EDGE 72
+#define CONNECT_SPACING_M 0.00125f
+#define CONNECT_CLAY_RADIUS_M 0.030f
+#define CONNECT_CLAY_BELOW_M 0.040f       /* clay centre below the workspace centre */
+
+static volatile sig_atomic_t g_connect_stop;
+
+static void on_stop_signal(int sig)
+{
+    (void)sig;
+    g_connect_stop = 1;
+}
+
+/* What the link thread publishes for the solver thread (relaxed atomics: counters only). */
+typedef struct {
+    _Atomic uint32_t state;         /* link_state_t */
+    _Atomic uint32_t resyncs;       /* reconnections seen (each asks for a HELLO) */
+    _Atomic uint32_t frames_rx, frames_tx, errors_rx, errors_tx, reconnects;
+    _Atomic uint32_t tx_dropped;    /* frames the transport could not take */
+} link_pub_t;
+
+typedef struct {
+    link_t link;
+    spsc_ring_t rx, tx;             /* link → solver, solver → link */
+    uint8_t *rx_store, *tx_store;
+    link_pub_t pub;
+    _Atomic bool stop;
+} conn_t;
+
+typedef struct {
+    conn_t *c;
+    grid_t grid;
+    peer_t peer;
+    FILE *csv;
+    uint32_t csv_rows;
+    uint64_t t0_us, now_us;
+    /* what the board said */
+    uint32_t board_hellos;
+    uint32_t board_restarts;        /* telemetry tick went backwards */
+    uint32_t active_entries;        /* transitions into ACTIVE */
+    uint8_t last_state;
+    bool have_tm;
+    uint32_t prev_tick;
+    uint32_t deadline_misses;
+    float peak_force_n;
+    /* per status period */
+    uint32_t worst_compute_ns;
+    uint32_t tick_at_status;
+    uint64_t board_us_at_status;
+    bool have_status_ref;
+    /* window round trip: a window fully sent → telemetry reports it in use */
+    uint32_t rtt_version;
+    uint64_t rtt_t0_us;
+    bool rtt_pending;
+    double rtt_ms, rtt_worst_ms;
+    uint32_t rtt_samples;
+    uint32_t windows_seen;
+} solver_t;
+
+static uint64_t mono_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
+}
+
+/* ---- the link thread: frames between the transport and the rings, nothing else ---- */
+
+static void *link_thread(void *arg)
+{
+    conn_t *c = arg;
+    static uint8_t frame[PROTO_FRAME_MAX];
+    uint32_t losses = 0, drops = 0;
+    while (!atomic_load_explicit(&c->stop, memory_order_acquire)) {
+        link_poll(&c->link, 1000u, mono_us());
+        /* The poll may have waited, or the whole process been stopped: judge the silence
+         * with a fresh clock before taking in the frames that end it. */
+        link_set_time(&c->link, mono_us());
+        if (c->link.fsm.losses != losses) {
+            /* A loss marker in order with the frames: 1 byte, 1 when the transport itself
+             * went away (USB unplug), 0 for silence. */
+            const uint8_t by_transport = c->link.fsm.transport_drops != drops;
+            (void)spsc_push(&c->rx, &by_transport, 1);
+            losses = c->link.fsm.losses;
+            drops = c->link.fsm.transport_drops;
+        }
+        size_t n;
+        while ((n = link_recv(&c->link, frame, sizeof(frame))) > 0)
+            (void)spsc_push(&c->rx, frame, n); /* full: counted by the ring as dropped */
+        size_t len;
+        while (spsc_pop(&c->tx, frame, sizeof(frame), &len) == ARGIL_OK)
+            if (link_send(&c->link, frame, len) != ARGIL_OK)
+                atomic_fetch_add_explicit(&c->pub.tx_dropped, 1u, memory_order_relaxed);
+        if (link_take_resync(&c->link))
+            atomic_fetch_add_explicit(&c->pub.resyncs, 1u, memory_order_relaxed);
+        const link_stats_t *s = &c->link.stats;
+        atomic_store_explicit(&c->pub.state, (uint32_t)link_state(&c->link), memory_order_relaxed);
+        atomic_store_explicit(&c->pub.frames_rx, s->frames_rx, memory_order_relaxed);
+        atomic_store_explicit(&c->pub.frames_tx, s->frames_tx, memory_order_relaxed);
+        atomic_store_explicit(&c->pub.errors_rx, s->errors_rx, memory_order_relaxed);
+        atomic_store_explicit(&c->pub.errors_tx, s->errors_tx, memory_order_relaxed);
+        atomic_store_explicit(&c->pub.reconnects, s->reconnects, memory_order_relaxed);
+    }
+    /* Last frames out (the heartbeat that says we are going). */
+    size_t len;
+    while (spsc_pop(&c->tx, frame, sizeof(frame), &len) == ARGIL_OK)
+        (void)link_send(&c->link, frame, len);
+    link_poll(&c->link, 0u, mono_us());
+    return NULL;
+}
+
+/* ---- the solver thread ---- */
+
+static bool ring_send(void *ctx, const uint8_t *frame, size_t len)
+{
+    solver_t *s = ctx;
+    return spsc_push(&s->c->tx, frame, len) == ARGIL_OK;
+}
+
+static void send_simple(solver_t *s, uint8_t type, uint8_t command)
+{
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = type;
+    if (type == MSG_HELLO) {
+        m.u.hello.role = PROTO_ROLE_HOST;
+        m.u.hello.window_max = (uint16_t)s->peer.cfg.window_edge;
+        memcpy(m.u.hello.name, "argil connect", 13);
+    } else {
+        m.u.heartbeat.time_us = s->peer.time_us;
+        m.u.heartbeat.window_version = s->peer.have_current ? s->peer.current.version : 0u;
+        m.u.heartbeat.impulse_seq = s->peer.impulse_seq_applied;
+        m.u.heartbeat.command = command;
+    }
+    uint8_t buf[PROTO_FRAME_MAX];
+    size_t len = 0;
+    if (proto_encode(&m, s->peer.tx_seq, buf, sizeof(buf), &len) == PROTO_OK &&
+        ring_send(s, buf, len))
+        s->peer.tx_seq++;
+}
+
+static void on_telemetry(void *ctx, const msg_telemetry_t *t)
+{
+    solver_t *s = ctx;
+    if (s->have_tm && t->tick < s->prev_tick)
+        s->board_restarts++;
+    if (t->state == SAFETY_ACTIVE && (!s->have_tm || s->last_state != SAFETY_ACTIVE))
+        s->active_entries++;
+    s->have_tm = true;
+    s->prev_tick = t->tick;
+    s->last_state = t->state;
+    s->deadline_misses = t->deadline_misses;
+    if (t->compute_ns > s->worst_compute_ns)
+        s->worst_compute_ns = t->compute_ns;
+    const double fn = sqrt((double)t->force_n[0] * t->force_n[0] +
+                           (double)t->force_n[1] * t->force_n[1] +
+                           (double)t->force_n[2] * t->force_n[2]);
+    if ((float)fn > s->peak_force_n)
+        s->peak_force_n = (float)fn;
+    if (s->rtt_pending && t->window_version == s->rtt_version) {
+        s->rtt_pending = false;
+        s->rtt_ms = (double)(s->now_us - s->rtt_t0_us) / 1000.0;
+        if (s->rtt_ms > s->rtt_worst_ms)
+            s->rtt_worst_ms = s->rtt_ms;
+        s->rtt_samples++;
+    }
+    if (!s->csv)
+        return;
+    fprintf(s->csv, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%s,%u,%u,%u,%u,%u,%.6f,%u,%u,%u\n",
+            (double)(s->now_us - s->t0_us) * 1e-6, (double)t->pos_m[0] * 1e3,
+            (double)t->pos_m[1] * 1e3, (double)t->pos_m[2] * 1e3, (double)t->force_n[0],
+            (double)t->force_n[1], (double)t->force_n[2], fn,
+            safety_state_name((safety_state_t)t->state), t->tool_kind, t->buttons, t->flags & 1u,
+            (t->flags >> 1) & 1u, t->tick, (double)t->time_us * 1e-6, t->compute_ns / 1000u,
+            t->deadline_misses, t->window_version);
+    s->csv_rows++;
+}
+
+static void status_line(solver_t *s, bool tty, double elapsed_s, uint32_t rx_per_s,
+                        uint32_t tx_per_s)
+{
+    const link_state_t ls = (link_state_t)atomic_load(&s->c->pub.state);
+    const msg_telemetry_t *t = &s->peer.last_tm;
+    double loop_hz = 0.0;
+    if (s->have_tm && s->have_status_ref && t->time_us > s->board_us_at_status &&
+        t->tick >= s->tick_at_status)
+        loop_hz = (double)(t->tick - s->tick_at_status) * 1e6 /
+                  (double)(t->time_us - s->board_us_at_status);
+    const double fn = s->have_tm ? sqrt((double)t->force_n[0] * t->force_n[0] +
+                                        (double)t->force_n[1] * t->force_n[1] +
+                                        (double)t->force_n[2] * t->force_n[2])
+                                 : 0.0;
+    char loop[32], rtt[32];
+    if (loop_hz > 0.0)
+        snprintf(loop, sizeof(loop), "%5.0f Hz", loop_hz);
+    else
+        snprintf(loop, sizeof(loop), "    - Hz");
+    if (s->rtt_samples > 0)
+        snprintf(rtt, sizeof(rtt), "%.1f ms", s->rtt_ms);
+    else
+        snprintf(rtt, sizeof(rtt), "-");
+    fprintf(stderr,
+            "%sconnect %6.1f s  link %-9s  board %-6s  loop %s  worst tick %4u us  "
+            "window rtt %s  force %.3f N  frames/s in %u out %u%s",
+            tty ? "\r" : "", elapsed_s, link_state_name(ls),
+            s->have_tm ? safety_state_name((safety_state_t)t->state) : "-", loop,
+            s->worst_compute_ns / 1000u, rtt, fn, rx_per_s, tx_per_s, tty ? "  " : "\n");
+    fflush(stderr);
+    s->worst_compute_ns = 0;
+    if (s->have_tm) {
+        s->tick_at_status = t->tick;
+        s->board_us_at_status = t->time_us;
+        s->have_status_ref = true;
+    }
+}
+
+/* ---- files ---- */
+
+static int make_dir(const char *path)
+{
+    return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
+}
+
+/* Writes DIR/final.ply and DIR/model.argil from the clay; one line into err on failure. */
+static argil_err_t write_model(const grid_t *g, const char *dir, size_t *triangles, char *err,
+                               size_t err_len)
+{
+    char path[4096];
+    mesh_t m;
+    mesh_init(&m);
+    argil_err_t rc = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &m);
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "meshing the clay failed");
+    } else {
+        *triangles = m.n_tri;
+        snprintf(path, sizeof(path), "%s/final.ply", dir);
+        if (m.n_tri > 0)
+            rc = ply_write(path, &m, err, err_len);
+    }
+    mesh_free(&m);
+    if (rc != ARGIL_OK)
+        return rc;
+    argil_doc_t doc;
+    argil_doc_init(&doc);
+    doc.grid = *g; /* borrowed: the document is not freed */
+    snprintf(path, sizeof(path), "%s/model.argil", dir);
+    return argil_file_write(path, &doc, err, err_len);
+}
+
+/* ---- the command ---- */
+
+static void usage_connect(FILE *f)
+{
+    fprintf(f,
+            "usage: argil connect [--device DEV] [--seconds N] [--arm] [--telemetry FILE.csv]\n"
+            "                     [--out DIR] [--quiet]\n"
+            "\n"
+            "A live session with a board: the host keeps the global clay, sends the board its\n"
+            "local window and tool, applies the impulses the board sends back, and records the\n"
+            "board's telemetry. A status line on stderr once a second: link state, board safety\n"
+            "state, board loop rate, worst tick compute time, window round trip (a window's last\n"
+            "chunk sent -> the board's telemetry reports it in use), force, frames per second.\n"
+            "If the link is lost (cable, board restart) the clay is kept and the host\n"
+            "resynchronises (HELLO, tool and window again) when the board is back.\n"
+            "\n"
+            "options:\n"
+            "  --device DEV     sim            the simulated board in this process, in real time\n"
+            "                   udp:HOST:PORT  a board daemon on the network (argil-board --link udp:…)\n"
+            "                   usb            the first USB board 1209:0001 (default)\n"
+            "                   usb:VID:PID    a USB board by vendor and product id (hex)\n"
+            "                   usb:BUS-PORT[.PORT…]  a USB board by where it is plugged (lsusb -t)\n"
+            "  --seconds N      end after N seconds (default: run until Ctrl-C)\n"
+            "  --arm            arm the board (forces on) once it has its window; when it\n"
+            "                   faults because it lost the host (link loss, host stall), arm\n"
+            "                   it again; any other fault stays latched\n"
+            "  --telemetry FILE write the telemetry there (default DIR/telemetry.csv)\n"
+            "  --out DIR        where to write final.ply, model.argil and telemetry.csv at the\n"
+            "                   end (default out; created if missing)\n"
+            "  --quiet          no status line and no summary\n"
+            "  -h, --help       this text\n"
+            "\n"
+            "exit status: 0 ran for --seconds; 130 ended by Ctrl-C or SIGTERM (files written);\n"
+            "1 the link could not be opened (no such device, permission), the board never\n"
+            "answered, or a file could not be written; 2 a bad option or device string.\n"
+            "USB without root needs firmware/board/70-argil.rules (docs/link.md).\n");
+}
+
+typedef struct {
+    const char *device;
+    double seconds;                 /* 0: until Ctrl-C */
+    bool arm;
+    const char *telemetry;
+    const char *out_dir;
+    bool quiet;
+} connect_opts_t;
+
+/* Parses the options; returns -1 to go on, else the exit status. */
+static int parse_opts(int argc, char **argv, connect_opts_t *o)
+{
+    memset(o, 0, sizeof(*o));
+    o->device = "usb";
+    o->out_dir = "out";
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage_connect(stdout);
+            return 0;
+        } else if (strcmp(a, "--arm") == 0) {
+            o->arm = true;
+        } else if (strcmp(a, "--quiet") == 0) {
+            o->quiet = true;
+        } else if (strcmp(a, "--device") == 0 || strcmp(a, "--seconds") == 0 ||
+                   strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0) {
+            if (!v) {
+                fprintf(stderr, "argil connect: %s needs a value (see --help)\n", a);
+                return 2;
+            }
+            i++;
+            if (strcmp(a, "--device") == 0) {
+                o->device = v;
+            } else if (strcmp(a, "--telemetry") == 0) {
+                o->telemetry = v;
+            } else if (strcmp(a, "--out") == 0) {
+                o->out_dir = v;
+            } else {
+                char *end;
+                errno = 0;
+                const double s = strtod(v, &end);
+                if (errno || end == v || *end != '\0' || !(s > 0.0) || s > 1e7) {
+                    fprintf(stderr, "argil connect: --seconds must be a number > 0, got '%s'\n",
+                            v);
+                    return 2;
+                }
+                o->seconds = s;
+            }
+        } else {
+            fprintf(stderr, "argil connect: unknown option '%s' (see --help)\n", a);
+            return 2;
+        }
+    }
+    link_spec_t spec;
+    const link_spec_err_t pe = link_spec_parse(o->device, &spec);
+    if (pe != LINK_SPEC_OK) {
+        fprintf(stderr, "argil connect: bad device '%s': %s\n", o->device,
+                link_spec_err_text(pe));
+        return 2;
+    }
+    return -1;
+}
+
+static void default_tool(msg_tool_t *t)
+{
+    memset(t, 0, sizeof(*t));
+    t->kind = TOOL_TOUCH;
+    t->flags = TOOL_FLAG_ISO;
+    t->radius_m = 0.004f;
+    t->axis[2] = 1.0f;
+    t->alpha = 12000.0f;
+    t->contact_stiffness_n_per_m = 800.0f;
+    t->max_force_n = 3.3f;
+    t->iso = 0.5f;
+    t->model_scale = 1.0f;
+}
+
+/* Opens the CSV (as a .tmp file renamed at the end); one line into err on failure. */
+static argil_err_t open_csv(solver_t *s, const char *path, char *tmp, size_t tmp_len, char *err,
+                            size_t err_len)
+{
+    snprintf(tmp, tmp_len, "%s.tmp", path);
+    s->csv = fopen(tmp, "wb");
+    if (!s->csv) {
+        snprintf(err, err_len, "%s: cannot create: %s", tmp, strerror(errno));
+        return ARGIL_ERR_IO;
+    }
+    fprintf(s->csv, "time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state,tool,buttons,contact,"
+                    "sculpting,tick,board_time_s,compute_us,deadline_misses,window_version\n");
+    return ARGIL_OK;
+}
+
+int cmd_connect(int argc, char **argv)
+{
+    connect_opts_t o;
+    const int st = parse_opts(argc, argv, &o);
+    if (st >= 0)
+        return st;
+    const bool tty = isatty(STDERR_FILENO);
+    char err[1024] = "";
+    int exit_code = 0;
+
+    conn_t *c = calloc(1, sizeof(*c));
+    solver_t *s = calloc(1, sizeof(*s));
+    if (!c || !s) {
+        free(c);
+        free(s);
+        fprintf(stderr, "argil connect: out of memory\n");
+        return 1;
+    }
+    s->c = c;
+    c->rx_store = malloc(CONNECT_RX_RING_BYTES);
+    c->tx_store = malloc(CONNECT_TX_RING_BYTES);
+    if (!c->rx_store || !c->tx_store ||
+        spsc_init(&c->rx, c->rx_store, CONNECT_RX_RING_BYTES) != ARGIL_OK ||
+        spsc_init(&c->tx, c->tx_store, CONNECT_TX_RING_BYTES) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: out of memory\n");
+        exit_code = 1;
+        goto free_conn;
+    }
+    const argil_err_t lo = link_open(&c->link, o.device, err, sizeof(err));
+    if (lo != ARGIL_OK) {
+        fprintf(stderr, "argil connect: %s\n", err);
+        exit_code = lo == ARGIL_ERR_PARSE ? 2 : 1;
+        goto free_conn;
+    }
+
+    /* The host's clay: a sphere just below the arm's workspace centre (device = model). */
+    sim_params_t sp;
+    sim_params_default(&sp);
+    const vec3_t centre = arm_workspace_centre(&sp.arm.desc);
+    const int32_t dims[3] = {CONNECT_GRID_EDGE, CONNECT_GRID_EDGE, CONNECT_GRID_EDGE};
+    const float half = 0.5f * (float)(CONNECT_GRID_EDGE - 1) * CONNECT_SPACING_M;
+    peer_cfg_t pc;
+    peer_cfg_default(&pc);
+    if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
+            ARGIL_OK ||
+        peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: out of memory for the clay\n");
+        exit_code = 1;
+        goto close_link;
+    }
+    grid_fill_sphere(&s->grid, vec3_sub(centre, vec3(0, 0, CONNECT_CLAY_BELOW_M)),
+                     CONNECT_CLAY_RADIUS_M);
+    msg_tool_t tool;
+    default_tool(&tool);
+    peer_set_tool(&s->peer, &tool);
+    if (o.arm)
+        peer_request_arm(&s->peer);
+
+    char csv_path[4096], csv_tmp[4200];
+    if (make_dir(o.out_dir) != 0) {
+        fprintf(stderr, "argil connect: %s: cannot create directory: %s\n", o.out_dir,
+                strerror(errno));
+        exit_code = 1;
+        goto free_clay;
+    }
+    if (o.telemetry)
+        snprintf(csv_path, sizeof(csv_path), "%s", o.telemetry);
+    else
+        snprintf(csv_path, sizeof(csv_path), "%s/telemetry.csv", o.out_dir);
+    if (open_csv(s, csv_path, csv_tmp, sizeof(csv_tmp), err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: %s\n", err);
+        exit_code = 1;
+        goto free_clay;
+    }
+
+    g_connect_stop = 0;
+    struct sigaction sa;
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_stop_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    pthread_t lt;
+    if (pthread_create(&lt, NULL, link_thread, c) != 0) {
+        fprintf(stderr, "argil connect: cannot start the link thread\n");
+        exit_code = 1;
+        goto close_csv;
+    }
+
+    /* The solver loop, 1 ms period. */
+    static uint8_t frame[PROTO_FRAME_MAX];
+    s->t0_us = mono_us();
+    uint64_t last_us = s->t0_us, next_us = s->t0_us, status_at_us = s->t0_us + 1000000u;
+    uint64_t last_hello_us = 0, last_rearm_us = 0;
+    bool hello_wanted = true, rearm_pending = false;
+    uint32_t seen_resyncs = 0, restarts_seen = 0, rx_at_status = 0, tx_at_status = 0;
+    uint32_t windows_at_last = 0;
+    bool interrupted = false;
+    /* What the host knew when the link was lost (for the re-arm rule below). */
+    uint32_t faults_at_loss = 0, faults_seen = 0;
+    bool loss_by_transport = false, bad_before_loss = false;
+    for (;;) {
+        s->now_us = mono_us();
+        const double elapsed_s = (double)(s->now_us - s->t0_us) * 1e-6;
+        if (g_connect_stop) {
+            interrupted = true;
+            break;
+        }
+        if (o.seconds > 0 && elapsed_s >= o.seconds)
+            break;
+        size_t n;
+        while (spsc_pop(&c->rx, frame, sizeof(frame), &n) == ARGIL_OK) {
+            if (n == 1) { /* the link thread's loss marker */
+                loss_by_transport = frame[0] != 0;
+                faults_at_loss = s->peer.stats.faults;
+                bad_before_loss = s->have_tm && (s->last_state == SAFETY_FAULT ||
+                                                 s->last_state == SAFETY_ESTOP);
+                continue;
+            }
+            if (n > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO && frame[12] == PROTO_ROLE_BOARD) {
+                s->board_hellos++;
+                hello_wanted = false;
+            }
+            peer_receive(&s->peer, frame, n);
+        }
+        /* Resynchronise after a reconnection or a restarted board (its tick went back). */
+        const uint32_t r = atomic_load_explicit(&c->pub.resyncs, memory_order_relaxed);
+        if (r != seen_resyncs || s->board_restarts != restarts_seen) {
+            seen_resyncs = r;
+            restarts_seen = s->board_restarts;
+            hello_wanted = true;
+            last_hello_us = 0;
+            rearm_pending = o.arm;
+        }
+        /* The board says it lost the host (this host stalled, or the link dropped and came
+         * back before our silence timeout): as after a reconnection, arm again. */
+        if (s->peer.stats.faults != faults_seen) {
+            faults_seen = s->peer.stats.faults;
+            if (s->peer.stats.last_fault_code == FAULT_HOST_LOST)
+                rearm_pending = o.arm;
+        }
+        if (hello_wanted && s->now_us - last_hello_us >= CONNECT_HELLO_PERIOD_US) {
+            send_simple(s, MSG_HELLO, 0);
+            last_hello_us = s->now_us;
+        }
+        /* A link loss faulted the board (host lost): the person asked for --arm, so arm again
+         * once the board has its new window. Any other fault stays latched. The board reports
+         * a fault once, and over USB that FAULT frame is dropped while unplugged: when none
+         * arrived since the loss, the loss was the transport's own (both directions dead for
+         * longer than the board's host timeout) and the board was not faulted before it, the
+         * fault can only be host lost. */
+        if (rearm_pending && s->have_tm) {
+            const uint8_t bs = s->peer.last_tm.state;
+            const bool heard = s->peer.stats.faults != faults_at_loss;
+            const bool host_lost = heard ? s->peer.stats.last_fault_code == FAULT_HOST_LOST
+                                         : loss_by_transport && !bad_before_loss;
+            if (bs == SAFETY_ACTIVE || bs == SAFETY_ARMED) {
+                rearm_pending = false; /* armed again (an IDLE board is armed by the peer) */
+            } else if (bs == SAFETY_FAULT && host_lost && s->peer.have_current && !hello_wanted &&
+                       s->now_us - last_rearm_us >= CONNECT_REARM_PERIOD_US) {
+                send_simple(s, MSG_HEARTBEAT, PROTO_CMD_ARM);
+                last_rearm_us = s->now_us;
+            }
+        }
+        uint64_t dt_us = s->now_us - last_us;
+        if (dt_us > 50000u)
+            dt_us = 50000u; /* after a stall, do not replay time */
+        if (dt_us > 0) {
+            peer_tick(&s->peer, (uint32_t)dt_us);
+            last_us = s->now_us;
+        }
+        if (s->peer.stats.windows_sent != windows_at_last) {
+            windows_at_last = s->peer.stats.windows_sent;
+            s->rtt_version = s->peer.current.version;
+            s->rtt_t0_us = s->now_us;
+            s->rtt_pending = true;
+        }
+        if (s->now_us >= status_at_us) {
+            const uint32_t rx = atomic_load(&c->pub.frames_rx), tx = atomic_load(&c->pub.frames_tx);
+            if (!o.quiet)
+                status_line(s, tty, elapsed_s, rx - rx_at_status, tx - tx_at_status);
+            rx_at_status = rx;
+            tx_at_status = tx;
+            status_at_us += 1000000u;
+        }
+        next_us += 1000u;
+        if (next_us + 20000u < s->now_us)
+            next_us = s->now_us; /* fell far behind: do not try to catch up */
+        const struct timespec ts = {(time_t)(next_us / 1000000u), (long)(next_us % 1000000u) * 1000L};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+    }
+    /* Tell the board we are going: disarm (forces off at once, not after the host-lost fade). */
+    if (s->have_tm)
+        send_simple(s, MSG_HEARTBEAT, PROTO_CMD_DISARM);
+    atomic_store_explicit(&c->stop, true, memory_order_release);
+    pthread_join(lt, NULL);
+    /* Frames the link thread took in after the solver stopped reading. */
+    {
+        size_t n;
+        while (spsc_pop(&c->rx, frame, sizeof(frame), &n) == ARGIL_OK)
+            if (n > 1) /* not a loss marker */
+                peer_receive(&s->peer, frame, n);
+    }
+    if (tty && !o.quiet)
+        fputc('\n', stderr);
+
+    const double ran_s = (double)(mono_us() - s->t0_us) * 1e-6;
+    const uint32_t frames_rx = atomic_load(&c->pub.frames_rx);
+    size_t triangles = 0;
+    /* Files: the telemetry, the clay's surface and the model. */
+    {
+        int bad = fflush(s->csv) != 0 || fsync(fileno(s->csv)) != 0;
+        bad |= fclose(s->csv) != 0;
+        s->csv = NULL;
+        if (bad || rename(csv_tmp, csv_path) != 0) {
+            fprintf(stderr, "argil connect: %s: cannot write: %s\n", csv_path, strerror(errno));
+            exit_code = 1;
+        }
+        if (write_model(&s->grid, o.out_dir, &triangles, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil connect: %s\n", err);
+            exit_code = 1;
+        }
+    }
+    if (!o.quiet) {
+        const uint32_t rx_drop = atomic_load(&c->rx.dropped);
+        printf("argil connect: %s for %.1f s%s\n", o.device, ran_s,
+               interrupted ? " (interrupted)" : "");
+        printf("  link                %s; frames in %u, out %u; receive errors %u, send errors "
+               "%u, reconnects %u, frames dropped %u\n",
+               link_state_name((link_state_t)atomic_load(&c->pub.state)), frames_rx,
+               atomic_load(&c->pub.frames_tx), atomic_load(&c->pub.errors_rx),
+               atomic_load(&c->pub.errors_tx), atomic_load(&c->pub.reconnects),
+               rx_drop + atomic_load(&c->pub.tx_dropped));
+        printf("  board               %s; ACTIVE entered %u times; board HELLOs %u; restarts "
+               "seen %u; deadline misses %u; peak force %.3f N\n",
+               s->have_tm ? safety_state_name((safety_state_t)s->last_state) : "never heard",
+               s->active_entries, s->board_hellos, s->board_restarts, s->deadline_misses,
+               (double)s->peak_force_n);
+        printf("  protocol            telemetry rows %u (%.0f per s); decode errors %u; windows "
+               "sent %u; impulse frames %u; faults %u%s%s%s\n",
+               s->csv_rows, ran_s > 0 ? s->csv_rows / ran_s : 0.0,
+               s->peer.stats.decode_errors, s->peer.stats.windows_sent,
+               s->peer.stats.impulse_frames, s->peer.stats.faults,
+               s->peer.stats.faults ? " (last: " : "",
+               s->peer.stats.faults
+                   ? safety_fault_name((fault_code_t)s->peer.stats.last_fault_code)
+                   : "",
+               s->peer.stats.faults ? ")" : "");
+        if (s->rtt_samples > 0)
+            printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
+                   s->rtt_worst_ms, s->rtt_samples);
+        printf("  files               %s (%u rows), %s/final.ply (%zu triangles), "
+               "%s/model.argil\n",
+               csv_path, s->csv_rows, o.out_dir, triangles, o.out_dir);
+    }
+    if (frames_rx == 0) {
+        fprintf(stderr, "argil connect: the board never answered on %s\n", o.device);
+        exit_code = 1;
+    } else if (exit_code == 0 && interrupted) {
+        exit_code = 130;
+    }
+    goto free_clay;
+
+close_csv:
+    fclose(s->csv);
+    unlink(csv_tmp);
+free_clay:
+    peer_free(&s->peer);
+    grid_free(&s->grid);
+close_link:
+    link_close(&c->link);
+free_conn:
+    free(c->rx_store);
+    free(c->tx_store);
+    free(c);
+    free(s);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    return exit_code;
+}

@@ -1,0 +1,210 @@
+/* argil recover: rebuilds the model of an unfinished session from its autosave journal; and the
+ * offer to do so when a new session starts in a directory that still holds one. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "host/app/commands.h"
+#include "host/io/argil_file.h"
+#include "host/io/journal.h"
+#include "host/io/ply.h"
+#include "host/mesh/mc.h"
+#include "host/mesh/mesh.h"
+
+static void usage_recover(FILE *f)
+{
+    fprintf(f,
+            "usage: argil recover DIR [-o FILE.argil] [--keep-journal]\n"
+            "\n"
+            "Rebuilds the model of a session that did not end cleanly (a crash, kill -9, power\n"
+            "loss) from the autosave journal in DIR (DIR/" JOURNAL_FILE " on its base snapshot\n"
+            "DIR/" JOURNAL_BASE_PREFIX "N.argil), exactly as of the last whole journal record, and\n"
+            "writes it as a model and a PLY mesh. A record cut short by the crash is ignored.\n"
+            "\n"
+            "options:\n"
+            "  -o FILE.argil   where to write the model (default DIR/recovered.argil); the mesh\n"
+            "                  goes beside it with the extension .ply\n"
+            "  --keep-journal  keep the journal afterwards (by default it is removed once the\n"
+            "                  model is written, so the next session starts fresh)\n"
+            "  -h, --help      this text\n"
+            "\n"
+            "Exit status: 0 recovered; 1 nothing recovered, or the journal was damaged before its\n"
+            "end (the model is still written as of the last good record, and the journal kept).\n");
+}
+
+static void describe(const char *dir, const journal_info_t *info, FILE *f)
+{
+    fprintf(f, "argil: found an unfinished session in %s (%u edits, last at %.3f s); run "
+               "'argil recover %s' to restore it, or --discard-journal\n",
+            dir, info->records, info->last_sim_s, dir);
+}
+
+int recover_offer(const char *dir, bool discard, bool interactive)
+{
+    if (dir == NULL || !journal_exists(dir))
+        return -1;
+    char err[1024];
+    if (discard) {
+        if (journal_discard(dir, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil sculpt: %s\n", err);
+            return 1;
+        }
+        fprintf(stderr, "argil: discarded the unfinished session's journal in %s\n", dir);
+        return -1;
+    }
+    journal_info_t info;
+    const argil_err_t e = journal_probe(dir, &info, err, sizeof(err));
+    if (e != ARGIL_OK && e != ARGIL_ERR_PARSE) {
+        fprintf(stderr, "argil sculpt: %s holds a journal that cannot be read (%s); run 'argil "
+                        "recover %s' or --discard-journal\n",
+                dir, err, dir);
+        return 1;
+    }
+    describe(dir, &info, stderr);
+    if (!interactive)
+        return 1;
+    fprintf(stderr, "argil: recover it now [r], discard it and start a new session [d], or quit "
+                    "[q]? ");
+    char line[64];
+    if (fgets(line, sizeof(line), stdin) == NULL)
+        return 1;
+    if (line[0] == 'r' || line[0] == 'R') {
+        char *argv[] = {(char *)dir};
+        return cmd_recover(1, argv);
+    }
+    if (line[0] == 'd' || line[0] == 'D')
+        return recover_offer(dir, true, false);
+    return 1;
+}
+
+/* dst = src with its .argil extension (if any) replaced by ext. */
+static char *with_ext(const char *src, const char *ext)
+{
+    size_t len = strlen(src);
+    if (len >= 6 && strcmp(src + len - 6, ".argil") == 0)
+        len -= 6;
+    char *p = malloc(len + strlen(ext) + 1);
+    if (p == NULL)
+        return NULL;
+    memcpy(p, src, len);
+    strcpy(p + len, ext);
+    return p;
+}
+
+int cmd_recover(int argc, char **argv)
+{
+    const char *dir = NULL, *out = NULL;
+    bool keep = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage_recover(stdout);
+            return 0;
+        } else if (strcmp(a, "--keep-journal") == 0) {
+            keep = true;
+        } else if (strcmp(a, "-o") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "argil recover: -o needs a file name (see --help)\n");
+                return 2;
+            }
+            out = argv[++i];
+        } else if (a[0] == '-') {
+            fprintf(stderr, "argil recover: unknown option '%s' (see --help)\n", a);
+            return 2;
+        } else if (dir == NULL) {
+            dir = a;
+        } else {
+            fprintf(stderr, "argil recover: one directory only (see --help)\n");
+            return 2;
+        }
+    }
+    if (dir == NULL) {
+        usage_recover(stderr);
+        return 2;
+    }
+    char err[1024] = "", werr[1024] = "";
+    if (!journal_exists(dir)) {
+        fprintf(stderr, "argil recover: %s holds no journal (%s): nothing to recover\n", dir,
+                JOURNAL_FILE);
+        return 1;
+    }
+    char *model_path = NULL, *ply_path = NULL;
+    if (out == NULL) {
+        model_path = malloc(strlen(dir) + 32);
+        if (model_path != NULL)
+            sprintf(model_path, "%s/recovered.argil", dir);
+    } else {
+        model_path = strdup(out);
+    }
+    ply_path = model_path ? with_ext(model_path, ".ply") : NULL;
+    if (model_path == NULL || ply_path == NULL) {
+        fprintf(stderr, "argil recover: out of memory\n");
+        free(model_path);
+        free(ply_path);
+        return 1;
+    }
+    argil_doc_t doc;
+    journal_info_t info;
+    const argil_err_t e = journal_recover(dir, &doc, &info, err, sizeof(err));
+    int status = 0;
+    if (doc.grid.density == NULL) {
+        fprintf(stderr, "argil recover: %s\n", err);
+        status = 1;
+        goto out;
+    }
+    if (argil_file_write(model_path, &doc, werr, sizeof(werr)) != ARGIL_OK) {
+        fprintf(stderr, "argil recover: %s\n", werr);
+        status = 1;
+        goto out;
+    }
+    mesh_t mesh;
+    mesh_init(&mesh);
+    const grid_t *g = &doc.grid;
+    argil_err_t me = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &mesh);
+    if (me == ARGIL_OK && mesh.n_tri > 0)
+        me = ply_write(ply_path, &mesh, werr, sizeof(werr));
+    const size_t tris = mesh.n_tri;
+    mesh_free(&mesh);
+    if (me != ARGIL_OK) {
+        fprintf(stderr, "argil recover: %s\n", werr[0] ? werr : "meshing the model failed");
+        status = 1;
+        goto out;
+    }
+    const time_t wall = (time_t)(info.last_wall_ms / 1000u);
+    char when[64] = "never";
+    struct tm tmv;
+    if (info.records > 0 && gmtime_r(&wall, &tmv) != NULL)
+        strftime(when, sizeof(when), "%Y-%m-%d %H:%M:%S UTC", &tmv);
+    printf("argil: recovered the session in %s\n", dir);
+    printf("  base snapshot       %s/%s (checkpoint %u)\n", dir, info.base_name, info.checkpoint);
+    printf("  journal records     %u (numbers %u..%u), %llu samples replayed\n", info.records,
+           info.first_seq, info.last_seq, (unsigned long long)info.samples);
+    printf("  model as of         edit %u, %.3f s into the session\n", info.edits,
+           info.last_sim_s);
+    printf("  last record written %s (unix ms %llu)\n", when,
+           (unsigned long long)info.last_wall_ms);
+    if (info.torn_bytes > 0)
+        printf("  ignored             an incomplete last record (%zu bytes, cut short by the "
+               "crash)\n",
+               info.torn_bytes);
+    printf("  wrote               %s, %s (%zu triangles)\n", model_path, ply_path, tris);
+    if (e != ARGIL_OK) {
+        fprintf(stderr, "argil recover: %s; the model above is as of the record before it, and "
+                        "the journal is kept\n",
+                err);
+        status = 1;
+    } else if (!keep) {
+        if (journal_discard(dir, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil recover: %s\n", err);
+            status = 1;
+        }
+    }
+out:
+    argil_doc_free(&doc);
+    free(model_path);
+    free(ply_path);
+    return status;
+}

@@ -1,0 +1,780 @@
+/* The live sculpting window (see sculpt_window.h). Two threads: the session thread runs
+ * session_run with a per-tick hook (commands in, paced clock, incremental re-mesh and a
+ * snapshot every 1/60 s of simulated time out); the main thread owns GLFW and GL and draws. */
+#define _POSIX_C_SOURCE 200809L
+#define GLFW_INCLUDE_NONE
+#include "host/app/sculpt_window.h"
+
+#include <GLFW/glfw3.h>
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "firmware/core/safety.h"
+#include "host/app/live_hand.h"
+#include "host/mesh/mc_blocks.h"
+#include "host/render/backend_glfw.h"
+#include "host/render/camera.h"
+#include "host/render/hud.h"
+#include "host/render/png_write.h"
+#include "host/render/renderer.h"
+#include "host/render/triple_buffer.h"
+#include "host/render/ui_input.h"
+#include "host/render/ui_queue.h"
+
+#define FRAME_PERIOD_S (1.0 / 60.0)   /* simulated time between snapshots */
+#define EARLY_PUBLISH_S 0.008        /* least simulated time between snapshots */
+#define DISPLAY_PERIOD_NS 16666667u   /* the window draws at most this often */
+#define STATS_WINDOW_S 1.0            /* loop rate and worst tick over this much time */
+#define LATENCY_SAMPLES 4096u
+
+static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull",
+                                                        "carve", "probe", "rope"};
+static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussian", "spherical",
+                                                           "cylindrical", "conical"};
+
+/* The panel's parameters: ranges as scripts accept them (host/app/script.c), a step factor,
+ * and the first value above zero for those that may be 0. */
+static const struct {
+    int param;
+    const char *label;
+    float lo, hi, factor, first;
+} PANEL[] = {
+    {PARAM_RADIUS_MM, "radius mm", 0.5f, 50.0f, 1.25f, 0.5f},
+    {PARAM_STIFFNESS_N_PER_MM, "tool stiffness N/mm", 0.01f, 10.0f, 1.25f, 0.01f},
+    {PARAM_CLAY_STIFFNESS, "clay stiffness", 0.0f, 5000.0f, 1.5f, 0.1f},
+    {PARAM_PLASTIC_RATE_HZ, "plastic rate Hz", 0.0f, 1000.0f, 1.25f, 0.5f},
+    {PARAM_CLAY_DAMPING, "damping", 0.1f, 1000.0f, 1.25f, 0.1f},
+    {PARAM_ALPHA, "alpha", 0.0f, 1e7f, 1.5f, 100.0f},
+    {PARAM_YIELD_FORCE_N, "yield N", 0.0f, 10.0f, 1.25f, 0.05f},
+    {PARAM_MAX_FORCE_N, "max force N", 0.1f, 10.0f, 1.1f, 0.1f},
+};
+#define PANEL_N ((int)(sizeof(PANEL) / sizeof(PANEL[0])))
+
+/* One snapshot from the session to the window. */
+typedef struct {
+    mesh_t mesh;
+    uint64_t mesh_serial;         /* the re-mesh this slot's mesh is (0: none yet) */
+    double t_s;
+    bool active, script_done;
+    bool have_tm;
+    msg_telemetry_t tm;
+    float tool_radius_m;
+    bool have_box;
+    vec3_t box_lo_m, box_hi_m;
+    float loop_hz;
+    uint32_t worst_tick_ns;       /* over the last STATS_WINDOW_S */
+    float link_latency_ms;
+    int tool, filter;
+    float params[PARAM_COUNT];
+    bool inverted;
+    double change_t_s;            /* < 0, or when the oldest change this mesh shows arrived */
+    uint64_t published_ns;        /* monotonic wall clock at publication */
+} live_frame_t;
+
+typedef struct {
+    /* Shared between the threads. */
+    triple_buffer_t tb;
+    live_frame_t slot[3];
+    ui_queue_t q;
+    atomic_int want_stop, session_done;
+    /* Session thread only. */
+    const sculpt_window_opts_t *wo;
+    volatile sig_atomic_t *stop;
+    mc_blocks_t mcb;
+    bool mcb_ready, mcb_failed;
+    uint64_t serial;
+    double next_frame_s, last_t_s, last_publish_s;
+    uint64_t wall0_ns;
+    bool wall0_set;
+    double stats_start_s;
+    uint32_t worst_ns_now, worst_ns_shown, rate_tick0;
+    uint64_t rate_us0;
+    float loop_hz;
+    bool inverted;
+    int invert_from, invert_to;
+    bool mouse_down, have_ray;
+    vec3_t ray_o, ray_d;
+    live_hand_t hand;
+    live_hand_cfg_t hand_cfg;
+    bool mouse_started;
+    bool stopping, final_published;
+    uint32_t pending_seq;
+    double pending_since_s;       /* < 0: no impulse waiting to be shown */
+    /* The session's own results. */
+    session_opts_t so;
+    session_hook_t hook;
+    session_summary_t sum;
+    char err[1024];
+    argil_err_t rc;
+} live_t;
+
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+void sculpt_window_opts_default(sculpt_window_opts_t *o)
+{
+    memset(o, 0, sizeof(*o));
+    o->width = 1024;
+    o->height = 768;
+    o->linger_s = 2.0;
+}
+
+/* ---- session thread ---- */
+
+static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
+{
+    script_player_t *pl = f->player;
+    switch ((ui_cmd_kind_t)c->kind) {
+    case UI_CMD_TOOL:
+        if (c->arg >= 0 && c->arg < TOOL_KIND_COUNT) {
+            pl->tool = c->arg;
+            pl->params_changed = 1;
+            L->inverted = false;
+        }
+        break;
+    case UI_CMD_FILTER:
+        if (c->arg >= 0 && c->arg < BETA_FILTER_COUNT) {
+            pl->filter = c->arg;
+            pl->params_changed = 1;
+        }
+        break;
+    case UI_CMD_PARAM:
+        if (c->arg >= 0 && c->arg < PANEL_N) {
+            const int k = PANEL[c->arg].param;
+            float v = pl->params[k];
+            if (c->value > 0.0f)
+                v = v > 0.0f ? v * PANEL[c->arg].factor : PANEL[c->arg].first;
+            else
+                v = v / PANEL[c->arg].factor;
+            if (c->value < 0.0f && PANEL[c->arg].lo == 0.0f && v < PANEL[c->arg].first)
+                v = 0.0f;
+            v = v < PANEL[c->arg].lo ? PANEL[c->arg].lo : (v > PANEL[c->arg].hi ? PANEL[c->arg].hi : v);
+            pl->params[k] = v;
+            pl->params_changed = 1;
+        }
+        break;
+    case UI_CMD_INVERT:
+        /* Add ↔ remove while the key is held: push and carve become pull, pull becomes push. */
+        if (c->arg && !L->inverted) {
+            const int t = pl->tool;
+            const int to = (t == TOOL_PUSH || t == TOOL_CARVE) ? TOOL_PULL
+                           : t == TOOL_PULL                    ? TOOL_PUSH
+                                                               : t;
+            if (to != t) {
+                L->inverted = true;
+                L->invert_from = t;
+                L->invert_to = to;
+                pl->tool = to;
+                pl->params_changed = 1;
+            }
+        } else if (!c->arg && L->inverted) {
+            L->inverted = false;
+            if (pl->tool == L->invert_to) {
+                pl->tool = L->invert_from;
+                pl->params_changed = 1;
+            }
+        }
+        break;
+    case UI_CMD_MOUSE:
+        L->mouse_down = c->arg != 0;
+        L->ray_o = vec3(c->origin_m[0], c->origin_m[1], c->origin_m[2]);
+        L->ray_d = vec3(c->dir[0], c->dir[1], c->dir[2]);
+        L->have_ray = true;
+        break;
+    case UI_CMD_STOP:
+        *L->stop = 1;
+        L->stopping = true;
+        break;
+    }
+}
+
+/* Re-meshes what changed and publishes a snapshot. */
+static void publish(live_t *L, session_frame_t *f)
+{
+    peer_t *p = f->peer;
+    const grid_t *g = p->grid;
+    if (!L->mcb_ready && !L->mcb_failed) {
+        if (mc_blocks_init(&L->mcb, g->dims, g->spacing_m, g->origin_m, g->iso) == ARGIL_OK)
+            L->mcb_ready = true;
+        else
+            L->mcb_failed = true;
+    }
+    bool empty = false;
+    for (int a = 0; a < 3; a++)
+        empty |= p->dirty_lo[a] >= p->dirty_hi[a];
+    if (L->mcb_ready) {
+        if (!empty)
+            mc_blocks_mark(&L->mcb, p->dirty_lo, p->dirty_hi);
+        if (mc_blocks_update(&L->mcb, g->density, NULL) == ARGIL_OK && L->mcb.blocks_meshed > 0)
+            L->serial++;
+    }
+    for (int a = 0; a < 3; a++) {
+        p->dirty_lo[a] = 1;
+        p->dirty_hi[a] = 0;
+    }
+    live_frame_t *fr = &L->slot[triple_buffer_back(&L->tb)];
+    if (L->serial != 0 && fr->mesh_serial != L->serial) {
+        if (mc_blocks_assemble(&L->mcb, &fr->mesh) == ARGIL_OK)
+            fr->mesh_serial = L->serial;
+    }
+    fr->change_t_s = -1.0;
+    if (L->pending_since_s >= 0.0 && (int32_t)(p->impulse_seq_applied - L->pending_seq) >= 0 &&
+        fr->mesh_serial == L->serial) {
+        fr->change_t_s = L->pending_since_s;
+        L->pending_since_s = -1.0;
+    }
+    fr->t_s = f->t_s;
+    fr->active = f->active;
+    fr->script_done = f->script_done;
+    fr->have_tm = p->have_tm;
+    fr->tm = p->last_tm;
+    fr->tool_radius_m = p->tool.radius_m;
+    fr->have_box = p->have_current;
+    if (p->have_current) {
+        const float s = g->spacing_m;
+        fr->box_lo_m = vec3(g->origin_m.x + (float)p->current.corner[0] * s,
+                            g->origin_m.y + (float)p->current.corner[1] * s,
+                            g->origin_m.z + (float)p->current.corner[2] * s);
+        fr->box_hi_m = vec3_add(fr->box_lo_m, vec3((float)(p->current.dims[0] - 1) * s,
+                                                   (float)(p->current.dims[1] - 1) * s,
+                                                   (float)(p->current.dims[2] - 1) * s));
+    }
+    fr->loop_hz = L->loop_hz;
+    fr->worst_tick_ns = L->worst_ns_shown > L->worst_ns_now ? L->worst_ns_shown : L->worst_ns_now;
+    fr->link_latency_ms =
+        p->have_tm ? (float)((double)(p->time_us - p->last_tm.time_us) * 1e-3) : 0.0f;
+    fr->tool = f->player->tool;
+    fr->filter = f->player->filter;
+    memcpy(fr->params, f->player->params, sizeof(fr->params));
+    fr->inverted = L->inverted;
+    fr->published_ns = now_ns();
+    triple_buffer_publish(&L->tb);
+}
+
+static void on_tick(void *ctx, session_frame_t *f)
+{
+    live_t *L = ctx;
+    peer_t *p = f->peer;
+    const float dt_s = (float)(f->t_s - L->last_t_s);
+    L->last_t_s = f->t_s;
+    ui_cmd_t c;
+    while (ui_queue_pop(&L->q, &c))
+        apply_cmd(L, f, &c);
+    if (atomic_load_explicit(&L->want_stop, memory_order_relaxed)) {
+        *L->stop = 1;
+        L->stopping = true;
+    }
+    if (L->stopping && !L->final_published) {
+        /* The last snapshot shows every command taken before the stop. */
+        L->final_published = true;
+        publish(L, f);
+        return;
+    }
+
+    /* Status: loop rate and worst tick over the last second of simulated time. */
+    if (p->have_tm) {
+        if (p->last_tm.compute_ns > L->worst_ns_now)
+            L->worst_ns_now = p->last_tm.compute_ns;
+        if (f->t_s - L->stats_start_s >= STATS_WINDOW_S) {
+            const uint64_t dus = p->last_tm.time_us - L->rate_us0;
+            if (L->rate_us0 != 0 && dus > 0)
+                L->loop_hz = (float)((double)(p->last_tm.tick - L->rate_tick0) * 1e6 / (double)dus);
+            L->rate_tick0 = p->last_tm.tick;
+            L->rate_us0 = p->last_tm.time_us;
+            L->worst_ns_shown = L->worst_ns_now;
+            L->worst_ns_now = 0;
+            L->stats_start_s = f->t_s;
+        }
+    }
+    if (L->pending_since_s < 0.0 && p->impulse_seq_received != L->pending_seq) {
+        L->pending_seq = p->impulse_seq_received;
+        L->pending_since_s = f->t_s;
+    }
+
+    /* Mouse sculpting: once the board is ACTIVE and there is no script left, the hand is ours. */
+    if (L->wo->mouse && f->active && f->script_done) {
+        script_player_t *pl = f->player;
+        if (!L->mouse_started) {
+            L->mouse_started = true;
+            pl->tool = TOOL_PUSH;
+            pl->params_changed = 1;
+        }
+        if (L->have_ray) {
+            const bool outward = pl->tool == TOOL_PULL || pl->tool == TOOL_ROPE;
+            live_hand_step(&L->hand, &L->hand_cfg, p->grid, L->ray_o, L->ray_d, L->mouse_down,
+                           outward, p->tool.radius_m, dt_s, &pl->pos_m, &pl->vel_m_s,
+                           &pl->buttons);
+        }
+    }
+
+    /* A snapshot every frame period, and early (at most every 8 ms) once a solve step has
+     * changed the field, so a stroke reaches the screen without waiting for the period. */
+    bool changed = true;
+    for (int a = 0; a < 3; a++)
+        changed &= p->dirty_lo[a] < p->dirty_hi[a];
+    if (f->t_s + 1e-9 >= L->next_frame_s ||
+        (changed && f->t_s - L->last_publish_s >= EARLY_PUBLISH_S)) {
+        L->last_publish_s = f->t_s;
+        publish(L, f);
+        L->next_frame_s += FRAME_PERIOD_S;
+        if (L->next_frame_s < f->t_s)
+            L->next_frame_s = f->t_s + FRAME_PERIOD_S;
+    }
+
+    /* Real-time pacing: never ahead of the wall clock by more than a millisecond. */
+    if (!L->wo->fast) {
+        const uint64_t now = now_ns();
+        if (!L->wall0_set) {
+            L->wall0_ns = now - (uint64_t)(f->t_s * 1e9);
+            L->wall0_set = true;
+        }
+        const double ahead_s = f->t_s - (double)(now - L->wall0_ns) * 1e-9;
+        if (ahead_s > 1e-3) {
+            const struct timespec ts = {0, (long)(ahead_s * 1e9)};
+            nanosleep(&ts, NULL);
+        }
+    }
+}
+
+static void *session_main(void *arg)
+{
+    live_t *L = arg;
+    L->rc = session_run(&L->so, &L->sum, L->err, sizeof(L->err));
+    atomic_store(&L->session_done, 1);
+    return NULL;
+}
+
+/* ---- render thread ---- */
+
+typedef struct {
+    glfw_window_t win;
+    gl_api_t gl;
+    renderer_t r;
+    hud_t hud;
+    render_target_t shot;
+    bool shot_ready;
+    uint8_t *shot_rgb;
+    camera_t cam;
+    render_scene_t scene;
+    uint64_t uploaded_serial;
+    int panel_sel;
+    bool quit;                    /* Esc: no lingering after the session */
+    /* Input state (from GLFW, or from the input file when one is given). */
+    double cx, cy;
+    bool left, right, shift;
+    double prev_cx, prev_cy;
+    bool prev_right, prev_shift, prev_left;
+    ui_input_t script;
+    size_t next_ev;
+    /* Figures. */
+    double frame_ms[LATENCY_SAMPLES];
+    size_t n_frame;
+    double latency_ms[LATENCY_SAMPLES];
+    size_t n_latency;
+    double fps;
+} view_t;
+
+static void ui_send(live_t *L, uint8_t kind, int32_t arg, float value)
+{
+    ui_cmd_t c;
+    memset(&c, 0, sizeof(c));
+    c.kind = kind;
+    c.arg = arg;
+    c.value = value;
+    ui_queue_push(&L->q, &c);
+}
+
+static void on_key(live_t *L, view_t *v, int key)
+{
+    if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + TOOL_KIND_COUNT) {
+        ui_send(L, UI_CMD_TOOL, key - GLFW_KEY_1, 0);
+    } else if (key == GLFW_KEY_B) {
+        const live_frame_t *fr = &L->slot[L->tb.front];
+        ui_send(L, UI_CMD_FILTER, (fr->filter + 1) % BETA_FILTER_COUNT, 0);
+    } else if (key == GLFW_KEY_C) {
+        v->scene.mode = v->scene.mode == RENDER_MODE_PLAIN ? RENDER_MODE_CLEARCOAT
+                                                           : RENDER_MODE_PLAIN;
+    } else if (key == GLFW_KEY_TAB || key == GLFW_KEY_DOWN) {
+        v->panel_sel = (v->panel_sel + 1) % PANEL_N;
+    } else if (key == GLFW_KEY_UP) {
+        v->panel_sel = (v->panel_sel + PANEL_N - 1) % PANEL_N;
+    } else if (key == GLFW_KEY_RIGHT || key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) {
+        ui_send(L, UI_CMD_PARAM, v->panel_sel, 1.0f);
+    } else if (key == GLFW_KEY_LEFT || key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) {
+        ui_send(L, UI_CMD_PARAM, v->panel_sel, -1.0f);
+    } else if (key == GLFW_KEY_ESCAPE) {
+        /* In order after the keys before it; straight to the flag if the queue is full. */
+        ui_cmd_t c;
+        memset(&c, 0, sizeof(c));
+        c.kind = UI_CMD_STOP;
+        v->quit = true;
+        if (!ui_queue_push(&L->q, &c))
+            atomic_store(&L->want_stop, 1);
+    }
+}
+
+static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, char *out,
+                     size_t cap)
+{
+    const float *pr = fr->params;
+    const float fx = fr->tm.force_n[0], fy = fr->tm.force_n[1], fz = fr->tm.force_n[2];
+    const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
+    const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
+    const int sel = v->panel_sel;
+    snprintf(out, cap,
+             "%s  loop %.0f Hz  worst tick %.0f us  link %.1f ms  force %.2f N  t %.2f s  "
+             "view %.0f fps%s\n"
+             "tool %s%s  beta %s  radius %.1f mm  stiffness %.2f N/mm  clay k %.3g  damping %.3g"
+             "  plastic %.3g Hz  alpha %.3g\n"
+             "> %s = %.4g   [1-6 tool  B beta  TAB/UP/DOWN pick  -/+ change  SHIFT add<>remove"
+             "  C shading  ESC quit]",
+             fr->have_tm ? safety_state_name((safety_state_t)fr->tm.state) : "NO BOARD",
+             (double)fr->loop_hz, fr->worst_tick_ns / 1000.0, (double)fr->link_latency_ms,
+             sqrt((double)fx * fx + (double)fy * fy + (double)fz * fz), fr->t_s, v->fps,
+             L->wo->fast ? "  fast" : "", TOOL_NAMES[t], fr->inverted ? " (inverted)" : "",
+             FILTER_NAMES[b], (double)pr[PARAM_RADIUS_MM], (double)pr[PARAM_STIFFNESS_N_PER_MM],
+             (double)pr[PARAM_CLAY_STIFFNESS], (double)pr[PARAM_CLAY_DAMPING],
+             (double)pr[PARAM_PLASTIC_RATE_HZ], (double)pr[PARAM_ALPHA], PANEL[sel].label,
+             (double)pr[PANEL[sel].param]);
+}
+
+static void scene_from_frame(view_t *v, const live_frame_t *fr)
+{
+    render_scene_t *s = &v->scene;
+    s->show_tool = fr->have_tm;
+    s->tool_pos_m = vec3(fr->tm.pos_m[0], fr->tm.pos_m[1], fr->tm.pos_m[2]);
+    s->tool_radius_m = fr->tool_radius_m > 0.0f ? fr->tool_radius_m : 0.004f;
+    s->show_force = fr->have_tm;
+    s->force_n = vec3(fr->tm.force_n[0], fr->tm.force_n[1], fr->tm.force_n[2]);
+    s->show_box = fr->have_box;
+    s->box_lo_m = fr->box_lo_m;
+    s->box_hi_m = fr->box_hi_m;
+}
+
+static void draw_all(live_t *L, view_t *v, const live_frame_t *fr, int w, int h)
+{
+    camera_matrices(&v->cam, (float)w / (float)h, v->scene.view, v->scene.proj);
+    renderer_draw(&v->r, &v->scene, w, h);
+    char text[1024];
+    hud_text(L, v, fr, text, sizeof(text));
+    const float scale = w >= 1500 ? 2.0f : 1.0f;
+    hud_draw(&v->hud, text, scale, w, h);
+}
+
+static bool write_shot(live_t *L, view_t *v, const live_frame_t *fr, const char *path, int w,
+                       int h, char *err, size_t err_len)
+{
+    if (v->shot_ready && (v->shot.width != w || v->shot.height != h)) {
+        render_target_free(&v->shot);
+        v->shot_ready = false;
+    }
+    if (!v->shot_ready) {
+        free(v->shot_rgb);
+        v->shot_rgb = malloc((size_t)w * (size_t)h * 3);
+        if (v->shot_rgb == NULL ||
+            render_target_init(&v->shot, &v->gl, w, h, 4, err, err_len) != ARGIL_OK)
+            return false;
+        v->shot_ready = true;
+    }
+    render_target_bind(&v->shot);
+    draw_all(L, v, fr, w, h);
+    render_target_read_rgb(&v->shot, v->shot_rgb);
+    v->gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return png_write_rgb(path, w, h, v->shot_rgb, err, err_len) == ARGIL_OK;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *x, size_t n)
+{
+    if (n == 0)
+        return 0.0;
+    qsort(x, n, sizeof(*x), cmp_double);
+    return x[n / 2];
+}
+
+/* Applies the scripted input events due by simulated time t_s. */
+static void play_script(live_t *L, view_t *v, double t_s)
+{
+    while (v->next_ev < v->script.count && v->script.ev[v->next_ev].at_s <= t_s) {
+        const ui_event_t *e = &v->script.ev[v->next_ev++];
+        switch (e->kind) {
+        case UI_EV_KEY: on_key(L, v, e->code); break;
+        case UI_EV_SHIFT: v->shift = e->down; break;
+        case UI_EV_CURSOR:
+            v->cx = e->x;
+            v->cy = e->y;
+            break;
+        case UI_EV_LEFT: v->left = e->down; break;
+        case UI_EV_RIGHT: v->right = e->down; break;
+        case UI_EV_WHEEL: camera_zoom(&v->cam, e->x); break;
+        }
+    }
+}
+
+static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
+{
+    const sculpt_window_opts_t *wo = L->wo;
+    double next_shot_s = wo->screenshot_every_s > 0.0 ? 0.0 : INFINITY;
+    uint64_t last_frame_ns = now_ns(), done_at_ns = 0;
+    int status = 0;
+    bool have_frame = false;
+    const live_frame_t *fr = &L->slot[L->tb.front];
+    for (;;) {
+        glfw_input_t in;
+        glfw_window_poll(&v->win, &in);
+        if (glfw_window_should_close(&v->win))
+            atomic_store(&L->want_stop, 1);
+        int key;
+        while (glfw_window_take_key(&v->win, &key))
+            on_key(L, v, key);
+        uint32_t slot;
+        const bool fresh = triple_buffer_take(&L->tb, &slot);
+        fr = &L->slot[slot];
+        if (fresh)
+            have_frame = true;
+        if (v->script.count > 0) {
+            play_script(L, v, fr->t_s);
+        } else {
+            v->cx = in.cursor_x;
+            v->cy = in.cursor_y;
+            v->left = in.left_down;
+            v->right = in.right_down;
+            v->shift = in.shift;
+            camera_zoom(&v->cam, glfw_window_take_scroll(&v->win));
+        }
+        int w = 0, h = 0;
+        glfw_window_size(&v->win, &w, &h);
+        if (v->right && v->prev_right && w > 0 && h > 0)
+            camera_arcball(&v->cam, v->prev_cx, v->prev_cy, v->cx, v->cy, w, h);
+        if (v->shift != v->prev_shift)
+            ui_send(L, UI_CMD_INVERT, v->shift ? 1 : 0, 0);
+        if (wo->mouse && w > 0 && h > 0 &&
+            (v->left || v->prev_left || v->cx != v->prev_cx || v->cy != v->prev_cy || fresh)) {
+            vec3_t o, d;
+            camera_ray(&v->cam, v->cx, v->cy, w, h, &o, &d);
+            ui_cmd_t c;
+            memset(&c, 0, sizeof(c));
+            c.kind = UI_CMD_MOUSE;
+            c.arg = v->left ? 1 : 0;
+            c.origin_m[0] = o.x, c.origin_m[1] = o.y, c.origin_m[2] = o.z;
+            c.dir[0] = d.x, c.dir[1] = d.y, c.dir[2] = d.z;
+            ui_queue_push(&L->q, &c);
+        }
+        v->prev_cx = v->cx;
+        v->prev_cy = v->cy;
+        v->prev_right = v->right;
+        v->prev_shift = v->shift;
+        v->prev_left = v->left;
+
+        if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial) {
+            if (renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
+                v->uploaded_serial = fr->mesh_serial;
+        }
+        scene_from_frame(v, fr);
+        if (w > 0 && h > 0) {
+            if (have_frame && fr->t_s + 1e-9 >= next_shot_s && wo->frames_dir) {
+                char path[4096];
+                snprintf(path, sizeof(path), "%s/frame_%06ld.png", wo->frames_dir,
+                         lround(fr->t_s * 1000.0));
+                if (!write_shot(L, v, fr, path, w, h, err, err_len)) {
+                    status = 1;
+                    atomic_store(&L->want_stop, 1);
+                }
+                while (next_shot_s <= fr->t_s + 1e-9)
+                    next_shot_s += wo->screenshot_every_s;
+            }
+            draw_all(L, v, fr, w, h);
+        }
+        glfw_window_swap(&v->win);
+        /* At most 60 frames a second even where swaps do not wait for the display (Xvfb):
+         * the session thread keeps the CPU it needs. */
+        uint64_t now = now_ns();
+        if (now - last_frame_ns < DISPLAY_PERIOD_NS) {
+            const uint64_t rest = DISPLAY_PERIOD_NS - (now - last_frame_ns);
+            const struct timespec ts = {0, (long)rest};
+            nanosleep(&ts, NULL);
+            now = now_ns();
+        }
+        const double dt_ms = (double)(now - last_frame_ns) * 1e-6;
+        last_frame_ns = now;
+        if (dt_ms > 0.0)
+            v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms) : 1000.0 / dt_ms;
+        if (v->n_frame < LATENCY_SAMPLES)
+            v->frame_ms[v->n_frame++] = dt_ms;
+        if (fresh && fr->change_t_s >= 0.0 && v->n_latency < LATENCY_SAMPLES) {
+            /* Simulated time from the impulse's arrival to the snapshot, plus wall time from
+             * the snapshot to this swap (the session runs paced, so the two clocks agree). */
+            v->latency_ms[v->n_latency++] =
+                (fr->t_s - fr->change_t_s) * 1e3 + (double)(now - fr->published_ns) * 1e-6;
+        }
+        if (atomic_load(&L->session_done)) {
+            if (done_at_ns == 0) {
+                done_at_ns = now;
+                continue; /* one more pass takes the last snapshot */
+            }
+            if (atomic_load(&L->want_stop) || v->quit ||
+                (double)(now - done_at_ns) * 1e-9 >= wo->linger_s)
+                break;
+        }
+    }
+    if (wo->screenshot_path) {
+        int w = 0, h = 0;
+        glfw_window_size(&v->win, &w, &h);
+        if (w > 0 && h > 0 && !write_shot(L, v, fr, wo->screenshot_path, w, h, err, err_len))
+            status = 1;
+    }
+    return status;
+}
+
+argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo,
+                              session_summary_t *sum, bool *window_failed, char *err,
+                              size_t err_len)
+{
+    *window_failed = false;
+    memset(sum, 0, sizeof(*sum));
+    live_t *L = calloc(1, sizeof(*L));
+    view_t *v = calloc(1, sizeof(*v));
+    if (L == NULL || v == NULL) {
+        free(L);
+        free(v);
+        snprintf(err, err_len, "out of memory for the window");
+        return ARGIL_ERR_NOMEM;
+    }
+    ui_input_init(&v->script);
+    if (wo->input_path != NULL &&
+        ui_input_load(&v->script, wo->input_path, err, err_len) != ARGIL_OK) {
+        free(L);
+        free(v);
+        return ARGIL_ERR_PARSE;
+    }
+    if (wo->frames_dir != NULL && so->out_dir != NULL)
+        (void)mkdir(so->out_dir, 0777); /* the session creates it too; errors show below */
+    if (wo->frames_dir != NULL && mkdir(wo->frames_dir, 0777) != 0 && errno != EEXIST) {
+        snprintf(err, err_len, "%s: cannot create directory: %s", wo->frames_dir,
+                 strerror(errno));
+        ui_input_free(&v->script);
+        free(L);
+        free(v);
+        return ARGIL_ERR_IO;
+    }
+    char title[256];
+    snprintf(title, sizeof(title), "argil sculpt — %s",
+             so->script_path ? so->script_path : "mouse");
+    if (glfw_window_open(&v->win, wo->width, wo->height, true, 4, title, &v->gl, err,
+                         err_len) != ARGIL_OK) {
+        *window_failed = true;
+        ui_input_free(&v->script);
+        free(L);
+        free(v);
+        return ARGIL_ERR_STATE;
+    }
+    argil_err_t rc = renderer_init(&v->r, &v->gl, err, err_len);
+    if (rc == ARGIL_OK)
+        rc = hud_init(&v->hud, &v->gl, err, err_len);
+    if (rc != ARGIL_OK) {
+        *window_failed = true;
+        hud_free(&v->hud);
+        renderer_free(&v->r);
+        glfw_window_close(&v->win);
+        ui_input_free(&v->script);
+        free(L);
+        free(v);
+        return ARGIL_ERR_STATE;
+    }
+    v->gl.Enable(GL_MULTISAMPLE);
+    render_scene_default(&v->scene);
+    camera_frame(&v->cam, vec3(-0.036f, -0.036f, -0.036f), vec3(0.036f, 0.036f, 0.036f));
+    camera_orbit(&v->cam, -30.0f * (float)M_PI / 180.0f, 25.0f * (float)M_PI / 180.0f);
+
+    triple_buffer_init(&L->tb);
+    for (int i = 0; i < 3; i++)
+        mesh_init(&L->slot[i].mesh);
+    ui_queue_init(&L->q);
+    atomic_init(&L->want_stop, 0);
+    atomic_init(&L->session_done, 0);
+    L->wo = wo;
+    L->so = *so;
+    L->stop = so->stop;
+    L->pending_since_s = -1.0;
+    live_hand_init(&L->hand);
+    live_hand_cfg_default(&L->hand_cfg);
+    L->hook.on_tick = on_tick;
+    L->hook.ctx = L;
+    L->hook.hold_open = wo->mouse;
+    L->so.hook = &L->hook;
+    if (wo->mouse)
+        L->so.script_path = NULL;
+
+    pthread_t th;
+    int status = 0;
+    if (pthread_create(&th, NULL, session_main, L) != 0) {
+        snprintf(err, err_len, "cannot start the session thread");
+        rc = ARGIL_ERR_STATE;
+    } else {
+        char rerr[512] = "";
+        status = render_loop(L, v, rerr, sizeof(rerr));
+        atomic_store(&L->want_stop, 1);
+        pthread_join(th, NULL);
+        *sum = L->sum;
+        if (wo->mouse)
+            sum->interrupted = false; /* closing the window is how a mouse session ends */
+        rc = L->rc;
+        if (rc != ARGIL_OK)
+            snprintf(err, err_len, "%s", L->err);
+        else if (status != 0) {
+            snprintf(err, err_len, "%s", rerr);
+            rc = ARGIL_ERR_IO;
+        }
+        if (wo->report) {
+            const size_t nf = v->n_frame, nl = v->n_latency;
+            const double fm = median(v->frame_ms, nf), lm = median(v->latency_ms, nl);
+            const double lmax = nl ? v->latency_ms[nl - 1] : 0.0;
+            printf("  live window         %zu frames, frame time median %.1f ms; change to "
+                   "screen median %.1f ms, max %.1f ms (%zu changes)\n",
+                   nf, fm, lm, lmax, nl);
+            uint32_t slot;
+            triple_buffer_take(&L->tb, &slot);
+            const live_frame_t *fr = &L->slot[slot];
+            const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
+            const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
+            printf("  tool at the end     %s%s, radius %.2f mm, stiffness %.3f N/mm, beta %s, "
+                   "clay stiffness %.3g, damping %.3g, plastic rate %.3g Hz\n",
+                   TOOL_NAMES[t], fr->inverted ? " (inverted)" : "",
+                   (double)fr->params[PARAM_RADIUS_MM],
+                   (double)fr->params[PARAM_STIFFNESS_N_PER_MM], FILTER_NAMES[b],
+                   (double)fr->params[PARAM_CLAY_STIFFNESS],
+                   (double)fr->params[PARAM_CLAY_DAMPING],
+                   (double)fr->params[PARAM_PLASTIC_RATE_HZ]);
+        }
+    }
+    if (v->shot_ready)
+        render_target_free(&v->shot);
+    free(v->shot_rgb);
+    hud_free(&v->hud);
+    renderer_free(&v->r);
+    glfw_window_close(&v->win);
+    ui_input_free(&v->script);
+    if (L->mcb_ready)
+        mc_blocks_free(&L->mcb);
+    for (int i = 0; i < 3; i++)
+        mesh_free(&L->slot[i].mesh);
+    free(L);
+    free(v);
+    return rc;
+}

@@ -1,0 +1,866 @@
+/* Autosave journal: base .argil snapshot + CRC'd records of changed density samples; the writer
+ * buffers records and makes them durable at a bounded interval, the reader replays them. */
+#define _POSIX_C_SOURCE 200809L
+#include "journal.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "host/io/io_util.h"
+#include "shared/crc32c.h"
+
+static const uint8_t JOURNAL_MAGIC[8] = {'A', 'R', 'G', 'J', 'R', 'N', 'L', 0x1a};
+#define JOURNAL_RECORD_MAX_BYTES ((uint64_t)1 << 32) /* the length field is 32 bits */
+
+void journal_cfg_default(journal_cfg_t *cfg)
+{
+    cfg->autosave_s = 1.0f;
+    cfg->checkpoint_s = 60.0f;
+    cfg->checkpoint_bytes = (uint64_t)64 << 20;
+}
+
+/* ---- little helpers ---- */
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    io_put_u32le(p, (uint32_t)v);
+    io_put_u32le(p + 4, (uint32_t)(v >> 32));
+}
+
+static uint64_t get_u64(const uint8_t *p)
+{
+    return (uint64_t)io_get_u32le(p) | (uint64_t)io_get_u32le(p + 4) << 32;
+}
+
+static void put_material(uint8_t *p, const spring_material_t *m)
+{
+    io_put_f32le(p, m->node_mass);
+    io_put_f32le(p + 4, m->stiffness);
+    io_put_f32le(p + 8, m->coupling);
+    io_put_f32le(p + 12, m->damping);
+    io_put_f32le(p + 16, m->plastic_rate_hz);
+}
+
+static void get_material(const uint8_t *p, spring_material_t *m)
+{
+    m->node_mass = io_get_f32le(p);
+    m->stiffness = io_get_f32le(p + 4);
+    m->coupling = io_get_f32le(p + 8);
+    m->damping = io_get_f32le(p + 12);
+    m->plastic_rate_hz = io_get_f32le(p + 16);
+}
+
+static bool same_bits(const void *a, const void *b, size_t n)
+{
+    return memcmp(a, b, n) == 0;
+}
+
+static char *path_join(const char *dir, const char *name)
+{
+    const size_t a = strlen(dir), b = strlen(name);
+    char *p = malloc(a + b + 2);
+    if (p == NULL)
+        return NULL;
+    memcpy(p, dir, a);
+    p[a] = '/';
+    memcpy(p + a + 1, name, b + 1);
+    return p;
+}
+
+static void sync_dir(const char *dir)
+{
+    const int fd = open(dir, O_RDONLY | O_DIRECTORY);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        (void)close(fd);
+    }
+}
+
+static void base_name(uint32_t checkpoint, char out[JOURNAL_BASE_NAME_MAX + 1])
+{
+    snprintf(out, JOURNAL_BASE_NAME_MAX + 1, JOURNAL_BASE_PREFIX "%u.argil", checkpoint);
+}
+
+static bool write_all(int fd, const uint8_t *p, size_t len)
+{
+    while (len > 0) {
+        const ssize_t w = write(fd, p, len);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return false;
+        p += w;
+        len -= (size_t)w;
+    }
+    return true;
+}
+
+/* The base's identity: CRC-32C of its densities as little-endian binary32. (Not a CRC over the
+ * file: a CRC over data followed by its own CRC is a constant, so over an .argil, whose sections
+ * each end in their CRC, it would not depend on the sections' contents at all.) */
+static uint32_t density_crc(const float *density, size_t n)
+{
+    uint8_t chunk[1024];
+    uint32_t crc = 0;
+    size_t i = 0;
+    while (i < n) {
+        size_t k = 0;
+        for (; k < sizeof(chunk) / 4 && i < n; k++, i++)
+            io_put_f32le(chunk + 4 * k, density[i]);
+        crc = crc32c(crc, chunk, 4 * k);
+    }
+    return crc;
+}
+
+/* ---- the model as a journal holds it ---- */
+
+argil_err_t journal_model_doc(const journal_info_t *info, const float *density, argil_doc_t *doc)
+{
+    argil_doc_init(doc);
+    argil_err_t e = grid_init(&doc->grid, info->dims, info->spacing_m, info->origin_m);
+    if (e != ARGIL_OK)
+        return e;
+    const size_t n = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
+    memcpy(doc->grid.density, density, n * sizeof(float));
+    memcpy(doc->grid.rest, density, n * sizeof(float));
+    doc->grid.iso = info->iso;
+    doc->grid.band_m = info->band_m;
+    doc->grid.material = info->material;
+    doc->state.edits = info->edits;
+    return ARGIL_OK;
+}
+
+/* The header fields a writer knows, as an info. */
+static void writer_info(const journal_t *j, uint32_t edits, journal_info_t *info)
+{
+    memset(info, 0, sizeof(*info));
+    for (int a = 0; a < 3; a++)
+        info->dims[a] = j->dims[a];
+    info->spacing_m = j->spacing_m;
+    info->origin_m = j->origin_m;
+    info->iso = j->iso;
+    info->band_m = j->band_m;
+    info->material = j->material;
+    info->edits = edits;
+}
+
+argil_err_t journal_write_model(const journal_t *j, const float *density, uint32_t edits,
+                                const char *path, char *err, size_t err_len)
+{
+    if (density == NULL && j->shadow == NULL) {
+        io_err(err, err_len, "%s: the journal holds no model", path);
+        return ARGIL_ERR_STATE;
+    }
+    journal_info_t info;
+    writer_info(j, edits, &info);
+    argil_doc_t doc;
+    argil_err_t e = journal_model_doc(&info, density ? density : j->shadow, &doc);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", path);
+        argil_doc_free(&doc);
+        return e;
+    }
+    e = argil_file_write(path, &doc, err, err_len);
+    argil_doc_free(&doc);
+    return e;
+}
+
+/* ---- writer ---- */
+
+static void encode_header(const journal_t *j, const char *base, uint64_t base_len,
+                          uint32_t base_crc, uint32_t base_edits, uint8_t h[JOURNAL_HEADER_BYTES])
+{
+    memset(h, 0, JOURNAL_HEADER_BYTES);
+    memcpy(h, JOURNAL_MAGIC, 8);
+    io_put_u32le(h + 8, JOURNAL_VERSION);
+    io_put_u32le(h + 12, JOURNAL_HEADER_BYTES);
+    for (int a = 0; a < 3; a++)
+        io_put_u32le(h + 16 + 4 * a, (uint32_t)j->dims[a]);
+    io_put_f32le(h + 28, j->spacing_m);
+    io_put_f32le(h + 32, j->origin_m.x);
+    io_put_f32le(h + 36, j->origin_m.y);
+    io_put_f32le(h + 40, j->origin_m.z);
+    io_put_f32le(h + 44, j->iso);
+    io_put_f32le(h + 48, j->band_m);
+    put_material(h + 52, &j->material);
+    io_put_u32le(h + 72, j->checkpoint);
+    io_put_u32le(h + 76, j->seq + 1u);
+    put_u64(h + 80, base_len);
+    io_put_u32le(h + 88, base_crc);
+    io_put_u32le(h + 92, base_edits);
+    memcpy(h + 96, base, strlen(base));
+    io_put_u32le(h + JOURNAL_HEADER_BYTES - 4, crc32c(0, h, JOURNAL_HEADER_BYTES - 4));
+}
+
+/* Writes base snapshot number j->checkpoint from the shadow, then a new journal.log (via
+ * journal.log.tmp + rename) that starts on it; leaves the new file open in j->fd. */
+static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t err_len)
+{
+    char base[JOURNAL_BASE_NAME_MAX + 1];
+    base_name(j->checkpoint, base);
+    char *base_path = path_join(j->dir, base);
+    char *log_path = path_join(j->dir, JOURNAL_FILE);
+    char *tmp_path = path_join(j->dir, JOURNAL_FILE ".tmp");
+    argil_err_t e = ARGIL_ERR_NOMEM;
+    int fd = -1;
+    if (base_path == NULL || log_path == NULL || tmp_path == NULL) {
+        io_err(err, err_len, "%s: out of memory for the journal", j->dir);
+        goto out;
+    }
+    e = journal_write_model(j, NULL, edits, base_path, err, err_len);
+    if (e != ARGIL_OK)
+        goto out;
+    struct stat st;
+    if (stat(base_path, &st) != 0) {
+        io_err(err, err_len, "%s: cannot stat: %s", base_path, strerror(errno));
+        e = ARGIL_ERR_IO;
+        goto out;
+    }
+    uint8_t h[JOURNAL_HEADER_BYTES];
+    encode_header(j, base, (uint64_t)st.st_size, density_crc(j->shadow, j->n), edits, h);
+    fd = open(tmp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    e = ARGIL_ERR_IO;
+    if (fd < 0) {
+        io_err(err, err_len, "%s: cannot create: %s", tmp_path, strerror(errno));
+        goto out;
+    }
+    if (!write_all(fd, h, sizeof(h)) || fsync(fd) != 0) {
+        io_err(err, err_len, "%s: cannot write: %s", tmp_path, strerror(errno));
+        goto out;
+    }
+    if (rename(tmp_path, log_path) != 0) {
+        io_err(err, err_len, "%s: cannot rename to %s: %s", tmp_path, log_path, strerror(errno));
+        goto out;
+    }
+    sync_dir(j->dir);
+    if (j->fd >= 0)
+        (void)close(j->fd);
+    j->fd = fd;
+    fd = -1;
+    j->file_bytes = JOURNAL_HEADER_BYTES;
+    e = ARGIL_OK;
+out:
+    if (fd >= 0) {
+        (void)close(fd);
+        (void)unlink(tmp_path);
+    }
+    free(base_path);
+    free(log_path);
+    free(tmp_path);
+    return e;
+}
+
+argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const journal_cfg_t *cfg,
+                         double sim_s, double real_s, char *err, size_t err_len)
+{
+    memset(j, 0, sizeof(*j));
+    j->fd = -1;
+    if (!(cfg->autosave_s > 0.0f) || !(cfg->checkpoint_s > 0.0f) || cfg->checkpoint_bytes == 0 ||
+        g->density == NULL) {
+        io_err(err, err_len, "journal: autosave and checkpoint intervals must be > 0");
+        return ARGIL_ERR_ARG;
+    }
+    j->cfg = *cfg;
+    for (int a = 0; a < 3; a++)
+        j->dims[a] = g->dims[a];
+    j->spacing_m = g->spacing_m;
+    j->origin_m = g->origin_m;
+    j->iso = g->iso;
+    j->band_m = g->band_m;
+    j->material = g->material;
+    j->n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    j->dir = strdup(dir);
+    j->shadow = malloc(j->n * sizeof(float));
+    if (j->dir == NULL || j->shadow == NULL) {
+        io_err(err, err_len, "%s: out of memory for the journal", dir);
+        journal_close(j);
+        return ARGIL_ERR_NOMEM;
+    }
+    memcpy(j->shadow, g->density, j->n * sizeof(float));
+    if (journal_exists(dir)) {
+        io_err(err, err_len, "%s holds an unfinished session's journal: run 'argil recover %s' "
+                             "or start with --discard-journal", dir, dir);
+        journal_close(j);
+        return ARGIL_ERR_STATE;
+    }
+    (void)journal_discard(dir, NULL, 0); /* bases a crash left without a journal */
+    const argil_err_t e = start_file(j, 0, err, err_len);
+    if (e != ARGIL_OK) {
+        journal_close(j);
+        return e;
+    }
+    j->checkpoint_sim_s = sim_s;
+    (void)real_s;
+    return ARGIL_OK;
+}
+
+static bool reserve(journal_t *j, size_t more)
+{
+    if (j->buf_cap - j->buf_len >= more)
+        return true;
+    size_t cap = j->buf_cap ? j->buf_cap : 65536;
+    while (cap - j->buf_len < more)
+        cap *= 2;
+    uint8_t *p = realloc(j->buf, cap);
+    if (p == NULL)
+        return false;
+    j->buf = p;
+    j->buf_cap = cap;
+    return true;
+}
+
+/* Appends the run [start, end) of density to the open record and to the shadow. */
+static bool put_run(journal_t *j, const float *density, size_t start, size_t end)
+{
+    const size_t count = end - start;
+    if (!reserve(j, 8 + 4 * count))
+        return false;
+    uint8_t *p = j->buf + j->buf_len;
+    io_put_u32le(p, (uint32_t)start);
+    io_put_u32le(p + 4, (uint32_t)count);
+    for (size_t i = 0; i < count; i++)
+        io_put_f32le(p + 8 + 4 * i, density[start + i]);
+    memcpy(j->shadow + start, density + start, count * sizeof(float));
+    j->buf_len += 8 + 4 * count;
+    j->stats.samples += count;
+    return true;
+}
+
+argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
+                           uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
+                           bool *appended, char *err, size_t err_len)
+{
+    *appended = false;
+    if (j->shadow == NULL) {
+        io_err(err, err_len, "journal: not open (or stopped by an earlier failure)");
+        return ARGIL_ERR_STATE;
+    }
+    if (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] || g->dims[2] != j->dims[2]) {
+        io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
+        return ARGIL_ERR_ARG;
+    }
+    const bool material_changed = !same_bits(&g->material, &j->material, sizeof(j->material));
+    /* The box to compare, clipped to the grid. */
+    int32_t lo[3] = {0, 0, 0}, hi[3] = {j->dims[0], j->dims[1], j->dims[2]};
+    if (box != NULL) {
+        for (int a = 0; a < 3; a++) {
+            lo[a] = box->lo[a] < 0 ? 0 : (box->lo[a] > j->dims[a] ? j->dims[a] : box->lo[a]);
+            hi[a] = box->hi[a] < lo[a] ? lo[a] : (box->hi[a] > j->dims[a] ? j->dims[a] : box->hi[a]);
+        }
+    }
+    const size_t x0 = (size_t)lo[0], x1 = (size_t)hi[0];
+    const size_t rec_at = j->buf_len;
+    if (!reserve(j, 4 + JOURNAL_RECORD_HEAD_BYTES))
+        goto nomem;
+    j->buf_len += 4 + JOURNAL_RECORD_HEAD_BYTES;
+    uint32_t runs = 0;
+    bool open_run = false;
+    size_t run_start = 0, run_end = 0;
+    for (int32_t z = lo[2]; z < hi[2] && x1 > x0; z++) {
+        for (int32_t y = lo[1]; y < hi[1]; y++) {
+            const size_t r0 = ((size_t)y + (size_t)j->dims[1] * (size_t)z) * (size_t)j->dims[0];
+            const float *d = g->density + r0, *s = j->shadow + r0;
+            if (same_bits(d + x0, s + x0, (x1 - x0) * sizeof(float)))
+                continue;
+            for (size_t x = x0; x < x1; x++) {
+                if (same_bits(d + x, s + x, sizeof(float)))
+                    continue;
+                const size_t i = r0 + x;
+                if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
+                    run_end = i + 1; /* bridged samples are written with their current values */
+                    continue;
+                }
+                if (open_run) {
+                    if (!put_run(j, g->density, run_start, run_end))
+                        goto nomem;
+                    runs++;
+                }
+                open_run = true;
+                run_start = i;
+                run_end = i + 1;
+            }
+        }
+    }
+    if (open_run) {
+        if (!put_run(j, g->density, run_start, run_end))
+            goto nomem;
+        runs++;
+    }
+    if (runs == 0 && !material_changed) {
+        j->buf_len = rec_at;
+        return ARGIL_OK;
+    }
+    const size_t payload = j->buf_len - rec_at - 4;
+    if ((uint64_t)payload + 8 >= JOURNAL_RECORD_MAX_BYTES || !reserve(j, 4))
+        goto nomem;
+    j->material = g->material;
+    j->edits = edits;
+    j->seq++;
+    uint8_t *p = j->buf + rec_at;
+    io_put_u32le(p, (uint32_t)payload);
+    uint8_t *h = p + 4;
+    io_put_u32le(h, 1u); /* record type: edit step */
+    io_put_u32le(h + 4, j->seq);
+    const double sim_us = sim_s > 0.0 ? sim_s * 1e6 + 0.5 : 0.0;
+    put_u64(h + 8, (uint64_t)sim_us);
+    put_u64(h + 16, wall_ms);
+    io_put_u32le(h + 24, edits);
+    put_material(h + 28, &j->material);
+    io_put_u32le(h + 48, runs);
+    io_put_u32le(j->buf + j->buf_len, crc32c(0, p, 4 + payload));
+    j->buf_len += 4;
+    const size_t rec_bytes = j->buf_len - rec_at;
+    if (rec_at == 0) {
+        j->oldest_pending_sim_s = sim_s;
+        j->oldest_pending_real_s = real_s;
+    }
+    j->file_bytes += rec_bytes;
+    j->stats.records++;
+    j->stats.bytes += rec_bytes;
+    *appended = true;
+    return ARGIL_OK;
+nomem:
+    /* The shadow may already hold part of this step: the journal cannot go on consistently.
+     * The whole records before this one stay buffered and can still be synced. */
+    j->buf_len = rec_at;
+    io_err(err, err_len, "%s: out of memory for journal records", j->dir);
+    free(j->shadow);
+    j->shadow = NULL;
+    return ARGIL_ERR_NOMEM;
+}
+
+argil_err_t journal_sync(journal_t *j, char *err, size_t err_len)
+{
+    if (j->buf_len == 0)
+        return ARGIL_OK;
+    if (j->fd < 0) {
+        io_err(err, err_len, "%s/" JOURNAL_FILE ": the journal is not open", j->dir);
+        return ARGIL_ERR_STATE;
+    }
+    if (!write_all(j->fd, j->buf, j->buf_len) || fdatasync(j->fd) != 0) {
+        io_err(err, err_len, "%s/" JOURNAL_FILE ": cannot write: %s", j->dir, strerror(errno));
+        return ARGIL_ERR_IO;
+    }
+    j->buf_len = 0;
+    j->stats.syncs++;
+    return ARGIL_OK;
+}
+
+argil_err_t journal_checkpoint(journal_t *j, double sim_s, char *err, size_t err_len)
+{
+    argil_err_t e = journal_sync(j, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    /* The base holds the model as of the last record; the new journal starts after it. */
+    const uint32_t old = j->checkpoint;
+    j->checkpoint = old + 1u;
+    e = start_file(j, j->edits, err, err_len);
+    if (e != ARGIL_OK) {
+        j->checkpoint = old;
+        return e;
+    }
+    char name[JOURNAL_BASE_NAME_MAX + 1];
+    base_name(old, name);
+    char *p = path_join(j->dir, name);
+    if (p != NULL)
+        (void)unlink(p);
+    free(p);
+    j->checkpoint_sim_s = sim_s;
+    j->stats.checkpoints++;
+    return ARGIL_OK;
+}
+
+bool journal_sync_due(const journal_t *j, double sim_s, double real_s)
+{
+    return j->buf_len > 0 && (sim_s - j->oldest_pending_sim_s >= (double)j->cfg.autosave_s ||
+                              real_s - j->oldest_pending_real_s >= (double)j->cfg.autosave_s);
+}
+
+argil_err_t journal_tick(journal_t *j, double sim_s, double real_s, char *err, size_t err_len)
+{
+    if (journal_sync_due(j, sim_s, real_s)) {
+        const argil_err_t e = journal_sync(j, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    if (sim_s - j->checkpoint_sim_s >= (double)j->cfg.checkpoint_s ||
+        j->file_bytes >= j->cfg.checkpoint_bytes)
+        return journal_checkpoint(j, sim_s, err, err_len);
+    return ARGIL_OK;
+}
+
+void journal_close(journal_t *j)
+{
+    if (j->fd >= 0)
+        (void)close(j->fd);
+    j->fd = -1;
+    free(j->dir);
+    free(j->shadow);
+    free(j->buf);
+    j->dir = NULL;
+    j->shadow = NULL;
+    j->buf = NULL;
+    j->buf_len = j->buf_cap = 0;
+}
+
+argil_err_t journal_finish(journal_t *j, char *err, size_t err_len)
+{
+    if (j->dir == NULL) {
+        journal_close(j);
+        return ARGIL_OK;
+    }
+    char *dir = strdup(j->dir);
+    journal_close(j);
+    if (dir == NULL) {
+        io_err(err, err_len, "out of memory");
+        return ARGIL_ERR_NOMEM;
+    }
+    const argil_err_t e = journal_discard(dir, err, err_len);
+    free(dir);
+    return e;
+}
+
+bool journal_exists(const char *dir)
+{
+    char *p = path_join(dir, JOURNAL_FILE);
+    struct stat st;
+    const bool yes = p != NULL && stat(p, &st) == 0 && S_ISREG(st.st_mode);
+    free(p);
+    return yes;
+}
+
+argil_err_t journal_discard(const char *dir, char *err, size_t err_len)
+{
+    /* The journal first: once it is gone no base is needed. */
+    char *p = path_join(dir, JOURNAL_FILE);
+    if (p == NULL) {
+        io_err(err, err_len, "out of memory");
+        return ARGIL_ERR_NOMEM;
+    }
+    if (unlink(p) != 0 && errno != ENOENT) {
+        io_err(err, err_len, "%s: cannot remove: %s", p, strerror(errno));
+        free(p);
+        return ARGIL_ERR_IO;
+    }
+    free(p);
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return ARGIL_OK;
+    const size_t plen = strlen(JOURNAL_BASE_PREFIX);
+    struct dirent *ent;
+    while ((ent = readdir(d)) != NULL) {
+        const char *name = ent->d_name;
+        const size_t len = strlen(name);
+        const bool base = strncmp(name, JOURNAL_BASE_PREFIX, plen) == 0 &&
+                          (len > 6 && (strcmp(name + len - 6, ".argil") == 0 ||
+                                       (len > 10 && strcmp(name + len - 10, ".argil.tmp") == 0)));
+        if (!base && strcmp(name, JOURNAL_FILE ".tmp") != 0)
+            continue;
+        char *q = path_join(dir, name);
+        if (q != NULL)
+            (void)unlink(q);
+        free(q);
+    }
+    closedir(d);
+    sync_dir(dir);
+    return ARGIL_OK;
+}
+
+/* ---- reader ---- */
+
+static argil_err_t fail(char *err, size_t err_len, const char *name, size_t byte, const char *why)
+{
+    io_err(err, err_len, "%s: byte %zu: %s", name, byte, why);
+    return ARGIL_ERR_PARSE;
+}
+
+argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *name,
+                                  journal_info_t *info, char *err, size_t err_len)
+{
+    memset(info, 0, sizeof(*info));
+    if (len < JOURNAL_HEADER_BYTES)
+        return fail(err, err_len, name, len, "file shorter than the journal header");
+    if (memcmp(data, JOURNAL_MAGIC, 8) != 0)
+        return fail(err, err_len, name, 0, "not an argil journal");
+    if (io_get_u32le(data + JOURNAL_HEADER_BYTES - 4) !=
+        crc32c(0, data, JOURNAL_HEADER_BYTES - 4))
+        return fail(err, err_len, name, JOURNAL_HEADER_BYTES - 4, "header checksum mismatch");
+    if (io_get_u32le(data + 8) != JOURNAL_VERSION)
+        return fail(err, err_len, name, 8, "journal version (this argil reads 1..1)");
+    if (io_get_u32le(data + 12) != JOURNAL_HEADER_BYTES)
+        return fail(err, err_len, name, 12, "header size");
+    int64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        const int32_t d = (int32_t)io_get_u32le(data + 16 + 4 * a);
+        if (d < 1 || (n *= d) > GRID_SAMPLES_MAX)
+            return fail(err, err_len, name, 16 + 4 * (size_t)a, "grid dimension below 1 or "
+                                                               "more than 2^30 samples");
+        info->dims[a] = d;
+    }
+    info->spacing_m = io_get_f32le(data + 28);
+    info->origin_m = vec3(io_get_f32le(data + 32), io_get_f32le(data + 36),
+                          io_get_f32le(data + 40));
+    info->iso = io_get_f32le(data + 44);
+    info->band_m = io_get_f32le(data + 48);
+    if (!isfinite(info->spacing_m) || !(info->spacing_m > 0.0f) || !vec3_isfinite(info->origin_m) ||
+        !isfinite(info->iso) || !isfinite(info->band_m))
+        return fail(err, err_len, name, 28, "grid spacing, origin, iso or band not finite");
+    get_material(data + 52, &info->material);
+    if (!spring_material_valid(&info->material))
+        return fail(err, err_len, name, 52, "material out of range");
+    info->checkpoint = io_get_u32le(data + 72);
+    info->first_seq = io_get_u32le(data + 76);
+    if (info->first_seq == 0)
+        return fail(err, err_len, name, 76, "first record number 0");
+    info->last_seq = info->first_seq - 1u;
+    info->base_len = get_u64(data + 80);
+    info->base_crc = io_get_u32le(data + 88);
+    info->edits = io_get_u32le(data + 92);
+    const uint8_t *bn = data + 96;
+    size_t bl = 0;
+    while (bl < JOURNAL_BASE_NAME_MAX && bn[bl] != 0)
+        bl++;
+    for (size_t i = bl; i < JOURNAL_BASE_NAME_MAX; i++)
+        if (bn[i] != 0)
+            return fail(err, err_len, name, 96 + i, "base name not NUL-padded");
+    if (bl == 0 || memchr(bn, '/', bl) != NULL || (bl <= 2 && bn[0] == '.'))
+        return fail(err, err_len, name, 96, "base name empty or not a plain file name");
+    for (size_t i = 0; i < bl; i++)
+        if (bn[i] < 0x20 || bn[i] > 0x7e)
+            return fail(err, err_len, name, 96 + i, "base name not printable ASCII");
+    memcpy(info->base_name, bn, bl);
+    info->base_name[bl] = '\0';
+    info->good_bytes = JOURNAL_HEADER_BYTES;
+    return ARGIL_OK;
+}
+
+/* Checks one record's payload (CRC already good) and, with density, applies it. */
+static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, const char *name,
+                                float *density, size_t n, journal_info_t *info, char *err,
+                                size_t err_len)
+{
+    char why[160];
+    const uint32_t rec = info->records + 1u;
+    if (payload < JOURNAL_RECORD_HEAD_BYTES) {
+        snprintf(why, sizeof(why), "record %u: shorter than a record head", rec);
+        return fail(err, err_len, name, at, why);
+    }
+    if (io_get_u32le(p) != 1u) {
+        snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, io_get_u32le(p));
+        return fail(err, err_len, name, at + 4, why);
+    }
+    const uint32_t seq = io_get_u32le(p + 4);
+    if (seq != info->last_seq + 1u) {
+        snprintf(why, sizeof(why), "record %u: number %u, expected %u", rec, seq,
+                 info->last_seq + 1u);
+        return fail(err, err_len, name, at + 8, why);
+    }
+    spring_material_t m;
+    get_material(p + 28, &m);
+    if (!spring_material_valid(&m)) {
+        snprintf(why, sizeof(why), "record %u: material out of range", rec);
+        return fail(err, err_len, name, at + 32, why);
+    }
+    const uint32_t runs = io_get_u32le(p + 48);
+    /* Check every run before changing anything. */
+    size_t off = JOURNAL_RECORD_HEAD_BYTES;
+    uint64_t samples = 0;
+    for (uint32_t r = 0; r < runs; r++) {
+        if (payload - off < 8) {
+            snprintf(why, sizeof(why), "record %u: run %u head runs past the record", rec, r);
+            return fail(err, err_len, name, at + 4 + off, why);
+        }
+        const uint64_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+        if (count == 0 || start + count > (uint64_t)n || count > (payload - off - 8) / 4) {
+            snprintf(why, sizeof(why),
+                     "record %u: run %u (%llu samples from %llu) empty, beyond the grid or "
+                     "past the record",
+                     rec, r, (unsigned long long)count, (unsigned long long)start);
+            return fail(err, err_len, name, at + 4 + off, why);
+        }
+        for (uint64_t i = 0; i < count; i++) {
+            const float v = io_get_f32le(p + off + 8 + 4 * i);
+            if (!isfinite(v) || v < 0.0f || v > 1.0f) {
+                snprintf(why, sizeof(why), "record %u: density not a finite number in [0, 1]",
+                         rec);
+                return fail(err, err_len, name, at + 4 + off + 8 + 4 * (size_t)i, why);
+            }
+        }
+        off += 8 + 4 * (size_t)count;
+        samples += count;
+    }
+    if (off != payload) {
+        snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
+        return fail(err, err_len, name, at + 4 + off, why);
+    }
+    if (density != NULL) {
+        off = JOURNAL_RECORD_HEAD_BYTES;
+        for (uint32_t r = 0; r < runs; r++) {
+            const size_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+            for (size_t i = 0; i < count; i++)
+                density[start + i] = io_get_f32le(p + off + 8 + 4 * i);
+            off += 8 + 4 * count;
+        }
+    }
+    info->records++;
+    info->last_seq = seq;
+    info->last_sim_s = (double)get_u64(p + 8) * 1e-6;
+    info->last_wall_ms = get_u64(p + 16);
+    info->edits = io_get_u32le(p + 24);
+    info->material = m;
+    info->samples += samples;
+    return ARGIL_OK;
+}
+
+argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
+                           size_t n, journal_info_t *info, char *err, size_t err_len)
+{
+    argil_err_t e = journal_header_decode(data, len, name, info, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    const size_t want = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
+    if (density != NULL && n != want) {
+        io_err(err, err_len, "%s: the journal's grid (%zu samples) is not the model's (%zu)", name,
+               want, n);
+        return ARGIL_ERR_ARG;
+    }
+    size_t at = JOURNAL_HEADER_BYTES;
+    while (at < len) {
+        const size_t left = len - at;
+        if (left < 8) {
+            info->torn_bytes = left;
+            break;
+        }
+        const uint64_t payload = io_get_u32le(data + at);
+        if (payload + 8 > left) {
+            info->torn_bytes = left; /* declared length runs past the end: a cut-short write */
+            break;
+        }
+        const uint32_t crc = io_get_u32le(data + at + 4 + payload);
+        if (crc != crc32c(0, data + at, 4 + (size_t)payload)) {
+            if (payload + 8 == left) {
+                info->torn_bytes = left; /* the very last record, partly written */
+                break;
+            }
+            char why[96];
+            snprintf(why, sizeof(why), "record %u: checksum mismatch (recovery stops before it)",
+                     info->records + 1u);
+            return fail(err, err_len, name, at, why);
+        }
+        e = apply_record(data + at + 4, (size_t)payload, at, name, density, want, info, err,
+                         err_len);
+        if (e != ARGIL_OK)
+            return e;
+        at += 8 + (size_t)payload;
+        info->good_bytes = at;
+    }
+    return ARGIL_OK;
+}
+
+static argil_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
+                                char *err, size_t err_len)
+{
+    *data = NULL;
+    *path = path_join(dir, JOURNAL_FILE);
+    if (*path == NULL) {
+        io_err(err, err_len, "out of memory");
+        return ARGIL_ERR_NOMEM;
+    }
+    return io_slurp(*path, IO_FILE_MAX_BYTES, data, len, err, err_len);
+}
+
+argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len)
+{
+    uint8_t *data;
+    size_t len = 0;
+    char *path;
+    argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
+    if (e == ARGIL_OK)
+        e = journal_replay(data, len, path, NULL, 0, info, err, err_len);
+    free(data);
+    free(path);
+    return e;
+}
+
+static bool same_f32(float a, float b)
+{
+    return same_bits(&a, &b, sizeof(a));
+}
+
+argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
+                            size_t err_len)
+{
+    argil_doc_init(doc);
+    uint8_t *data = NULL;
+    size_t len = 0;
+    char *path = NULL, *base_path = NULL;
+    argil_doc_t b;
+    argil_doc_init(&b);
+    argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
+    if (e != ARGIL_OK)
+        goto out;
+    e = journal_header_decode(data, len, path, info, err, err_len);
+    if (e != ARGIL_OK)
+        goto out;
+    base_path = path_join(dir, info->base_name);
+    if (base_path == NULL) {
+        e = ARGIL_ERR_NOMEM;
+        io_err(err, err_len, "out of memory");
+        goto out;
+    }
+    e = argil_file_read(base_path, &b, err, err_len);
+    if (e != ARGIL_OK)
+        goto out;
+    const grid_t *g = &b.grid;
+    const size_t bn = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    struct stat st;
+    const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
+    const uint32_t crc = density_crc(g->density, bn);
+    if (blen != info->base_len || crc != info->base_crc ||
+        !same_bits(&g->material, &info->material, sizeof(g->material)) ||
+        b.state.edits != info->edits) {
+        io_err(err, err_len,
+               "%s: the base snapshot %s is not the one this journal continues (%llu bytes, "
+               "density CRC %08x; the journal expects %llu bytes, CRC %08x, and its material "
+               "and edit count): refusing to replay onto it",
+               path, base_path, (unsigned long long)blen, crc, (unsigned long long)info->base_len,
+               info->base_crc);
+        e = ARGIL_ERR_PARSE;
+        goto out;
+    }
+    if (g->dims[0] != info->dims[0] || g->dims[1] != info->dims[1] ||
+        g->dims[2] != info->dims[2] || !same_f32(g->spacing_m, info->spacing_m) ||
+        !same_f32(g->origin_m.x, info->origin_m.x) || !same_f32(g->origin_m.y, info->origin_m.y) ||
+        !same_f32(g->origin_m.z, info->origin_m.z) || !same_f32(g->iso, info->iso) ||
+        !same_f32(g->band_m, info->band_m)) {
+        io_err(err, err_len, "%s: the base snapshot's grid differs from the journal's", base_path);
+        e = ARGIL_ERR_PARSE;
+        goto out;
+    }
+    e = journal_replay(data, len, path, b.grid.density, bn, info, err, err_len);
+    if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
+        goto out;
+    /* After a bad record (PARSE) the density holds the model as of the record before it. */
+    const argil_err_t me = journal_model_doc(info, b.grid.density, doc);
+    if (me != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the recovered model", path);
+        e = me;
+    }
+out:
+    if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
+        argil_doc_free(doc);
+    else if (e == ARGIL_ERR_PARSE && doc->grid.density == NULL)
+        argil_doc_free(doc);
+    argil_doc_free(&b);
+    free(data);
+    free(path);
+    free(base_path);
+    return e;
+}

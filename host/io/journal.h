@@ -1,0 +1,160 @@
+/* The autosave journal of a sculpting session: every applied edit step is appended as the
+ * density samples it changed (sparse runs of new values, CRC-32C per record) on top of a base
+ * .argil snapshot; records are written and fdatasync'ed at a bounded interval, and the journal
+ * is rotated onto a new snapshot at checkpoints. After a crash the model is rebuilt bit for bit
+ * as of the last whole record. Layout byte by byte: docs/files.md. */
+#ifndef ARGIL_JOURNAL_H
+#define ARGIL_JOURNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "host/io/argil_file.h"
+#include "host/model/grid.h"
+#include "shared/argil_err.h"
+
+#define JOURNAL_VERSION 1u
+#define JOURNAL_HEADER_BYTES 160u
+#define JOURNAL_RECORD_HEAD_BYTES 52u      /* payload bytes before the runs */
+#define JOURNAL_BASE_NAME_MAX 60u          /* bytes for the base file's name in the header */
+#define JOURNAL_FILE "journal.log"         /* inside the session's output directory */
+#define JOURNAL_BASE_PREFIX "journal-base-" /* + checkpoint number + ".argil" */
+#define JOURNAL_RUN_GAP 2u                 /* unchanged samples bridged inside one run */
+
+typedef struct {
+    float autosave_s;        /* write + fdatasync once records are this old (sim or real s) */
+    float checkpoint_s;      /* new base snapshot + new journal every this many sim seconds */
+    uint64_t checkpoint_bytes; /* ... or once the journal holds this many bytes */
+} journal_cfg_t;
+
+typedef struct {
+    uint32_t records;         /* records appended */
+    uint64_t bytes;           /* record bytes appended */
+    uint32_t syncs;           /* write + fdatasync rounds */
+    uint32_t checkpoints;     /* rotations onto a new base */
+    uint64_t samples;         /* sample values journaled */
+} journal_stats_t;
+
+/* The open journal of a running session (writer side). */
+typedef struct {
+    journal_cfg_t cfg;
+    char *dir;
+    int fd;
+    int32_t dims[3];
+    float spacing_m, iso, band_m;
+    vec3_t origin_m;
+    size_t n;                 /* samples */
+    float *shadow;            /* density as of the last record */
+    spring_material_t material; /* as of the last record */
+    uint8_t *buf;             /* records not yet written to the file */
+    size_t buf_len, buf_cap;
+    uint32_t seq;             /* of the last record appended (0: none yet) */
+    uint32_t edits;           /* the session's edit steps as of the last record */
+    uint32_t checkpoint;      /* number of the current base snapshot */
+    uint64_t file_bytes;      /* in the current journal file, written or buffered */
+    double oldest_pending_sim_s, oldest_pending_real_s; /* of the oldest unwritten record */
+    double checkpoint_sim_s;  /* when the current base was taken */
+    journal_stats_t stats;
+} journal_t;
+
+/* What a journal holds, as far as its records are whole and valid. */
+typedef struct {
+    uint32_t checkpoint;
+    uint32_t first_seq;       /* seq the first record must carry */
+    uint32_t records;         /* good records */
+    uint32_t last_seq;        /* of the last good record (first_seq - 1 when none) */
+    double last_sim_s;        /* session time of the last good record */
+    uint64_t last_wall_ms;    /* wall-clock time (ms since 1970) it was made */
+    uint32_t edits;           /* edit steps since the session began, as of the last record */
+    spring_material_t material; /* as of the last record (the base's when there is none) */
+    uint64_t samples;         /* sample values replayed */
+    size_t good_bytes;        /* header + good records */
+    size_t torn_bytes;        /* an incomplete last record, ignored */
+    char base_name[JOURNAL_BASE_NAME_MAX + 1];
+    uint64_t base_len;
+    uint32_t base_crc;
+    int32_t dims[3];
+    float spacing_m, iso, band_m;
+    vec3_t origin_m;
+} journal_info_t;
+
+void journal_cfg_default(journal_cfg_t *cfg);
+
+/* Starts a journal in dir for the grid as it is now: writes the base snapshot
+ * journal-base-0.argil, then journal.log (both fsync'ed). ARGIL_ERR_STATE when dir already
+ * holds a journal (never overwrites work that could be recovered: see journal_discard). */
+argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const journal_cfg_t *cfg,
+                         double sim_s, double real_s, char *err, size_t err_len);
+
+/* A sample index box [lo, hi) (empty when lo >= hi on any axis). */
+typedef struct {
+    int32_t lo[3], hi[3];
+} journal_box_t;
+
+/* Appends one record when the grid's densities or material differ from the last record
+ * (buffered; *appended says whether one was made). Only samples inside box are compared when
+ * box is not NULL: the caller promises nothing changed outside it. edits counts the session's
+ * edit steps. */
+argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
+                           uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
+                           bool *appended, char *err, size_t err_len);
+
+/* True when journal_tick would write the buffered records now. */
+bool journal_sync_due(const journal_t *j, double sim_s, double real_s);
+
+/* Writes and fdatasyncs the buffered records once the oldest is autosave_s old (simulated or
+ * real time), and rotates onto a new base snapshot when a checkpoint is due. */
+argil_err_t journal_tick(journal_t *j, double sim_s, double real_s, char *err, size_t err_len);
+
+/* Writes and fdatasyncs every buffered record now. */
+argil_err_t journal_sync(journal_t *j, char *err, size_t err_len);
+
+/* Writes a new base snapshot (the model as of the last record) and starts a new journal on it;
+ * the old journal stays valid until the new one has replaced it by rename. */
+argil_err_t journal_checkpoint(journal_t *j, double sim_s, char *err, size_t err_len);
+
+/* Writes density (the journal's grid; NULL: the journal's copy as of the last record) with the
+ * material of the last record and edits to path as .argil, in exactly the form argil recover
+ * writes, so a model and its recovery compare byte for byte. */
+argil_err_t journal_write_model(const journal_t *j, const float *density, uint32_t edits,
+                                const char *path, char *err, size_t err_len);
+
+/* Releases the journal and keeps its files (the session did not end cleanly). */
+void journal_close(journal_t *j);
+
+/* Clean end: releases the journal and removes its files. */
+argil_err_t journal_finish(journal_t *j, char *err, size_t err_len);
+
+/* True when dir holds a journal file (an unfinished session). */
+bool journal_exists(const char *dir);
+
+/* Removes a journal and every base snapshot in dir. */
+argil_err_t journal_discard(const char *dir, char *err, size_t err_len);
+
+/* Decodes and checks a journal's header. ARGIL_ERR_PARSE with err naming name and the byte. */
+argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *name,
+                                  journal_info_t *info, char *err, size_t err_len);
+
+/* Walks the records after the header; with density (n samples, matching the header's dims)
+ * applies each good record to it. An incomplete last record (a write cut short by a crash) is
+ * ignored and counted in torn_bytes. A bad record before the end stops the walk: density holds
+ * the model as of the record before it, info describes the good part, and the result is
+ * ARGIL_ERR_PARSE with err naming the byte, the record and the rule. */
+argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
+                           size_t n, journal_info_t *info, char *err, size_t err_len);
+
+/* Reads dir's journal without its base: counts the good records (for the offer to recover). */
+argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len);
+
+/* Rebuilds the model in doc (initialised here) from dir's base snapshot and journal: refuses a
+ * base whose length or CRC differ from the header's, or whose grid differs. Same results as
+ * journal_replay (ARGIL_ERR_PARSE after a bad record, with doc as of the record before it). */
+argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
+                            size_t err_len);
+
+/* Fills doc (initialised here, owning a copy of density) with the model as a journal holds it:
+ * the grid geometry, material and edits from info. ARGIL_ERR_NOMEM / ARG. */
+argil_err_t journal_model_doc(const journal_info_t *info, const float *density, argil_doc_t *doc);
+
+#endif

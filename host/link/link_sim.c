@@ -1,0 +1,124 @@
+/* The in-process simulated board as a host-link transport, in real time: each poll runs the
+ * board core and the simulated arm (the hand holding still at the workspace centre) for the
+ * 1 ms ticks the wall clock has reached, so `argil connect --device sim` behaves like a board
+ * on a cable. The deterministic lockstep session is `argil sculpt`, not this. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "firmware/core/board_hal.h"
+#include "firmware/hal/hal_sim.h"
+#include "firmware/hal/link_io.h"
+#include "host/link/link.h"
+#include "sim/sim_device.h"
+
+#define SIM_CATCH_UP_TICKS 50u   /* at most this many ticks per poll; later ones are skipped */
+
+typedef struct {
+    hal_t hal;
+    board_t board;
+    board_io_t io;
+    sim_device_t dev;
+    sim_params_t params;
+    vec3_t hold_m;                 /* where the hand holds the stylus */
+    uint32_t tick_us;
+    uint64_t start_us;
+    uint64_t ticks;
+    uint64_t skipped_ticks;
+    uint8_t rx[HAL_SIM_LINK_BYTES];
+    size_t rx_len, rx_at;
+} sim_link_t;
+
+static argil_err_t sim_send(link_t *l, const uint8_t *frame, size_t len)
+{
+    sim_link_t *s = l->impl;
+    return hal_sim_host_send(&s->hal, frame, len);
+}
+
+static size_t sim_recv(link_t *l, uint8_t *buf, size_t cap)
+{
+    sim_link_t *s = l->impl;
+    if (s->rx_at >= s->rx_len) {
+        s->rx_len = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
+        s->rx_at = 0;
+        if (s->rx_len == 0)
+            return 0;
+    }
+    const size_t f = link_frame_size(s->rx + s->rx_at, s->rx_len - s->rx_at);
+    if (f == 0 || f > s->rx_len - s->rx_at || f > cap) {
+        l->stats.errors_rx++;
+        s->rx_at = s->rx_len = 0;
+        return 0;
+    }
+    memcpy(buf, s->rx + s->rx_at, f);
+    s->rx_at += f;
+    return f;
+}
+
+static void sim_tick(sim_link_t *s)
+{
+    sim_device_set_hand(&s->dev, s->hold_m, vec3(0, 0, 0), false, false);
+    can_batch_t from_board, to_board;
+    to_board.n = 0;
+    hal_sim_take_from_board(&s->hal, &from_board);
+    sim_device_step(&s->dev, &from_board, hal_sim_gpio_out(&s->hal), &to_board, s->tick_us);
+    hal_sim_put_to_board(&s->hal, &to_board);
+    hal_sim_set_gpio_in(&s->hal, sim_device_gpio_in(&s->dev));
+    (void)board_run_tick(&s->board, &s->io, &s->hal);
+    s->ticks++;
+}
+
+static void sim_poll(link_t *l, uint32_t wait_us, uint64_t now_us)
+{
+    sim_link_t *s = l->impl;
+    if (s->start_us == 0)
+        s->start_us = now_us;
+    const uint64_t due = (now_us - s->start_us) / s->tick_us;
+    if (due > s->ticks + s->skipped_ticks + SIM_CATCH_UP_TICKS)
+        s->skipped_ticks = due - s->ticks - SIM_CATCH_UP_TICKS;
+    while (s->ticks + s->skipped_ticks < due)
+        sim_tick(s);
+    /* Sleep until the next tick is due, at most wait_us. */
+    const uint64_t next_us = s->start_us + (s->ticks + s->skipped_ticks + 1u) * s->tick_us;
+    uint64_t nap_us = next_us > now_us ? next_us - now_us : 0;
+    if (nap_us > wait_us)
+        nap_us = wait_us;
+    if (nap_us > 0) {
+        const struct timespec ts = {0, (long)nap_us * 1000L};
+        nanosleep(&ts, NULL);
+    }
+}
+
+static void sim_close(link_t *l)
+{
+    free(l->impl);
+}
+
+static const link_ops_t SIM_OPS = {sim_send, sim_recv, sim_poll, sim_close};
+
+argil_err_t link_sim_open(link_t *l, char *err, size_t err_len)
+{
+    sim_link_t *s = calloc(1, sizeof(*s));
+    if (!s) {
+        snprintf(err, err_len, "out of memory for the simulated board");
+        return ARGIL_ERR_NOMEM;
+    }
+    sim_params_default(&s->params);
+    sim_device_init(&s->dev, &s->params);
+    hal_sim_init(&s->hal);
+    board_cfg_t cfg;
+    board_cfg_default(&cfg);
+    cfg.arm = s->params.arm.desc;
+    if (board_init(&s->board, &cfg) != ARGIL_OK) {
+        free(s);
+        snprintf(err, err_len, "sim: the simulated board refused its configuration");
+        return ARGIL_ERR_ARG;
+    }
+    board_io_init(&s->io);
+    s->tick_us = cfg.tick_us;
+    s->hold_m = sim_device_tip_m(&s->dev);
+    link_attach(l, &SIM_OPS, s, true);
+    return ARGIL_OK;
+}

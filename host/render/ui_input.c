@@ -1,0 +1,216 @@
+/* Scripted window input (see ui_input.h). One event per line:
+ *   AT_S key NAME | shift down|up | cursor X Y | left down|up | right down|up | wheel STEPS */
+#define GLFW_INCLUDE_NONE
+#include "host/render/ui_input.h"
+
+#include <GLFW/glfw3.h>
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const struct {
+    const char *name;
+    int code;
+} KEYS[] = {
+    {"1", GLFW_KEY_1},         {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},
+    {"4", GLFW_KEY_4},         {"5", GLFW_KEY_5},         {"6", GLFW_KEY_6},
+    {"B", GLFW_KEY_B},         {"C", GLFW_KEY_C},         {"TAB", GLFW_KEY_TAB},
+    {"UP", GLFW_KEY_UP},       {"DOWN", GLFW_KEY_DOWN},   {"LEFT", GLFW_KEY_LEFT},
+    {"RIGHT", GLFW_KEY_RIGHT}, {"PLUS", GLFW_KEY_EQUAL},  {"MINUS", GLFW_KEY_MINUS},
+    {"ESC", GLFW_KEY_ESCAPE},
+};
+
+int ui_input_key_code(const char *name)
+{
+    for (size_t i = 0; i < sizeof(KEYS) / sizeof(KEYS[0]); i++)
+        if (strcmp(KEYS[i].name, name) == 0)
+            return KEYS[i].code;
+    return -1;
+}
+
+void ui_input_init(ui_input_t *in)
+{
+    in->ev = NULL;
+    in->count = 0;
+    in->cap = 0;
+}
+
+void ui_input_free(ui_input_t *in)
+{
+    free(in->ev);
+    ui_input_init(in);
+}
+
+/* Splits a line into at most 5 words (in place); returns how many, or 6 when there are more. */
+static int split(char *line, char *w[5])
+{
+    int n = 0;
+    for (char *p = line;;) {
+        while (*p == ' ' || *p == '\t' || *p == '\r')
+            p++;
+        if (*p == '\0')
+            return n;
+        if (n == 5)
+            return 6;
+        w[n++] = p;
+        while (*p && *p != ' ' && *p != '\t' && *p != '\r')
+            p++;
+        if (*p)
+            *p++ = '\0';
+    }
+}
+
+static bool number(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v) || v < lo || v > hi)
+        return false;
+    *out = v;
+    return true;
+}
+
+static argil_err_t fail(ui_input_t *in, int line, const char *what, const char *word, char *err,
+                        size_t err_len)
+{
+    snprintf(err, err_len, "line %d: %s%s%s%s", line, what, word ? " '" : "", word ? word : "",
+             word ? "'" : "");
+    ui_input_free(in);
+    return ARGIL_ERR_PARSE;
+}
+
+argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *err,
+                           size_t err_len)
+{
+    ui_input_free(in);
+    char buf[256];
+    int line = 0;
+    size_t pos = 0;
+    double last_s = 0.0;
+    while (pos < len) {
+        line++;
+        size_t end = pos;
+        while (end < len && text[end] != '\n')
+            end++;
+        if (end - pos >= sizeof(buf))
+            return fail(in, line, "line longer than 255 characters", NULL, err, err_len);
+        const size_t line_len = end - pos;
+        memcpy(buf, text + pos, line_len);
+        buf[line_len] = '\0';
+        pos = end + 1;
+        if (strlen(buf) != line_len)
+            return fail(in, line, "NUL byte in the line", NULL, err, err_len);
+        char *hash = strchr(buf, '#');
+        if (hash)
+            *hash = '\0';
+        char *w[5];
+        const int n = split(buf, w);
+        if (n == 0)
+            continue;
+        if (n > 4)
+            return fail(in, line, "too many words", NULL, err, err_len);
+        ui_event_t e;
+        memset(&e, 0, sizeof(e));
+        e.line = line;
+        if (!number(w[0], 0.0, 1e6, &e.at_s))
+            return fail(in, line, "time is not a number of seconds 0..1e6:", w[0], err, err_len);
+        if (e.at_s < last_s)
+            return fail(in, line, "time goes backwards:", w[0], err, err_len);
+        last_s = e.at_s;
+        if (n < 2)
+            return fail(in, line, "an event is missing after the time", NULL, err, err_len);
+        const char *ev = w[1];
+        if (strcmp(ev, "key") == 0) {
+            if (n != 3)
+                return fail(in, line, "key needs one NAME", NULL, err, err_len);
+            e.kind = UI_EV_KEY;
+            e.code = ui_input_key_code(w[2]);
+            if (e.code < 0)
+                return fail(in, line, "unknown key", w[2], err, err_len);
+        } else if (strcmp(ev, "shift") == 0 || strcmp(ev, "left") == 0 ||
+                   strcmp(ev, "right") == 0) {
+            if (n != 3 || (strcmp(w[2], "down") != 0 && strcmp(w[2], "up") != 0))
+                return fail(in, line, "needs down or up:", ev, err, err_len);
+            e.kind = ev[0] == 's' ? UI_EV_SHIFT : ev[0] == 'l' ? UI_EV_LEFT : UI_EV_RIGHT;
+            e.down = strcmp(w[2], "down") == 0;
+        } else if (strcmp(ev, "cursor") == 0) {
+            if (n != 4 || !number(w[2], -1e5, 1e5, &e.x) || !number(w[3], -1e5, 1e5, &e.y))
+                return fail(in, line, "cursor needs X Y in pixels (within 1e5)", NULL, err,
+                            err_len);
+            e.kind = UI_EV_CURSOR;
+        } else if (strcmp(ev, "wheel") == 0) {
+            if (n != 3 || !number(w[2], -100, 100, &e.x))
+                return fail(in, line, "wheel needs STEPS within -100..100", NULL, err, err_len);
+            e.kind = UI_EV_WHEEL;
+        } else {
+            return fail(in, line, "unknown event", ev, err, err_len);
+        }
+        if (in->count == UI_INPUT_MAX_EVENTS)
+            return fail(in, line, "more than 100000 events", NULL, err, err_len);
+        if (in->count == in->cap) {
+            const size_t cap = in->cap ? 2 * in->cap : 64;
+            ui_event_t *p = realloc(in->ev, cap * sizeof(*p));
+            if (p == NULL) {
+                ui_input_free(in);
+                snprintf(err, err_len, "out of memory");
+                return ARGIL_ERR_NOMEM;
+            }
+            in->ev = p;
+            in->cap = cap;
+        }
+        in->ev[in->count++] = e;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t ui_input_load(ui_input_t *in, const char *path, char *err, size_t err_len)
+{
+    ui_input_init(in);
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
+        return ARGIL_ERR_IO;
+    }
+    char *text = NULL;
+    size_t len = 0, cap = 0;
+    for (;;) {
+        if (len == cap) {
+            cap = cap ? 2 * cap : 4096;
+            if (cap > ((size_t)16 << 20)) {
+                free(text);
+                fclose(f);
+                snprintf(err, err_len, "%s: larger than 16 MiB", path);
+                return ARGIL_ERR_PARSE;
+            }
+            char *p = realloc(text, cap);
+            if (p == NULL) {
+                free(text);
+                fclose(f);
+                snprintf(err, err_len, "%s: out of memory", path);
+                return ARGIL_ERR_NOMEM;
+            }
+            text = p;
+        }
+        const size_t got = fread(text + len, 1, cap - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    const int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(text);
+        snprintf(err, err_len, "%s: read error", path);
+        return ARGIL_ERR_IO;
+    }
+    char perr[256];
+    const argil_err_t rc = ui_input_parse(in, text, len, perr, sizeof(perr));
+    free(text);
+    if (rc != ARGIL_OK)
+        snprintf(err, err_len, "%s: %s", path, perr);
+    return rc;
+}

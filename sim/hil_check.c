@@ -1,0 +1,543 @@
+/* Expectations decided from recorded CAN frames and DRIVE_ENABLE edges (see hil_check.h). */
+#include "hil_check.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "shared/argil_limits.h"
+
+#define ERR_FLAG 0x20000000u   /* <linux/can.h> CAN_ERR_FLAG */
+
+void hil_obs_init(hil_obs_t *o)
+{
+    memset(o, 0, sizeof(*o));
+}
+
+void hil_obs_free(hil_obs_t *o)
+{
+    free(o->frame);
+    free(o->gpio);
+    hil_obs_init(o);
+}
+
+hil_err_t hil_obs_push_frame(hil_obs_t *o, int64_t t_us, const can_frame_t *f)
+{
+    if (o->n_frames == o->cap_frames) {
+        const size_t cap = o->cap_frames ? o->cap_frames * 2u : 4096u;
+        hil_frame_t *p = realloc(o->frame, cap * sizeof(*p));
+        if (p == NULL)
+            return HIL_ERR_MEMORY;
+        o->frame = p;
+        o->cap_frames = cap;
+    }
+    o->frame[o->n_frames].t_us = t_us;
+    o->frame[o->n_frames].f = *f;
+    o->n_frames++;
+    return HIL_OK;
+}
+
+hil_err_t hil_obs_push_gpio(hil_obs_t *o, int64_t t_us, bool drive_enable)
+{
+    if (o->n_gpio == o->cap_gpio) {
+        const size_t cap = o->cap_gpio ? o->cap_gpio * 2u : 64u;
+        hil_gpio_t *p = realloc(o->gpio, cap * sizeof(*p));
+        if (p == NULL)
+            return HIL_ERR_MEMORY;
+        o->gpio = p;
+        o->cap_gpio = cap;
+    }
+    o->gpio[o->n_gpio].t_us = t_us;
+    o->gpio[o->n_gpio].drive_enable = drive_enable;
+    o->n_gpio++;
+    return HIL_OK;
+}
+
+const char *hil_err_name(hil_err_t e)
+{
+    switch (e) {
+    case HIL_OK: return "ok";
+    case HIL_ERR_SYNTAX: return "expected '(SECONDS.MICROSECONDS) ...'";
+    case HIL_ERR_FRAME: return "bad frame (expected ID#HEXDATA, 3-digit id or 8-digit error id)";
+    case HIL_ERR_ORDER: return "timestamp earlier than the line before";
+    case HIL_ERR_EVENT: return "unknown event or a step line not in the scenario";
+    case HIL_ERR_MEMORY: return "out of memory";
+    case HIL_ERR_NO_START: return "the event log has no start line";
+    case HIL_ERR_SCENARIO: return "the event log is of another scenario (start scenario NAME)";
+    }
+    return "?";
+}
+
+static int hex(char c)
+{
+    if (c >= '0' && c <= '9')
+        return c - '0';
+    if (c >= 'a' && c <= 'f')
+        return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F')
+        return c - 'A' + 10;
+    return -1;
+}
+
+/* "(SECONDS.UUUUUU)" at p; returns the characters used, 0 when malformed. */
+static size_t timestamp(const char *p, size_t len, int64_t *t_us)
+{
+    size_t i = 0;
+    if (len < 10 || p[0] != '(')
+        return 0;
+    i = 1;
+    int64_t s = 0;
+    size_t digits = 0;
+    while (i < len && p[i] >= '0' && p[i] <= '9' && digits < 12) {
+        s = s * 10 + (p[i++] - '0');
+        digits++;
+    }
+    if (digits == 0 || i + 8 > len || p[i] != '.')
+        return 0;
+    i++;
+    int64_t us = 0;
+    for (int k = 0; k < 6; k++) {
+        if (p[i] < '0' || p[i] > '9')
+            return 0;
+        us = us * 10 + (p[i++] - '0');
+    }
+    if (p[i] != ')')
+        return 0;
+    *t_us = s * 1000000 + us;
+    return i + 1;
+}
+
+hil_err_t hil_candump_line(const char *line, size_t len, int64_t *t_us, can_frame_t *f)
+{
+    size_t i = timestamp(line, len, t_us);
+    if (i == 0 || i >= len || line[i] != ' ')
+        return HIL_ERR_SYNTAX;
+    while (i < len && line[i] == ' ')
+        i++;
+    const size_t iface = i;
+    while (i < len && line[i] != ' ')
+        i++;
+    if (i == iface || i - iface > 15 || i >= len)
+        return HIL_ERR_SYNTAX;
+    while (i < len && line[i] == ' ')
+        i++;
+    const size_t id0 = i;
+    uint32_t id = 0;
+    while (i < len && line[i] != '#') {
+        const int h = hex(line[i]);
+        if (h < 0 || i - id0 >= 8)
+            return HIL_ERR_FRAME;
+        id = id << 4 | (uint32_t)h;
+        i++;
+    }
+    const size_t id_digits = i - id0;
+    if (i >= len || (id_digits != 3 && id_digits != 8))
+        return HIL_ERR_FRAME;
+    if (id_digits == 3 ? id > 0x7FFu : (id & ERR_FLAG) == 0 || (id & 0xC0000000u) != 0)
+        return HIL_ERR_FRAME; /* an 8-digit id is accepted only as an error frame */
+    i++; /* '#' */
+    memset(f, 0, sizeof(*f));
+    f->id = id;
+    size_t end = len;
+    while (end > i && (line[end - 1] == ' ' || line[end - 1] == '\r' || line[end - 1] == '\n'))
+        end--;
+    const size_t n = end - i;
+    if (n % 2u != 0 || n > 16u)
+        return HIL_ERR_FRAME; /* also refuses "R" (remote) and "#" (CAN FD) */
+    for (size_t k = 0; k < n / 2u; k++) {
+        const int a = hex(line[i + 2 * k]), b = hex(line[i + 2 * k + 1]);
+        if (a < 0 || b < 0)
+            return HIL_ERR_FRAME;
+        f->data[k] = (uint8_t)(a << 4 | b);
+    }
+    f->len = (uint8_t)(n / 2u);
+    return HIL_OK;
+}
+
+/* Calls fn for each non-blank line; stops at the first error. */
+typedef hil_err_t (*line_fn)(void *ctx, const char *p, size_t n);
+
+static hil_err_t each_line(const char *text, size_t len, uint32_t *err_line, line_fn fn,
+                           void *ctx)
+{
+    uint32_t line = 0;
+    size_t pos = 0;
+    *err_line = 0;
+    while (pos < len) {
+        line++;
+        size_t end = pos;
+        while (end < len && text[end] != '\n')
+            end++;
+        const char *p = text + pos;
+        size_t n = end - pos;
+        pos = end + 1;
+        while (n > 0 && (p[n - 1] == '\r' || p[n - 1] == ' '))
+            n--;
+        if (n == 0)
+            continue;
+        const hil_err_t e = fn(ctx, p, n);
+        if (e != HIL_OK) {
+            *err_line = line;
+            return e;
+        }
+    }
+    return HIL_OK;
+}
+
+static hil_err_t candump_fn(void *ctx, const char *p, size_t n)
+{
+    hil_obs_t *o = ctx;
+    int64_t t;
+    can_frame_t f;
+    const hil_err_t e = hil_candump_line(p, n, &t, &f);
+    if (e != HIL_OK)
+        return e;
+    if (o->n_frames > 0 && t < o->frame[o->n_frames - 1].t_us)
+        return HIL_ERR_ORDER;
+    return hil_obs_push_frame(o, t, &f);
+}
+
+hil_err_t hil_obs_add_candump(hil_obs_t *o, const char *text, size_t len, uint32_t *err_line)
+{
+    return each_line(text, len, err_line, candump_fn, o);
+}
+
+typedef struct {
+    hil_obs_t *o;
+    const scenario_t *s;
+    int64_t last_us;
+} events_ctx_t;
+
+static bool word_is(const char *p, size_t n, const char *w)
+{
+    const size_t k = strlen(w);
+    return n >= k && memcmp(p, w, k) == 0 && (n == k || p[k] == ' ');
+}
+
+static hil_err_t events_fn(void *vctx, const char *p, size_t n)
+{
+    events_ctx_t *c = vctx;
+    int64_t t;
+    size_t i = timestamp(p, n, &t);
+    if (i == 0 || i >= n || p[i] != ' ')
+        return HIL_ERR_SYNTAX;
+    if (t < c->last_us)
+        return HIL_ERR_ORDER;
+    c->last_us = t;
+    while (i < n && p[i] == ' ')
+        i++;
+    const char *w = p + i;
+    const size_t wn = n - i;
+    if (word_is(w, wn, "start")) {
+        /* "start scenario NAME …": a log of another scenario is refused */
+        static const char key[] = "start scenario ";
+        const size_t k = sizeof(key) - 1u, nl = strlen(c->s->name);
+        if (wn > k && memcmp(w, key, k) == 0 &&
+            (wn - k < nl || memcmp(w + k, c->s->name, nl) != 0 ||
+             (wn - k > nl && w[k + nl] != ' ')))
+            return HIL_ERR_SCENARIO;
+        c->o->have_start = true;
+        c->o->start_us = t;
+        return HIL_OK;
+    }
+    if (word_is(w, wn, "note") || word_is(w, wn, "end") || word_is(w, wn, "host"))
+        return HIL_OK;
+    if (word_is(w, wn, "gpio_out")) {
+        static const char key[] = "gpio_out DRIVE_ENABLE=";
+        const size_t k = sizeof(key) - 1u;
+        if (wn < k + 1u || memcmp(w, key, k) != 0 || (w[k] != '0' && w[k] != '1') ||
+            (wn > k + 1u && w[k + 1u] != ' '))
+            return HIL_ERR_EVENT;
+        return hil_obs_push_gpio(c->o, t, w[k] == '1');
+    }
+    if (word_is(w, wn, "inject")) {
+        static const char key[] = "inject line=";
+        const size_t k = sizeof(key) - 1u;
+        if (wn <= k || memcmp(w, key, k) != 0)
+            return HIL_ERR_EVENT;
+        uint32_t line = 0;
+        size_t j = k;
+        while (j < wn && w[j] >= '0' && w[j] <= '9' && line < 1000000u)
+            line = line * 10u + (uint32_t)(w[j++] - '0');
+        if (j == k)
+            return HIL_ERR_EVENT;
+        for (uint32_t s = 0; s < c->s->n_steps; s++) {
+            if (c->s->step[s].line == line) {
+                if (!c->o->step_seen[s]) {
+                    c->o->step_seen[s] = true;
+                    c->o->step_us[s] = t;
+                }
+                return HIL_OK;
+            }
+        }
+        return HIL_ERR_EVENT;
+    }
+    return HIL_ERR_EVENT;
+}
+
+hil_err_t hil_obs_add_events(hil_obs_t *o, const scenario_t *s, const char *text, size_t len,
+                             uint32_t *err_line)
+{
+    events_ctx_t c = {o, s, INT64_MIN};
+    const hil_err_t e = each_line(text, len, err_line, events_fn, &c);
+    if (e != HIL_OK)
+        return e;
+    if (!o->have_start)
+        return HIL_ERR_NO_START;
+    return HIL_OK;
+}
+
+/* Absolute time of scenario time t_us: the logged injection of a step at exactly that time,
+ * else start + t. */
+static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
+{
+    for (uint32_t i = 0; i < s->n_steps; i++)
+        if (s->step[i].t_us == t_us && o->step_seen[i])
+            return o->step_us[i];
+    return o->start_us + t_us;
+}
+
+/* DRIVE_ENABLE level just before t (taken as high when nothing was logged before). */
+static bool enable_before(const hil_obs_t *o, int64_t t)
+{
+    bool level = true;
+    for (size_t k = 0; k < o->n_gpio && o->gpio[k].t_us <= t; k++)
+        level = o->gpio[k].drive_enable;
+    return level;
+}
+
+static bool rpdo(const hil_frame_t *h, uint8_t *node, uint16_t *cw, int16_t *tq)
+{
+    return (h->f.id & ERR_FLAG) == 0 && canopen_rpdo_decode(&h->f, node, cw, tq);
+}
+
+static bool cw_off(uint16_t cw)
+{
+    return cw == CIA402_CW_QUICK_STOP || cw == CIA402_CW_DISABLE_VOLTAGE;
+}
+
+#define MS(us) ((double)(us) / 1000.0)
+
+void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_result_t *r)
+{
+    const scn_expect_t *e = &s->expect[i];
+    const int64_t t0 = abs_time(s, o, e->t_us);
+    const int64_t t_end = e->until == SCN_UNTIL_TIME ? o->start_us + e->until_us
+                                                     : abs_time(s, o, scenario_until_us(s, e));
+    const int64_t t_bound = t0 + e->within_us;
+    const bool gpio = o->n_gpio > 0;
+    r->pass = false;
+    r->observed_us = -1;
+    size_t rpdos = 0;
+    uint8_t node;
+    uint16_t cw;
+    int16_t tq;
+    switch (e->kind) {
+    case SCN_EXP_TORQUE_ZERO:
+    case SCN_EXP_FORCE_ZERO:
+    case SCN_EXP_FAULT: {
+        /* The last "bad" RPDO in [t0, t_end): torque non-zero (or, for fault, drives not
+         * commanded off); the condition holds from the next RPDO on. */
+        const bool fault = e->kind == SCN_EXP_FAULT;
+        int64_t t_can = -1;          /* first RPDO of the final run of good ones */
+        bool any_bad = false;
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us < t0 || h->t_us >= t_end || !rpdo(h, &node, &cw, &tq))
+                continue;
+            rpdos++;
+            if (tq != 0 || (fault && !cw_off(cw))) {
+                any_bad = true;
+                t_can = -1;
+            } else if (t_can < 0) {
+                t_can = h->t_us;
+            }
+        }
+        if (rpdos > 0 && t_can < 0) {
+            snprintf(r->msg, sizeof(r->msg), "still %s at the end of the window (%zu RPDOs seen)",
+                     fault ? "drives commanded on or torque non-zero" : "torque non-zero", rpdos);
+            return;
+        }
+        /* No offending frame after the injection at all (the board's first frame already
+         * complied, or it fell silent, as in bus-off): observed at once. */
+        const int64_t t_first_ok = t_can;
+        if (!any_bad)
+            t_can = t0;
+        int64_t t_obs = t_can;
+        if (fault && gpio) {
+            bool level = enable_before(o, t0);
+            int64_t t_low = level ? -1 : t0;
+            for (size_t k = 0; k < o->n_gpio; k++) {
+                const hil_gpio_t *g = &o->gpio[k];
+                if (g->t_us < t0 || g->t_us >= t_end)
+                    continue;
+                if (!g->drive_enable && level)
+                    t_low = g->t_us;
+                if (g->drive_enable) {
+                    snprintf(r->msg, sizeof(r->msg), "DRIVE_ENABLE back high at +%.3f ms",
+                             MS(g->t_us - t0));
+                    return;
+                }
+                level = g->drive_enable;
+            }
+            if (t_low < 0) {
+                snprintf(r->msg, sizeof(r->msg), "DRIVE_ENABLE never went low");
+                return;
+            }
+            if (t_low > t_obs)
+                t_obs = t_low;
+        }
+        r->observed_us = t_obs - t0;
+        if (e->until != SCN_UNTIL_NONE) {
+            r->pass = !any_bad && (!fault || !gpio || t_obs == t0);
+            snprintf(r->msg, sizeof(r->msg), "%s from +%.3f ms (%zu RPDOs checked)",
+                     r->pass ? "held" : "reached only", MS(t_obs - t0), rpdos);
+            return;
+        }
+        r->pass = t_obs <= t_bound;
+        if (any_bad)
+            snprintf(r->msg, sizeof(r->msg), "observed after %.3f ms (bound %.3f ms, %zu RPDOs%s)",
+                     MS(t_obs - t0), MS(e->within_us), rpdos, fault && gpio ? ", DRIVE_ENABLE" : "");
+        else
+            snprintf(r->msg, sizeof(r->msg),
+                     "observed after %.3f ms: no offending RPDO after the injection, first "
+                     "RPDO at +%.3f ms (bound %.3f ms%s)",
+                     MS(t_obs - t0), t_first_ok < 0 ? -1.0 : MS(t_first_ok - t0),
+                     MS(e->within_us), fault && gpio ? ", DRIVE_ENABLE" : "");
+        return;
+    }
+    case SCN_EXP_QUICK_STOP: {
+        int64_t t_node[ARGIL_DRIVES] = {-1, -1, -1};
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us < t0 || h->t_us > t_bound || !rpdo(h, &node, &cw, &tq))
+                continue;
+            if (node >= 1 && node <= ARGIL_DRIVES && cw == CIA402_CW_QUICK_STOP &&
+                t_node[node - 1] < 0)
+                t_node[node - 1] = h->t_us;
+        }
+        int64_t worst = t0;
+        for (int j = 0; j < ARGIL_DRIVES; j++) {
+            if (t_node[j] < 0) {
+                snprintf(r->msg, sizeof(r->msg), "drive %d got no QUICK_STOP within %.3f ms",
+                         j + 1, MS(e->within_us));
+                return;
+            }
+            if (t_node[j] > worst)
+                worst = t_node[j];
+        }
+        r->pass = true;
+        r->observed_us = worst - t0;
+        snprintf(r->msg, sizeof(r->msg), "every drive got QUICK_STOP after %.3f ms (bound %.3f ms)",
+                 MS(worst - t0), MS(e->within_us));
+        return;
+    }
+    case SCN_EXP_ENABLED: {
+        bool on[ARGIL_DRIVES] = {false, false, false};
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us < t0 || h->t_us > t_bound || !rpdo(h, &node, &cw, &tq))
+                continue;
+            if (node >= 1 && node <= ARGIL_DRIVES)
+                on[node - 1] = cw == CIA402_CW_ENABLE_OP;
+            if (on[0] && on[1] && on[2] && (!gpio || enable_before(o, h->t_us))) {
+                r->pass = true;
+                r->observed_us = h->t_us - t0;
+                snprintf(r->msg, sizeof(r->msg), "every drive enabled after %.3f ms (bound %.3f ms)",
+                         MS(h->t_us - t0), MS(e->within_us));
+                return;
+            }
+        }
+        snprintf(r->msg, sizeof(r->msg), "drives not all enabled within %.3f ms",
+                 MS(e->within_us));
+        return;
+    }
+    case SCN_EXP_TORQUE_NONZERO:
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us < t0 || h->t_us > t_bound || !rpdo(h, &node, &cw, &tq))
+                continue;
+            if (tq != 0) {
+                r->pass = true;
+                r->observed_us = h->t_us - t0;
+                snprintf(r->msg, sizeof(r->msg), "torque %d ‰ on drive %u after %.3f ms", tq,
+                         node, MS(h->t_us - t0));
+                return;
+            }
+        }
+        snprintf(r->msg, sizeof(r->msg), "no non-zero torque within %.3f ms", MS(e->within_us));
+        return;
+    case SCN_EXP_NO_TORQUE_FRAMES:
+    case SCN_EXP_RUNNING: {
+        const bool running = e->kind == SCN_EXP_RUNNING;
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us < t0 || h->t_us >= t_end || !rpdo(h, &node, &cw, &tq))
+                continue;
+            rpdos++;
+            if (running ? cw != CIA402_CW_ENABLE_OP : tq != 0) {
+                r->observed_us = h->t_us - t0;
+                snprintf(r->msg, sizeof(r->msg), "drive %u: controlword 0x%04X torque %d at +%.3f ms",
+                         node, cw, tq, MS(h->t_us - t0));
+                return;
+            }
+        }
+        if (running && gpio) {
+            bool level = enable_before(o, t0);
+            for (size_t k = 0; k < o->n_gpio; k++)
+                if (o->gpio[k].t_us >= t0 && o->gpio[k].t_us < t_end && !o->gpio[k].drive_enable)
+                    level = false;
+            if (!level) {
+                snprintf(r->msg, sizeof(r->msg), "DRIVE_ENABLE low within the window");
+                return;
+            }
+        }
+        if (running && rpdos == 0) {
+            snprintf(r->msg, sizeof(r->msg), "no RPDO in the window: nothing ran");
+            return;
+        }
+        r->pass = true;
+        snprintf(r->msg, sizeof(r->msg), "held for %.3f ms (%zu RPDOs)", MS(t_end - t0), rpdos);
+        return;
+    }
+    case SCN_EXP_SAFE: {
+        /* Walk RPDOs and DRIVE_ENABLE edges in time order; a rearm ends the latch. */
+        scn_expect_t to_rearm = *e;
+        to_rearm.until = SCN_UNTIL_REARM;
+        const int64_t t_rearm = abs_time(s, o, scenario_until_us(s, &to_rearm));
+        const int64_t t_stop = t_rearm < t_end ? t_rearm : t_end;
+        int64_t t_off = -1;
+        size_t g = 0;
+        for (size_t k = 0; k < o->n_frames; k++) {
+            const hil_frame_t *h = &o->frame[k];
+            if (h->t_us >= t_stop)
+                break;
+            for (; g < o->n_gpio && o->gpio[g].t_us <= h->t_us; g++)
+                if (o->gpio[g].t_us >= t0 && !o->gpio[g].drive_enable && t_off < 0)
+                    t_off = o->gpio[g].t_us;
+            if (h->t_us < t0 || !rpdo(h, &node, &cw, &tq))
+                continue;
+            rpdos++;
+            if (t_off >= 0 && tq != 0) {
+                r->observed_us = h->t_us - t0;
+                snprintf(r->msg, sizeof(r->msg),
+                         "torque %d on drive %u at +%.3f ms after the drives went off at +%.3f ms",
+                         tq, node, MS(h->t_us - t0), MS(t_off - t0));
+                return;
+            }
+            if (cw_off(cw) && t_off < 0)
+                t_off = h->t_us;
+        }
+        r->pass = true;
+        if (t_off >= 0)
+            snprintf(r->msg, sizeof(r->msg), "drives off at +%.3f ms, no torque after (%zu RPDOs)",
+                     MS(t_off - t0), rpdos);
+        else
+            snprintf(r->msg, sizeof(r->msg), "ran without a fault (%zu RPDOs)", rpdos);
+        return;
+    }
+    default:
+        snprintf(r->msg, sizeof(r->msg), "unknown expectation");
+        return;
+    }
+}

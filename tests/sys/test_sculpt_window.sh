@@ -1,0 +1,172 @@
+#!/bin/sh
+# The live sculpting window under Xvfb: `argil sculpt` with a display shows the session being
+# sculpted (screenshots: the clay lit, the tool, the dent appearing) and writes the very same
+# files as a headless run; `argil sculpt --mouse` with scripted input sculpts with the mouse
+# (push, Shift inverts to pull), and the keyboard panel changes the tool's parameters. The GL
+# runs use the release build (Mesa's JIT leaves allocations LeakSanitizer cannot attribute).
+set -eu
+rel="$REL/argil"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+command -v xvfb-run >/dev/null 2>&1 || fail "xvfb-run is missing (toolchain/install-deps.sh render)"
+xvfb() { xvfb-run -a -s "-screen 0 1024x768x24" "$@"; }
+py=/usr/bin/python3
+
+# Pixel classes of a window screenshot below the HUD band (HUD_ROWS rows):
+#   "stats PNG": W H CLAY_SHARE TOOL_PX CLAY_LUMA_P5 CLAY_LUMA_P95
+#   "diff A B [X0 Y0 X1 Y1]": pixels that are clay in both and differ by > 25 levels of luma
+cat >"$tmp/png.py" <<'PY'
+import struct, sys, zlib
+HUD_ROWS = 40
+def load(path):
+    data = open(path, 'rb').read()
+    assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+    pos, idat = 8, b''
+    while pos < len(data):
+        n, kind = struct.unpack('>I4s', data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        if kind == b'IHDR':
+            w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
+            assert depth == 8 and ctype == 2, 'not 8-bit RGB'
+        elif kind == b'IDAT':
+            idat += body
+        pos += 12 + n
+    raw = zlib.decompress(idat)
+    stride, prev, px = w * 3, bytearray(w * 3), []
+    for y in range(h):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - 3] if i >= 3 else 0
+            b = prev[i]
+            c = prev[i - 3] if i >= 3 else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + b) & 255
+            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        px.append([tuple(line[i:i + 3]) for i in range(0, stride, 3)])
+        prev = line
+    return w, h, px
+def clay(p): return p[0] > p[2] + 25 and p[0] >= p[1]
+def tool(p): return p[2] > p[0] + 20 and p[1] > p[0] + 10 and not (p[1] > p[0] + 60 and p[1] > p[2] + 60)
+def luma(p): return (299 * p[0] + 587 * p[1] + 114 * p[2]) // 1000
+if sys.argv[1] == 'stats':
+    w, h, px = load(sys.argv[2])
+    body = [p for row in px[HUD_ROWS:] for p in row]
+    c = sorted(luma(p) for p in body if clay(p))
+    t = sum(1 for p in body if tool(p))
+    p5 = c[len(c) // 20] if c else 0
+    p95 = c[len(c) * 19 // 20] if c else 0
+    print(w, h, round(len(c) / len(body), 3), t, p5, p95)
+else:
+    wa, ha, a = load(sys.argv[2])
+    wb, hb, b = load(sys.argv[3])
+    assert (wa, ha) == (wb, hb)
+    x0, y0, x1, y1 = (int(v) for v in sys.argv[4:8]) if len(sys.argv) > 4 else (0, HUD_ROWS, wa, ha)
+    n = 0
+    for y in range(max(y0, HUD_ROWS), y1):
+        for x in range(x0, x1):
+            p, q = a[y][x], b[y][x]
+            if clay(p) and clay(q) and abs(luma(p) - luma(q)) > 25:
+                n += 1
+    print(n)
+PY
+stats() { "$py" "$tmp/png.py" stats "$1"; }
+diffpx() { "$py" "$tmp/png.py" diff "$@"; }
+
+# 1. The default session in the window (as fast as it can), a screenshot every simulated second.
+xvfb "$rel" sculpt --script scripts/default.scn --out "$tmp/live" --fast --width 480 \
+    --height 360 --screenshot-every 1000 --screenshot "$tmp/last.png" --linger 0 \
+    >"$tmp/live.txt" 2>&1 || { cat "$tmp/live.txt"; fail "live sculpt failed"; }
+cat "$tmp/live.txt"
+grep -q "live window .* frames" "$tmp/live.txt" || fail "no window ran (no 'live window' line)"
+"$rel" sculpt --script scripts/default.scn --out "$tmp/head" --headless --quiet ||
+    fail "headless sculpt failed"
+env -u DISPLAY "$rel" sculpt --script scripts/default.scn --out "$tmp/nodisp" --quiet ||
+    fail "sculpt without DISPLAY failed"
+for f in final.ply telemetry.csv session.scn; do
+    cmp -s "$tmp/live/$f" "$tmp/head/$f" || fail "$f differs between the window and --headless"
+    cmp -s "$tmp/nodisp/$f" "$tmp/head/$f" || fail "$f differs without DISPLAY"
+done
+echo "window, --headless and no-DISPLAY runs wrote identical final.ply, telemetry.csv, session.scn"
+
+n=$(ls "$tmp/live/frames" | wc -l)
+echo "frames: $n"
+[ "$n" -ge 5 ] || fail "only $n screenshots in $tmp/live/frames"
+first=$(ls "$tmp/live/frames" | head -n 1)
+early=$(ls "$tmp/live/frames" | awk -F'[_.]' '$2 >= 800 { print; exit }')
+[ -n "$early" ] || fail "no frame after 0.8 s"
+best_tool=0
+for f in "$tmp/live/frames"/*.png "$tmp/last.png"; do
+    set -- $(stats "$f")
+    echo "$(basename "$f"): $1 x $2, clay share $3, tool pixels $4, clay luma p5 $5 p95 $6"
+    [ "$1" = 480 ] && [ "$2" = 360 ] || fail "$f is $1 x $2, not 480 x 360"
+    awk -v s="$3" 'BEGIN { exit !(s > 0.10 && s < 0.60) }' || fail "$f: clay share $3"
+    [ $(($6 - $5)) -ge 40 ] || fail "$f: the clay is flat (luma $5..$6): not lit"
+    [ "$4" -gt "$best_tool" ] && best_tool=$4
+done
+echo "most tool pixels in one frame: $best_tool"
+[ "$best_tool" -ge 60 ] || fail "the tool is not visible in any frame ($best_tool pixels)"
+changed=$(diffpx "$tmp/live/frames/$early" "$tmp/last.png")
+echo "clay pixels changed between $early and the end: $changed"
+[ "$changed" -ge 150 ] || fail "the sculpture did not change on screen ($changed pixels)"
+
+# 2. Mouse sculpting with scripted input on a 640 x 480 window (real time): push a dent at the
+#    centre, pull at another spot with Shift held, then the panel: beta, radius ×1.25³,
+#    stiffness ×1.25, and Esc.
+cat >"$tmp/input.txt" <<'EOF'
+2.0 cursor 320 240
+2.5 left down
+4.5 left up
+4.6 cursor 380 200
+5.0 shift down
+5.2 left down
+6.5 left up
+6.6 shift up
+6.65 key B
+6.7 key PLUS
+6.75 key PLUS
+6.8 key PLUS
+6.85 key TAB
+6.9 key PLUS
+7.5 key ESC
+EOF
+xvfb "$rel" sculpt --mouse --input "$tmp/input.txt" --out "$tmp/mouse" --width 640 \
+    --height 480 --screenshot-every 500 --linger 0 >"$tmp/mouse.txt" 2>&1 ||
+    [ $? = 130 ] || { cat "$tmp/mouse.txt"; fail "mouse sculpt failed"; }
+cat "$tmp/mouse.txt"
+grep -q "radius 7.81 mm, stiffness 1.000 N/mm, beta spherical" "$tmp/mouse.txt" ||
+    fail "the keyboard panel did not set radius 7.81 mm, stiffness 1.000, beta spherical"
+set -- $(awk -F, 'NR > 1 && $11 == 1 { n[$10]++ } END { print n[1] + 0, n[2] + 0 }' \
+    "$tmp/mouse/telemetry.csv")
+echo "button held: $1 ticks with push, $2 ticks with pull (Shift)"
+[ "$1" -ge 1000 ] || fail "the push stroke held the button only $1 ticks"
+[ "$2" -ge 500 ] || fail "Shift did not turn the stroke into pull ($2 ticks)"
+set -- $(awk -F, 'NR > 1 && $13 == 1 { n[$10]++ } END { print n[1] + 0, n[2] + 0 }' \
+    "$tmp/mouse/telemetry.csv")
+echo "sculpting: $1 ticks pushing, $2 ticks pulling"
+[ "$1" -ge 300 ] && [ "$2" -ge 100 ] || fail "the mouse strokes did not sculpt ($1 / $2 ticks)"
+before=$(ls "$tmp/mouse/frames" | awk -F'[_.]' '$2 >= 1900 { print; exit }')
+after=$(ls "$tmp/mouse/frames" | awk -F'[_.]' '$2 >= 4500 { print; exit }')
+[ -n "$before" ] && [ -n "$after" ] || fail "missing frames around the push stroke"
+dent=$(diffpx "$tmp/mouse/frames/$before" "$tmp/mouse/frames/$after" 260 180 380 300)
+echo "clay pixels changed under the cursor between $before and $after: $dent"
+[ "$dent" -ge 100 ] || fail "no dent on screen where the mouse pushed ($dent pixels)"
+# 3. Errors: one line each, nothing run.
+printf '0.5 key 1\n0.2 key F\n' >"$tmp/bad.txt"
+if xvfb "$rel" sculpt --input "$tmp/bad.txt" --out "$tmp/bad" 2>"$tmp/err"; then
+    fail "a bad input file was accepted"
+fi
+cat "$tmp/err"
+grep -q "bad.txt: line 2: time goes backwards: '0.2'" "$tmp/err" || fail "input error text"
+[ "$(wc -l <"$tmp/err")" = 1 ] || fail "the input error is not one line"
+[ ! -e "$tmp/bad/final.ply" ] || fail "a session ran despite a bad input file"
+set +e
+env -u DISPLAY "$rel" sculpt --mouse --out "$tmp/bad" 2>"$tmp/err"
+st=$?
+set -e
+[ "$st" = 2 ] && grep -q "needs the window" "$tmp/err" || fail "--mouse without a display: $st"
+echo "sculpt window: all checks passed"

@@ -1,0 +1,228 @@
+/* The HIL log checker (sim/hil_check.c): candump and event-log readers refuse bad lines with a
+ * reason and a line; each expectation kind passes on a log that shows it and fails, with a
+ * latency, on one that does not. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <string.h>
+
+#include "sim/hil_check.h"
+
+static void test_candump_lines(void **st)
+{
+    (void)st;
+    int64_t t;
+    can_frame_t f;
+    const char ok[] = "(1700000000.123456) vcan0 201#0F00E803";
+    assert_int_equal(hil_candump_line(ok, strlen(ok), &t, &f), HIL_OK);
+    assert_int_equal(t, 1700000000123456LL);
+    assert_int_equal(f.id, 0x201);
+    assert_int_equal(f.len, 4);
+    assert_int_equal(f.data[2], 0xE8);
+    const char sync[] = "(1.000001)  can0  080#\r";
+    assert_int_equal(hil_candump_line(sync, strlen(sync), &t, &f), HIL_OK);
+    assert_int_equal(f.len, 0);
+    assert_int_equal(t, 1000001);
+    const char errf[] = "(2.000000) vcan0 20000040#0000000000000000";
+    assert_int_equal(hil_candump_line(errf, strlen(errf), &t, &f), HIL_OK);
+    assert_int_equal(f.id, 0x20000040u);
+    static const struct {
+        const char *line;
+        hil_err_t e;
+    } bad[] = {
+        {"1.000000 vcan0 201#00", HIL_ERR_SYNTAX},          /* no parentheses */
+        {"(1.00000) vcan0 201#00", HIL_ERR_SYNTAX},         /* 5 decimals */
+        {"(.000000) vcan0 201#00", HIL_ERR_SYNTAX},         /* no seconds */
+        {"(1.000000 vcan0 201#00", HIL_ERR_SYNTAX},         /* no ')' */
+        {"(1.000000)vcan0 201#00", HIL_ERR_SYNTAX},         /* no blank */
+        {"(1.000000) vcan0", HIL_ERR_SYNTAX},               /* no frame */
+        {"(1.000000) averyveryverylongname 201#00", HIL_ERR_SYNTAX},
+        {"(1.000000) vcan0 2G1#00", HIL_ERR_FRAME},         /* not hex */
+        {"(1.000000) vcan0 201", HIL_ERR_FRAME},            /* no '#' */
+        {"(1.000000) vcan0 2010#00", HIL_ERR_FRAME},        /* 4 digits */
+        {"(1.000000) vcan0 801#00", HIL_ERR_FRAME},         /* > 0x7FF */
+        {"(1.000000) vcan0 12345678#00", HIL_ERR_FRAME},    /* extended, not an error frame */
+        {"(1.000000) vcan0 201#R", HIL_ERR_FRAME},          /* remote */
+        {"(1.000000) vcan0 201##100", HIL_ERR_FRAME},       /* CAN FD */
+        {"(1.000000) vcan0 201#0", HIL_ERR_FRAME},          /* odd digits */
+        {"(1.000000) vcan0 201#000000000000000000", HIL_ERR_FRAME}, /* 9 bytes */
+        {"(1.000000) vcan0 201#0Z", HIL_ERR_FRAME},
+        {"(1.000000) vcan0 123456789#00", HIL_ERR_FRAME},   /* 9 digits */
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        const hil_err_t e = hil_candump_line(bad[i].line, strlen(bad[i].line), &t, &f);
+        if (e != bad[i].e)
+            fail_msg("'%s': got %d want %d", bad[i].line, e, bad[i].e);
+    }
+    hil_obs_t o;
+    hil_obs_init(&o);
+    uint32_t line = 0;
+    const char order[] = "(2.000000) vcan0 080#\n\n(1.000000) vcan0 080#\n";
+    assert_int_equal(hil_obs_add_candump(&o, order, strlen(order), &line), HIL_ERR_ORDER);
+    assert_int_equal(line, 3);
+    assert_string_equal(hil_err_name(HIL_ERR_ORDER), "timestamp earlier than the line before");
+    hil_obs_free(&o);
+}
+
+static scenario_t scn;
+
+static void load_scn(void)
+{
+    static const char text[] = "name t\nduration 3s\n"
+                               "at 1.0 estop press\n"                 /* line 3 */
+                               "at 2.0 rearm\n"                       /* line 4 */
+                               "expect at 1.0 torque_zero within 1ms\n"
+                               "expect at 1.0 quick_stop within 1ms\n"
+                               "expect at 1.0 fault within 2ms\n"
+                               "expect at 1.0 no_torque_frames until rearm\n"
+                               "expect at 0.5 running until 0.9\n"
+                               "expect at 1.0 safe until end\n"
+                               "expect at 2.0 enabled within 300ms\n"
+                               "expect at 0.0 torque_nonzero within 1s\n";
+    scn_error_t err;
+    assert_int_equal(scenario_parse(&scn, text, sizeof(text) - 1, &err), SCN_OK);
+}
+
+static void test_event_logs(void **st)
+{
+    (void)st;
+    load_scn();
+    static const struct {
+        const char *text;
+        hil_err_t e;
+        uint32_t line;
+    } cases[] = {
+        {"(5.000000) start scenario t\n(5.5) end\n", HIL_ERR_SYNTAX, 2},
+        {"(5.000000) start scenario t\n(4.000000) end\n", HIL_ERR_ORDER, 2},
+        {"(5.000000) start scenario t\n(6.000000) dance\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) inject line=9 x\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) inject line=x\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=2\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=1x\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario other\n", HIL_ERR_SCENARIO, 1},
+        {"(5.000000) start scenario tt\n", HIL_ERR_SCENARIO, 1},
+        {"(5.000000) note hello\n", HIL_ERR_NO_START, 0},
+        {"(5.000000)start\n", HIL_ERR_SYNTAX, 1},
+    };
+    for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        hil_obs_t o;
+        hil_obs_init(&o);
+        uint32_t line = 0;
+        const hil_err_t e = hil_obs_add_events(&o, &scn, cases[i].text, strlen(cases[i].text),
+                                               &line);
+        if (e != cases[i].e || line != cases[i].line)
+            fail_msg("case %zu: got %d line %u, want %d line %u", i, e, line, cases[i].e,
+                     cases[i].line);
+        assert_true(strlen(hil_err_name(e)) > 1);
+        hil_obs_free(&o);
+    }
+}
+
+/* A synthetic run at 1 kHz: RPDOs for 3 drives each ms at +0.5 ms; torque 100 ‰ and ENABLE_OP
+ * until the e-stop at 1.0 s is seen `react_us` later, then QUICK_STOP with torque 0; DRIVE_ENABLE
+ * falls at +1 ms; re-enabled at 2.050 s. */
+static void synth(hil_obs_t *o, int64_t react_us, bool torque_after_off)
+{
+    hil_obs_init(o);
+    const int64_t t0 = 10000000;
+    const char ev[] = "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+                      "(11.001000) gpio_out DRIVE_ENABLE=0 t=1.001\n"
+                      "(12.000000) inject line=4 rearm\n(12.050000) gpio_out DRIVE_ENABLE=1\n";
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(o, &scn, ev, strlen(ev), &line), HIL_OK);
+    for (int64_t ms = 0; ms < 3000; ms++) {
+        const int64_t t = t0 + ms * 1000 + 500;
+        const bool off = t >= t0 + 1000000 + react_us && t < t0 + 2050000;
+        for (uint8_t n = 1; n <= 3; n++) {
+            can_frame_t f;
+            int16_t tq = off ? 0 : 100;
+            if (torque_after_off && ms == 1500)
+                tq = 5;
+            canopen_rpdo_encode(&f, n, off ? CIA402_CW_QUICK_STOP : CIA402_CW_ENABLE_OP, tq);
+            assert_int_equal(hil_obs_push_frame(o, t, &f), HIL_OK);
+        }
+    }
+}
+
+static void test_expectations_pass_and_fail(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    hil_result_t r;
+    synth(&o, 0, false); /* reacts in the same tick */
+    for (uint32_t i = 0; i < scn.n_expects; i++) {
+        hil_check_expect(&scn, &o, i, &r);
+        if (!r.pass)
+            fail_msg("expectation %u failed: %s", i, r.msg);
+    }
+    hil_check_expect(&scn, &o, 0, &r);
+    assert_int_equal(r.observed_us, 0);      /* the board's first RPDO after it is zero */
+    assert_non_null(strstr(r.msg, "first RPDO at +0.500 ms"));
+    hil_check_expect(&scn, &o, 2, &r);
+    assert_int_equal(r.observed_us, 1000);   /* DRIVE_ENABLE fell at +1 ms */
+    hil_check_expect(&scn, &o, 6, &r);
+    assert_int_equal(r.observed_us, 50500);  /* enabled again 50.5 ms after the rearm */
+    hil_obs_free(&o);
+
+    synth(&o, 5000, false); /* reacts 5 ms late: the 1 ms bounds fail, with the latency */
+    hil_check_expect(&scn, &o, 0, &r);
+    assert_false(r.pass);
+    assert_int_equal(r.observed_us, 5500);
+    hil_check_expect(&scn, &o, 1, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "no QUICK_STOP"));
+    hil_check_expect(&scn, &o, 2, &r);
+    assert_false(r.pass);
+    hil_check_expect(&scn, &o, 3, &r);       /* torque frames after the e-stop */
+    assert_false(r.pass);
+    assert_int_equal(r.observed_us, 500);
+    hil_obs_free(&o);
+
+    synth(&o, 0, true); /* one torque frame in the middle of the fault */
+    hil_check_expect(&scn, &o, 3, &r);
+    assert_false(r.pass);
+    assert_int_equal(r.observed_us, 500500);
+    hil_check_expect(&scn, &o, 5, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "after the drives went off"));
+    hil_check_expect(&scn, &o, 0, &r);       /* zero torque did not hold */
+    assert_false(r.pass);
+    hil_obs_free(&o);
+
+    /* running fails when the drives go off inside its window */
+    static const char text[] = "name t\nduration 3s\nat 1.0 estop press\nat 2.0 rearm\n"
+                               "expect at 0.5 running until 1.5\n"
+                               "expect at 1.0 fault within 2ms\n";
+    scn_error_t err;
+    scenario_t s2;
+    assert_int_equal(scenario_parse(&s2, text, sizeof(text) - 1, &err), SCN_OK);
+    synth(&o, 0, false);
+    hil_check_expect(&s2, &o, 0, &r);
+    assert_false(r.pass);
+    assert_int_equal(r.observed_us, 500500);
+    hil_obs_free(&o);
+    /* fault fails when DRIVE_ENABLE never drops */
+    hil_obs_init(&o);
+    const char ev[] = "(10.000000) start scenario t\n(10.000100) gpio_out DRIVE_ENABLE=1\n";
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(&o, &s2, ev, strlen(ev), &line), HIL_OK);
+    hil_check_expect(&s2, &o, 1, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "never went low"));
+    hil_obs_free(&o);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_candump_lines),
+        cmocka_unit_test(test_event_logs),
+        cmocka_unit_test(test_expectations_pass_and_fail),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,647 @@
+/* The autosave journal: edits recovered bit for bit, a record torn at any byte ignored, a bad
+ * record in the middle stops replay there, a foreign base refused, rotation, the autosave
+ * interval, and one crafted journal per rule the reader enforces. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "host/io/argil_file.h"
+#include "host/io/io_util.h"
+#include "host/io/journal.h"
+#include "shared/crc32c.h"
+
+#define EDGE_X 10
+#define EDGE_Y 9
+#define EDGE_Z 8
+#define N_SAMPLES (EDGE_X * EDGE_Y * EDGE_Z)
+#define MAX_STEPS 40
+
+static char g_dir[64];
+
+static int setup_dir(void **state)
+{
+    (void)state;
+    strcpy(g_dir, "/tmp/argil_test_journal_XXXXXX");
+    return mkdtemp(g_dir) != NULL ? 0 : -1;
+}
+
+static int teardown_dir(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", g_dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void path_in(char *out, size_t cap, const char *name)
+{
+    snprintf(out, cap, "%s/%s", g_dir, name);
+}
+
+static uint8_t *slurp(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    fseek(fp, 0, SEEK_END);
+    const long n = ftell(fp);
+    rewind(fp);
+    uint8_t *b = malloc((size_t)n + 1);
+    assert_non_null(b);
+    assert_int_equal(fread(b, 1, (size_t)n, fp), (size_t)n);
+    fclose(fp);
+    *len = (size_t)n;
+    return b;
+}
+
+static void spit(const char *path, const void *data, size_t len)
+{
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(data, 1, len, fp), len);
+    assert_int_equal(fclose(fp), 0);
+}
+
+static long file_size(const char *name)
+{
+    char p[128];
+    path_in(p, sizeof(p), name);
+    struct stat st;
+    return stat(p, &st) == 0 ? (long)st.st_size : -1;
+}
+
+static uint32_t rng_next(uint32_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return *s;
+}
+
+/* A session under test: the grid, its journal and the density after every record. */
+typedef struct {
+    grid_t grid;
+    journal_t j;
+    uint32_t rng;
+    uint32_t records;
+    float after[MAX_STEPS + 1][N_SAMPLES]; /* [k]: density after record k (0: the base) */
+    spring_material_t mat_after[MAX_STEPS + 1];
+} sess_t;
+
+static sess_t *sess_new(const journal_cfg_t *cfg)
+{
+    sess_t *s = calloc(1, sizeof(*s));
+    assert_non_null(s);
+    const int32_t dims[3] = {EDGE_X, EDGE_Y, EDGE_Z};
+    assert_int_equal(grid_init(&s->grid, dims, 0.002f, vec3(-0.009f, -0.008f, -0.007f)),
+                     ARGIL_OK);
+    grid_fill_sphere(&s->grid, vec3(0, 0, 0), 0.006f);
+    s->rng = 0x2545F491u;
+    journal_cfg_t c;
+    journal_cfg_default(&c);
+    if (cfg)
+        c = *cfg;
+    char err[512] = "";
+    assert_int_equal(journal_open(&s->j, g_dir, &s->grid, &c, 0.0, 0.0, err, sizeof(err)),
+                     ARGIL_OK);
+    memcpy(s->after[0], s->grid.density, sizeof(s->after[0]));
+    s->mat_after[0] = s->grid.material;
+    return s;
+}
+
+static void sess_free(sess_t *s)
+{
+    journal_close(&s->j);
+    grid_free(&s->grid);
+    free(s);
+}
+
+/* One edit step k: a cluster of changed samples with gaps, scattered singles, odd bit patterns
+ * (-0, a subnormal, 1); every 5th step changes nothing, every 7th only the material. Returns
+ * whether a record was appended, after checking the journal agrees. */
+static bool sess_step(sess_t *s, uint32_t k, double sim_s, double real_s)
+{
+    float *d = s->grid.density;
+    const bool material_only = k % 7 == 6, nothing = k % 5 == 4 && !material_only;
+    if (material_only) {
+        s->grid.material.stiffness += 0.25f;
+    } else if (!nothing) {
+        const uint32_t start = rng_next(&s->rng) % (N_SAMPLES - 40);
+        for (uint32_t i = 0; i < 30; i++)
+            if (i % 4 != 3) /* gaps of one unchanged sample: bridged into one run */
+                d[start + i] = (float)(rng_next(&s->rng) % 100001u) * 1e-5f;
+        for (uint32_t i = 0; i < 5; i++)
+            d[rng_next(&s->rng) % N_SAMPLES] = (float)(rng_next(&s->rng) % 1000u) * 1e-3f;
+        d[rng_next(&s->rng) % N_SAMPLES] = -0.0f;
+        d[rng_next(&s->rng) % N_SAMPLES] = 1e-40f;
+        d[rng_next(&s->rng) % N_SAMPLES] = 1.0f;
+    }
+    bool appended = false;
+    char err[512] = "";
+    assert_int_equal(journal_record(&s->j, &s->grid, NULL, s->records + 1u, sim_s, real_s,
+                                    1700000000000ull + k, &appended, err, sizeof(err)),
+                     ARGIL_OK);
+    assert_int_equal(appended, !nothing);
+    if (appended) {
+        s->records++;
+        assert_true(s->records <= MAX_STEPS);
+        memcpy(s->after[s->records], d, sizeof(s->after[0]));
+        s->mat_after[s->records] = s->grid.material;
+    }
+    assert_int_equal(journal_tick(&s->j, sim_s, real_s, err, sizeof(err)), ARGIL_OK);
+    return appended;
+}
+
+static void sess_steps(sess_t *s, uint32_t n)
+{
+    for (uint32_t k = 0; k < n; k++)
+        (void)sess_step(s, k, 0.1 * (double)k, 0.05 * (double)k);
+    char err[512] = "";
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+}
+
+static void assert_density(const float *got, const float *want)
+{
+    assert_memory_equal(got, want, N_SAMPLES * sizeof(float));
+}
+
+static void test_round_trip(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    sess_steps(s, 30);
+    assert_int_equal(s->records, 24); /* 30 steps, 6 of them without a change */
+    assert_int_equal(s->j.stats.records, 24);
+    assert_true(s->j.stats.syncs >= 2); /* 3 s simulated with autosave 1 s */
+
+    argil_doc_t doc;
+    journal_info_t info;
+    char err[512] = "";
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_density(doc.grid.density, s->grid.density);
+    assert_density(doc.grid.rest, s->grid.density);
+    assert_int_equal(info.records, 24);
+    assert_int_equal(info.first_seq, 1);
+    assert_int_equal(info.last_seq, 24);
+    assert_int_equal(info.edits, 24);
+    assert_int_equal(doc.state.edits, 24);
+    assert_int_equal(info.torn_bytes, 0);
+    assert_memory_equal(&doc.grid.material, &s->grid.material, sizeof(spring_material_t));
+    assert_true(fabs(info.last_sim_s - 2.8) < 1e-6); /* step 29 changed nothing */
+    assert_int_equal(info.last_wall_ms, 1700000000000ull + 28);
+
+    /* The writer's own model file and the recovery's are the same bytes. */
+    char a[128], b[128];
+    path_in(a, sizeof(a), "writer.argil");
+    path_in(b, sizeof(b), "recovered.argil");
+    assert_int_equal(journal_write_model(&s->j, s->grid.density, 24, a, err, sizeof(err)),
+                     ARGIL_OK);
+    assert_int_equal(argil_file_write(b, &doc, err, sizeof(err)), ARGIL_OK);
+    size_t la, lb;
+    uint8_t *ba = slurp(a, &la), *bb = slurp(b, &lb);
+    assert_int_equal(la, lb);
+    assert_memory_equal(ba, bb, la);
+    free(ba);
+    free(bb);
+    argil_doc_free(&doc);
+
+    /* Probe (no base needed) sees the same. */
+    journal_info_t p;
+    assert_int_equal(journal_probe(g_dir, &p, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(p.records, 24);
+
+    /* A clean end removes the journal and its base. */
+    assert_true(journal_exists(g_dir));
+    assert_int_equal(journal_finish(&s->j, err, sizeof(err)), ARGIL_OK);
+    assert_false(journal_exists(g_dir));
+    assert_int_equal(file_size("journal-base-0.argil"), -1);
+    sess_free(s);
+}
+
+static void test_no_records_gives_the_base(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    argil_doc_t doc;
+    journal_info_t info;
+    char err[512] = "";
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 0);
+    assert_density(doc.grid.density, s->after[0]);
+    argil_doc_free(&doc);
+    sess_free(s);
+}
+
+/* Every cut inside the last record: that record is ignored, the rest recovered exactly. */
+static void test_torn_tail_every_byte(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    sess_steps(s, 4); /* steps 0..3: four records */
+    assert_int_equal(s->records, 4);
+    char jp[128];
+    path_in(jp, sizeof(jp), JOURNAL_FILE);
+    size_t len;
+    uint8_t *full = slurp(jp, &len);
+    /* Find where the last record starts by walking the length fields. */
+    size_t at = JOURNAL_HEADER_BYTES, last = 0;
+    while (at < len) {
+        last = at;
+        at += 8 + io_get_u32le(full + at);
+    }
+    assert_int_equal(at, len);
+    assert_true(len - last > 100);
+    for (size_t cut = last; cut < len; cut++) {
+        spit(jp, full, cut);
+        argil_doc_t doc;
+        journal_info_t info;
+        char err[512] = "";
+        assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+        assert_int_equal(info.records, 3);
+        assert_int_equal(info.torn_bytes, cut - last);
+        assert_density(doc.grid.density, s->after[3]);
+        argil_doc_free(&doc);
+    }
+    /* A cut inside the header is a clear refusal, not a crash. */
+    spit(jp, full, JOURNAL_HEADER_BYTES - 1);
+    argil_doc_t doc;
+    journal_info_t info;
+    char err[512] = "";
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_non_null(strstr(err, "shorter than the journal header"));
+    assert_null(doc.grid.density);
+    free(full);
+    sess_free(s);
+}
+
+static void test_bad_crc_in_the_middle_stops_there(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    sess_steps(s, 4);
+    char jp[128];
+    path_in(jp, sizeof(jp), JOURNAL_FILE);
+    size_t len;
+    uint8_t *full = slurp(jp, &len);
+    const size_t r1 = JOURNAL_HEADER_BYTES, r2 = r1 + 8 + io_get_u32le(full + r1);
+    const size_t r3 = r2 + 8 + io_get_u32le(full + r2);
+    const size_t r4 = r3 + 8 + io_get_u32le(full + r3);
+    /* A flipped bit inside record 2's values. */
+    full[r2 + 70] ^= 0x10;
+    spit(jp, full, len);
+    argil_doc_t doc;
+    journal_info_t info;
+    char err[512] = "";
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_non_null(strstr(err, "record 2: checksum mismatch"));
+    char want[64];
+    snprintf(want, sizeof(want), "byte %zu:", r2);
+    assert_non_null(strstr(err, want));
+    assert_int_equal(info.records, 1);
+    assert_non_null(doc.grid.density);
+    assert_density(doc.grid.density, s->after[1]);
+    argil_doc_free(&doc);
+    full[r2 + 70] ^= 0x10;
+
+    /* The same flip in the last record, which ends the file, reads as a torn write. */
+    full[r4 + 70] ^= 0x10;
+    spit(jp, full, len);
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 3);
+    assert_int_equal(info.torn_bytes, len - r4);
+    assert_density(doc.grid.density, s->after[3]);
+    argil_doc_free(&doc);
+    free(full);
+    sess_free(s);
+}
+
+static void test_wrong_base_refused(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    sess_steps(s, 3);
+    char err[512] = "", bp[128];
+    path_in(bp, sizeof(bp), "journal-base-0.argil");
+    /* Another model under the base's name. */
+    grid_fill_sphere(&s->grid, vec3(0, 0, 0), 0.004f);
+    assert_int_equal(journal_write_model(&s->j, s->grid.density, 0, bp, err, sizeof(err)),
+                     ARGIL_OK);
+    argil_doc_t doc;
+    journal_info_t info;
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_non_null(strstr(err, "is not the one this journal continues"));
+    assert_null(doc.grid.density);
+    /* No base at all. */
+    assert_int_equal(unlink(bp), 0);
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "journal-base-0.argil"));
+    assert_null(doc.grid.density);
+    sess_free(s);
+}
+
+static void test_checkpoint_rotation(void **state)
+{
+    (void)state;
+    journal_cfg_t c;
+    journal_cfg_default(&c);
+    c.checkpoint_s = 1.0f;
+    sess_t *s = sess_new(&c);
+    sess_steps(s, 16); /* 1.5 s simulated: one rotation at 1.0 s */
+    assert_int_equal(s->j.stats.checkpoints, 1);
+    assert_int_equal(file_size("journal-base-0.argil"), -1);
+    assert_true(file_size("journal-base-1.argil") > 0);
+    assert_int_equal(file_size(JOURNAL_FILE ".tmp"), -1);
+    argil_doc_t doc;
+    journal_info_t info;
+    char err[512] = "";
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.checkpoint, 1);
+    assert_true(info.first_seq > 1);
+    assert_int_equal(info.last_seq, s->records);
+    assert_int_equal(info.edits, s->records);
+    assert_density(doc.grid.density, s->grid.density);
+    assert_memory_equal(&doc.grid.material, &s->grid.material, sizeof(spring_material_t));
+    argil_doc_free(&doc);
+    sess_free(s);
+}
+
+/* Records stay in memory until the oldest is autosave_s old, in simulated or in real time. */
+static void test_autosave_interval(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    char err[512] = "";
+    const long header = JOURNAL_HEADER_BYTES;
+    assert_true(sess_step(s, 0, 0.0, 0.0));
+    assert_int_equal(file_size(JOURNAL_FILE), header);
+    assert_int_equal(journal_tick(&s->j, 0.5, 0.4, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(file_size(JOURNAL_FILE), header);
+    assert_int_equal(s->j.stats.syncs, 0);
+    assert_int_equal(journal_tick(&s->j, 1.0, 0.6, err, sizeof(err)), ARGIL_OK); /* sim 1 s */
+    assert_int_equal(s->j.stats.syncs, 1);
+    const long one = file_size(JOURNAL_FILE);
+    assert_true(one > header);
+    assert_true(sess_step(s, 1, 1.1, 0.5));
+    assert_int_equal(journal_tick(&s->j, 1.2, 1.49, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(file_size(JOURNAL_FILE), one);
+    assert_int_equal(journal_tick(&s->j, 1.2, 1.5, err, sizeof(err)), ARGIL_OK); /* real 1 s */
+    assert_int_equal(s->j.stats.syncs, 2);
+    assert_true(file_size(JOURNAL_FILE) > one);
+    sess_free(s);
+}
+
+/* A journal with one record; rewrite fields and fix the record's CRC. */
+static uint8_t *one_record(size_t *len)
+{
+    sess_t *s = sess_new(NULL);
+    assert_true(sess_step(s, 0, 0.0, 0.0));
+    char err[512] = "", jp[128];
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+    sess_free(s);
+    path_in(jp, sizeof(jp), JOURNAL_FILE);
+    return slurp(jp, len);
+}
+
+static void fix_record_crc(uint8_t *b, size_t len)
+{
+    const size_t r = JOURNAL_HEADER_BYTES, payload = io_get_u32le(b + r);
+    if (r + 8 + payload <= len)
+        io_put_u32le(b + r + 4 + payload, crc32c(0, b + r, 4 + payload));
+}
+
+static void expect_refusal(const uint8_t *b, size_t len, const char *rule)
+{
+    journal_info_t info;
+    char err[512] = "";
+    static float density[N_SAMPLES];
+    const argil_err_t e = journal_replay(b, len, "j.log", density, N_SAMPLES, &info, err,
+                                         sizeof(err));
+    if (e != ARGIL_ERR_PARSE || strstr(err, rule) == NULL || strstr(err, "j.log: byte ") != err)
+        fail_msg("wanted '%s', got %d '%s'", rule, e, err);
+    assert_int_equal(info.records, 0);
+}
+
+static void test_each_rule(void **state)
+{
+    (void)state;
+    size_t len;
+    uint8_t *good = one_record(&len);
+    uint8_t *b = malloc(len + 64);
+    assert_non_null(b);
+    const size_t h = JOURNAL_HEADER_BYTES, p = h + 4; /* record payload */
+    journal_info_t info;
+    char err[512];
+    static float density[N_SAMPLES];
+    assert_int_equal(journal_replay(good, len, "j.log", density, N_SAMPLES, &info, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_int_equal(info.records, 1);
+    assert_int_equal(journal_replay(good, len, "j.log", density, N_SAMPLES - 1, &info, err,
+                                    sizeof(err)),
+                     ARGIL_ERR_ARG);
+
+#define FRESH() memcpy(b, good, len)
+    /* Header rules. */
+    FRESH();
+    b[0] = 'X';
+    expect_refusal(b, len, "not an argil journal");
+    FRESH();
+    b[20] ^= 1;
+    expect_refusal(b, len, "header checksum mismatch");
+#define HDR_FIX() io_put_u32le(b + h - 4, crc32c(0, b, h - 4))
+    FRESH();
+    io_put_u32le(b + 8, 2);
+    HDR_FIX();
+    expect_refusal(b, len, "journal version");
+    FRESH();
+    io_put_u32le(b + 12, 100);
+    HDR_FIX();
+    expect_refusal(b, len, "header size");
+    FRESH();
+    io_put_u32le(b + 16, 0);
+    HDR_FIX();
+    expect_refusal(b, len, "grid dimension");
+    FRESH();
+    io_put_f32le(b + 28, -1.0f);
+    HDR_FIX();
+    expect_refusal(b, len, "spacing");
+    FRESH();
+    io_put_f32le(b + 52, 0.0f); /* node mass */
+    HDR_FIX();
+    expect_refusal(b, len, "material out of range");
+    FRESH();
+    io_put_u32le(b + 76, 0);
+    HDR_FIX();
+    expect_refusal(b, len, "first record number 0");
+    FRESH();
+    b[96] = '/';
+    HDR_FIX();
+    expect_refusal(b, len, "plain file name");
+    FRESH();
+    b[96 + 50] = 'x';
+    HDR_FIX();
+    expect_refusal(b, len, "NUL-padded");
+    FRESH();
+    b[97] = 0x01;
+    HDR_FIX();
+    expect_refusal(b, len, "printable");
+
+    /* Record rules, each with a good CRC. */
+    FRESH();
+    io_put_u32le(b + p, 7);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "unknown record type 7");
+    FRESH();
+    io_put_u32le(b + p + 4, 5);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "record 1: number 5, expected 1");
+    FRESH();
+    io_put_f32le(b + p + 28, -1.0f);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "record 1: material out of range");
+    FRESH();
+    io_put_u32le(b + p + 52, N_SAMPLES); /* first run's start: past the last sample */
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "beyond the grid");
+    FRESH();
+    io_put_u32le(b + p + 56, 0); /* first run's count */
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "empty");
+    FRESH();
+    io_put_f32le(b + p + 60, 1.5f);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "density not a finite number in [0, 1]");
+    FRESH();
+    io_put_f32le(b + p + 60, NAN);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "density not a finite number in [0, 1]");
+    FRESH();
+    io_put_u32le(b + p + 48, io_get_u32le(b + p + 48) + 1u); /* one run more than there is */
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "head runs past the record");
+    FRESH();
+    io_put_u32le(b + p + 48, io_get_u32le(b + p + 48) - 1u); /* one run less */
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "bytes after the last run");
+    /* A record shorter than its head: length 8, its CRC fixed, and a second copy after it so
+     * it is not the last. */
+    {
+        uint8_t small[JOURNAL_HEADER_BYTES + 32];
+        memcpy(small, good, h);
+        io_put_u32le(small + h, 8);
+        memset(small + h + 4, 0, 8);
+        io_put_u32le(small + h + 12, crc32c(0, small + h, 12));
+        memcpy(small + h + 16, small + h, 16);
+        expect_refusal(small, sizeof(small), "shorter than a record head");
+    }
+    /* Scanning without a model gives the same verdicts. */
+    FRESH();
+    assert_int_equal(journal_replay(b, len, "j.log", NULL, 0, &info, err, sizeof(err)),
+                     ARGIL_OK);
+    assert_int_equal(info.records, 1);
+#undef FRESH
+#undef HDR_FIX
+    free(b);
+    free(good);
+}
+
+/* A box limits what is compared: changes inside it (clipped to the grid) are recorded, one
+ * outside it waits for the next whole-grid record, and replay still ends bit-exact. */
+static void test_box_hint(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    float *d = s->grid.density;
+    char err[512] = "";
+    bool appended = false;
+    const size_t inside = 1 + EDGE_X * (2 + EDGE_Y * 3);     /* (1, 2, 3) */
+    const size_t outside = 9 + EDGE_X * (8 + EDGE_Y * 7);    /* (9, 8, 7) */
+    d[inside] = 0.123f;
+    d[outside] = 0.456f;
+    const journal_box_t box = {{-5, 0, 1}, {4, 3, 4}};       /* x clipped to [0, 4) */
+    assert_int_equal(journal_record(&s->j, &s->grid, &box, 1, 0.01, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.samples, 1);
+    const journal_box_t empty = {{3, 3, 3}, {3, 9, 9}};
+    assert_int_equal(journal_record(&s->j, &s->grid, &empty, 2, 0.02, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_false(appended);
+    const journal_box_t huge = {{-100, -100, -100}, {100, 100, 100}};
+    assert_int_equal(journal_record(&s->j, &s->grid, &huge, 2, 0.03, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.samples, 2);
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+    argil_doc_t doc;
+    journal_info_t info;
+    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 2);
+    assert_density(doc.grid.density, d);
+    argil_doc_free(&doc);
+    sess_free(s);
+}
+
+static void test_discard_and_bad_config(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    sess_steps(s, 3);
+    char err[512] = "";
+    assert_true(journal_exists(g_dir));
+    assert_int_equal(journal_discard(g_dir, err, sizeof(err)), ARGIL_OK);
+    assert_false(journal_exists(g_dir));
+    assert_int_equal(file_size("journal-base-0.argil"), -1);
+    journal_info_t info;
+    assert_int_equal(journal_probe(g_dir, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    sess_free(s);
+
+    journal_t j;
+    grid_t g;
+    const int32_t dims[3] = {4, 4, 4};
+    assert_int_equal(grid_init(&g, dims, 0.01f, vec3(0, 0, 0)), ARGIL_OK);
+    journal_cfg_t c;
+    journal_cfg_default(&c);
+    c.autosave_s = 0.0f;
+    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_ERR_ARG);
+    journal_cfg_default(&c);
+    assert_int_equal(journal_open(&j, "/nonexistent/argil", &g, &c, 0.0, 0.0, err, sizeof(err)),
+                     ARGIL_ERR_IO);
+    assert_non_null(strstr(err, "/nonexistent/argil"));
+    /* A journal already there is never overwritten. */
+    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_OK);
+    journal_close(&j);
+    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)),
+                     ARGIL_ERR_STATE);
+    assert_non_null(strstr(err, "unfinished session"));
+    grid_free(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_round_trip, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_no_records_gives_the_base, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_torn_tail_every_byte, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_bad_crc_in_the_middle_stops_there, setup_dir,
+                                        teardown_dir),
+        cmocka_unit_test_setup_teardown(test_wrong_base_refused, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_checkpoint_rotation, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_autosave_interval, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, teardown_dir),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
