@@ -13,12 +13,22 @@
  * protocol peer (host/app/peer.c: tool, windows around the tool over a clay sphere, heartbeats,
  * ARM) so the board goes ACTIVE and sculpts, and at their times the host-side steps: rearm,
  * link lost / restore / delay / duplicate / reorder / garbage. Its clock starts when it starts
- * (start it together with argil-sim). It prints one line per step performed; a step it cannot
- * perform over UDP (overrun, nan_tool) is printed as "unsupported" and the exit status is 3. */
+ * (start it together with argil-sim), or with "--sync CAN_IF" at the first drive frame on
+ * the bus, i.e. when argil-sim's scenario starts. It prints one line per step performed; a step it cannot
+ * perform over UDP (overrun, nan_tool) is printed as "unsupported" and the exit status is 3.
+ * Its heartbeats come from their own thread every 5 ms of wall time at HIL_FIFO_PRIO, while
+ * the peer's loop (global solve limited to 20 Hz here: this host tests the board, the solve is
+ * tested elsewhere; windows) runs 20 below, under the board's link thread: on a slow emulated
+ * rig neither the solve holds the heartbeats back nor the peer starves the board's link. */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
 #include <errno.h>
+#include <pthread.h>
 #include <sched.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,6 +41,7 @@
 #include "host/model/grid.h"
 #include "shared/proto.h"
 #include "sim/scenario.h"
+#include "sim/sim_device.h"
 
 static double realtime_s(void)
 {
@@ -57,6 +68,7 @@ static void send_msg(int fd, const struct sockaddr_in *to, proto_msg_t *m, uint3
 
 /* ---- scenario host ---- */
 #define HELD_MAX 64u
+#define HOST_LOOP_DROP 20           /* the peer loop's FIFO priority below the heartbeats' */
 
 typedef struct {
     uint64_t due_us;
@@ -78,6 +90,10 @@ typedef struct {
     msg_telemetry_t tm;
     uint32_t tm_n, last_state;
     uint32_t frames_sent, frames_dropped;
+    pthread_mutex_t mu;             /* the link state and socket, shared with the beat thread */
+    atomic_bool board_seen, stop;
+    atomic_uint window_version, impulse_seq; /* the peer's, for the beat thread's heartbeats */
+    atomic_uint beats;
 } shost_t;
 
 static void raw_send(shost_t *h, const uint8_t *f, size_t len)
@@ -86,10 +102,9 @@ static void raw_send(shost_t *h, const uint8_t *f, size_t len)
     h->frames_sent++;
 }
 
-/* The peer's frames go through the scripted link faults. */
-static bool shost_send(void *ctx, const uint8_t *f, size_t len)
+/* The peer's frames go through the scripted link faults; the caller holds h->mu. */
+static bool shost_send_locked(shost_t *h, const uint8_t *f, size_t len)
 {
-    shost_t *h = ctx;
     if (h->lost || len > PROTO_FRAME_MAX) {
         h->frames_dropped++;
         return true;
@@ -124,6 +139,49 @@ static bool shost_send(void *ctx, const uint8_t *f, size_t len)
         h->duplicate_n--;
     }
     return true;
+}
+
+static bool shost_send(void *ctx, const uint8_t *f, size_t len)
+{
+    shost_t *h = ctx;
+    pthread_mutex_lock(&h->mu);
+    const bool ok = shost_send_locked(h, f, len);
+    pthread_mutex_unlock(&h->mu);
+    return ok;
+}
+
+/* Sends a heartbeat carrying the peer's window version and impulse ack every 5 ms of
+ * CLOCK_MONOTONIC until h->stop, whatever the main loop is doing. */
+static void *shost_beat(void *arg)
+{
+    shost_t *h = arg;
+    static proto_msg_t m;
+    uint32_t seq = 0x20000000u;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    while (!atomic_load(&h->stop)) {
+        ts.tv_nsec += 5000000L;
+        if (ts.tv_nsec >= 1000000000L) {
+            ts.tv_nsec -= 1000000000L;
+            ts.tv_sec++;
+        }
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+        if (!atomic_load(&h->board_seen))
+            continue;
+        memset(&m, 0, sizeof(m));
+        m.type = MSG_HEARTBEAT;
+        m.u.heartbeat.time_us = mono_us();
+        m.u.heartbeat.window_version = atomic_load(&h->window_version);
+        m.u.heartbeat.impulse_seq = atomic_load(&h->impulse_seq);
+        m.u.heartbeat.command = PROTO_CMD_NONE;
+        uint8_t buf[PROTO_FRAME_MAX];
+        size_t len = 0;
+        if (proto_encode(&m, seq++, buf, sizeof(buf), &len) == PROTO_OK) {
+            (void)shost_send(h, buf, len);
+            atomic_fetch_add(&h->beats, 1u);
+        }
+    }
+    return NULL;
 }
 
 static void shost_on_tm(void *ctx, const msg_telemetry_t *t)
@@ -204,7 +262,30 @@ static bool shost_step(shost_t *h, const scn_step_t *st, uint32_t *rearm_ms)
     }
 }
 
-static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, const char *path)
+/* A raw CAN socket on iface that receives only the drives' NMT boot-up/heartbeat frames
+ * (0x701-0x77F); -1 with one line on stderr when it cannot be opened. */
+static int sync_can_open(const char *iface)
+{
+    const int s = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK, CAN_RAW);
+    if (s < 0) {
+        fprintf(stderr, "hil-host: CAN socket for --sync %s: %s\n", iface, strerror(errno));
+        return -1;
+    }
+    const struct can_filter flt = {.can_id = 0x700u, .can_mask = CAN_SFF_MASK & ~0x7Fu};
+    (void)setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, &flt, sizeof(flt));
+    struct sockaddr_can addr = {.can_family = AF_CAN, .can_ifindex = (int)if_nametoindex(iface)};
+    if (addr.can_ifindex == 0 || bind(s, (struct sockaddr *)&addr, sizeof(addr)) != 0) {
+        fprintf(stderr, "hil-host: cannot bind CAN interface '%s' for the scenario clock\n", iface);
+        close(s);
+        return -1;
+    }
+    return s;
+}
+
+/* Runs the scenario's host side for `seconds` from its time 0: when sync_fd >= 0, the first
+ * drive frame on it (argil-sim's drives boot when its scenario starts), else at once. */
+static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, const char *path,
+                        int sync_fd, int beat_prio)
 {
     static scenario_t scn;
     scn_error_t err;
@@ -219,42 +300,88 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     h.fd = fd;
     h.board = *board;
     h.last_state = 0xFFu;
-    /* A clay sphere under the stylus's home, as the SIL rig and argil sculpt use. */
+    /* The SIL rig's clay and tool (tests/sil/rig.h): a 30 mm sphere at the model origin, the
+     * stylus's home mapped 60 mm above its centre (the surface 26 mm under a 4 mm tool). */
     const int32_t dims[3] = {72, 72, 72};
     const float cell_m = 0.00125f, half = 0.5f * 71.0f * cell_m;
-    if (grid_init(&grid, dims, cell_m, vec3(-half, -half, 0.174f - half)) != ARGIL_OK)
+    if (grid_init(&grid, dims, cell_m, vec3(-half, -half, -half)) != ARGIL_OK)
         return 2;
-    grid_fill_sphere(&grid, vec3(0, 0, 0.174f - 0.040f), 0.030f);
+    grid_fill_sphere(&grid, vec3(0, 0, 0), 0.030f);
     peer_cfg_t pc;
     peer_cfg_default(&pc);
     pc.window_edge = 16;
+    pc.solve_period_us = 50000u;
     if (peer_init(&peer, &pc, &grid, shost_send, shost_on_tm, &h) != ARGIL_OK)
         return 2;
+    static sim_params_t arm_p;
+    static sim_device_t dev;
+    sim_params_default(&arm_p);
+    sim_device_init(&dev, &arm_p);
+    const vec3_t offset = vec3_sub(vec3(0, 0, 0.060f), sim_device_tip_m(&dev));
     msg_tool_t t;
     memset(&t, 0, sizeof(t));
     t.kind = TOOL_TOUCH;
+    t.shape = TOOL_SHAPE_POINT;
+    t.filter = BETA_GAUSSIAN;
     t.radius_m = 0.004f;
     t.axis[2] = 1.0f;
-    t.alpha = 12000.0f;
+    t.alpha = 30000.0f;
     t.contact_stiffness_n_per_m = 800.0f;
     t.max_force_n = 3.3f;
+    t.iso = 0.5f;
+    t.yield_force_n = 0.5f;
+    t.probe_gain = 0.02f;
+    t.rope_stiffness_n_per_m = 200.0f;
     t.model_scale = 1.0f;
+    t.model_offset_m[0] = offset.x;
+    t.model_offset_m[1] = offset.y;
+    t.model_offset_m[2] = offset.z;
     peer_set_tool(&peer, &t);
     peer_request_arm(&peer);
 
     int unsupported = 0;
     uint32_t next_step = 0, rearm_ms = 0;
     static uint8_t buf[65536];
+    pthread_mutex_init(&h.mu, NULL);
+    pthread_t beat;
+    pthread_attr_t attr;
+    pthread_attr_init(&attr);
+    if (beat_prio > 0) {
+        const struct sched_param sp = {.sched_priority = beat_prio};
+        pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+        pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+        pthread_attr_setschedparam(&attr, &sp);
+    }
+    if (pthread_create(&beat, &attr, shost_beat, &h) != 0) {
+        fprintf(stderr, "hil-host: cannot start the heartbeat thread at FIFO %d\n", beat_prio);
+        pthread_attr_destroy(&attr);
+        return 2;
+    }
+    pthread_attr_destroy(&attr);
     h.t0_us = mono_us();
-    const uint64_t t_end = h.t0_us + (uint64_t)seconds * 1000000u;
+    uint64_t last_tick_us = h.t0_us;
+    /* Until the scenario clock starts, the peer runs (HELLO, windows, ARM) with no steps; the
+     * wait for it is bounded by `seconds` too. */
+    bool synced = sync_fd < 0;
+    uint64_t t_end = h.t0_us + (uint64_t)seconds * 1000000u;
     uint64_t next = h.t0_us;
     for (uint32_t ms = 0; mono_us() < t_end; ms++) {
+        struct can_frame cf;
+        if (!synced && read(sync_fd, &cf, sizeof(cf)) == (ssize_t)sizeof(cf)) {
+            synced = true;
+            h.t0_us = mono_us();
+            t_end = h.t0_us + (uint64_t)seconds * 1000000u;
+            printf("%.6f scenario clock starts (drive frame 0x%03X)\n", realtime_s(),
+                   (unsigned)(cf.can_id & CAN_SFF_MASK));
+        }
         const int64_t now_us = (int64_t)(mono_us() - h.t0_us);
-        while (next_step < scn.n_steps && scn.step[next_step].t_us <= now_us) {
+        while (synced && next_step < scn.n_steps && scn.step[next_step].t_us <= now_us) {
             const scn_step_t *st = &scn.step[next_step++];
             if (!scenario_action_is_host_side(st->action))
                 continue;
+            pthread_mutex_lock(&h.mu);
             const bool ok = shost_step(&h, st, &rearm_ms);
+            pthread_mutex_unlock(&h.mu);
             printf("%.6f step line=%u %s%s\n", realtime_s(), st->line, st->text,
                    ok ? "" : " unsupported");
             unsupported += !ok;
@@ -270,8 +397,17 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
                 shost_simple(&h, MSG_HEARTBEAT, PROTO_CMD_ARM);
             rearm_ms--;
         }
-        peer_tick(&peer, 1000);
+        /* The peer's clock is wall time, however late this loop runs. */
+        const uint64_t tick_now = mono_us();
+        const uint64_t dt = tick_now - last_tick_us;
+        last_tick_us = tick_now;
+        peer_tick(&peer, dt > 100000u ? 100000u : (uint32_t)dt);
+        atomic_store(&h.window_version, peer.have_current ? peer.current.version : 0u);
+        atomic_store(&h.impulse_seq, peer.impulse_seq_applied);
+        atomic_store(&h.board_seen, peer.board_seen);
+        pthread_mutex_lock(&h.mu);
         shost_release_held(&h, false);
+        pthread_mutex_unlock(&h.mu);
         next += 1000;
         const uint64_t now = mono_us();
         if (next < now)
@@ -279,10 +415,18 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
         struct timespec ts = {(time_t)(next / 1000000u), (long)(next % 1000000u) * 1000};
         clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
     }
-    printf("%.6f telemetry=%u frames_sent=%u dropped=%u windows=%u\n", realtime_s(), h.tm_n,
-           h.frames_sent, h.frames_dropped, peer.stats.windows_sent);
+    atomic_store(&h.stop, true);
+    pthread_join(beat, NULL);
+    printf("%.6f telemetry=%u frames_sent=%u dropped=%u windows=%u beats=%u solves=%u\n",
+           realtime_s(), h.tm_n, h.frames_sent, h.frames_dropped, peer.stats.windows_sent,
+           atomic_load(&h.beats), peer.stats.solves);
     peer_free(&peer);
     grid_free(&grid);
+    if (!synced) {
+        fprintf(stderr, "hil-host: no drive frame on the sync interface in %ld s: the scenario never started\n",
+                seconds);
+        return 1;
+    }
     if (h.tm_n == 0)
         return 1;
     return unsupported ? 3 : 0;
@@ -291,11 +435,18 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
 int main(int argc, char **argv)
 {
     char *end1 = NULL, *end2 = NULL;
+    /* "--sync IFACE" after the scenario: its clock starts at the first drive frame on IFACE. */
+    const char *sync_if = NULL;
+    if (argc == 6 && strcmp(argv[4], "--sync") == 0) {
+        sync_if = argv[5];
+        argc = 4;
+    }
     const bool args_ok = argc == 3 || argc == 4;
     const long port = args_ok ? strtol(argv[1], &end1, 10) : 0;
     const long seconds = args_ok ? strtol(argv[2], &end2, 10) : 0;
     if (!args_ok || *end1 || *end2 || port < 1 || port > 65535 || seconds < 1 || seconds > 3600) {
-        fprintf(stderr, "usage: hil-host PORT SECONDS [SCENARIO] (port 1-65535, 1-3600 s)\n");
+        fprintf(stderr, "usage: hil-host PORT SECONDS [SCENARIO [--sync CAN_IF]] (port 1-65535, "
+                        "1-3600 s)\n");
         return 2;
     }
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
@@ -307,15 +458,28 @@ int main(int argc, char **argv)
     inet_pton(AF_INET, "127.0.0.1", &board.sin_addr);
     setvbuf(stdout, NULL, _IOLBF, 0);
     const char *prio_env = getenv("HIL_FIFO_PRIO");
-    const int prio = prio_env ? atoi(prio_env) : 0;
-    if (prio >= 1 && prio <= 98) {
-        struct sched_param sp = {.sched_priority = prio};
+    const int prio_in = prio_env ? atoi(prio_env) : 0;
+    const int prio = prio_in >= 1 && prio_in <= 98 ? prio_in : 0;
+    if (prio > 0) {
+        /* A scenario host's heartbeats get prio; its peer (grid, solve, windows) runs
+         * HOST_LOOP_DROP below, under the board's link thread, which must stay free to take
+         * the heartbeats in. */
+        struct sched_param sp = {.sched_priority = argc == 4 && prio > HOST_LOOP_DROP
+                                                       ? prio - HOST_LOOP_DROP
+                                                       : prio};
         if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
             fprintf(stderr, "hil-host: SCHED_FIFO %d: %s\n", prio, strerror(errno));
     }
 
     if (argc == 4) {
-        const int st = run_scenario(fd, &board, seconds, argv[3]);
+        const int sync_fd = sync_if ? sync_can_open(sync_if) : -1;
+        if (sync_if != NULL && sync_fd < 0) {
+            close(fd);
+            return 1;
+        }
+        const int st = run_scenario(fd, &board, seconds, argv[3], sync_fd, prio);
+        if (sync_fd >= 0)
+            close(sync_fd);
         close(fd);
         return st;
     }

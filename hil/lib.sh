@@ -10,6 +10,8 @@ PROBE_PRIO=${PROBE_PRIO:-50}
 PROBE_PERIOD_US=${PROBE_PERIOD_US:-200}
 CANDUMP_PRIO=${CANDUMP_PRIO:-$PROBE_PRIO}
 HOST_PRIO=${HOST_PRIO:-60}
+# argil-sim in the scenarios (the arm); a rig config may put it under the board's link thread.
+SIM_PRIO=${SIM_PRIO:-$((HOST_PRIO - 1))}
 
 # ---- results ----
 pass() { RESULT=PASS; DETAIL="$*"; }
@@ -493,14 +495,16 @@ check_scenario() {
     can_log_start
     board_start --can "$CAN_IF" --link "udp:127.0.0.1:$UDP_PORT" || { fail "did not start: $(board_tail)"; return; }
     mkdir -p "$OUT/$CHECK.sim"
-    HIL_FIFO_PRIO=$HOST_PRIO hil-host "$UDP_PORT" "$dur" "$scn" >"$OUT/$CHECK.host.log" 2>&1 &
+    # hil-host's scenario clock starts at argil-sim's drives' boot-up on the bus (~10 ms after
+    # argil-sim's start); the host steps are timed by its own log below.
+    HIL_FIFO_PRIO=$HOST_PRIO hil-host "$UDP_PORT" "$dur" "$scn" --sync "$CAN_IF" >"$OUT/$CHECK.host.log" 2>&1 &
     HOST_PID=$!
     st=0
     # argil-sim finds a gpio-sim chip by its device name (gpiochipN); a real rig's arm
     # stand-in drives the board's lines through the loopback chip.
     if [ "$STIM" = gpio-sim ]; then simchip=$(cat "$GPIO_SIM_CONFIGFS/bank0/chip_name"); else simchip=$LOOP_CHIP; fi
     # The arm is its own hardware: it must not wait behind the daemon's SCHED_FIFO loop.
-    hil-probe fifo $((HOST_PRIO - 1)) argil-sim --can "$CAN_IF" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
+    hil-probe fifo "$SIM_PRIO" argil-sim --can "$CAN_IF" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
         >"$OUT/$CHECK.sim.out" 2>&1 || st=$?
     hst=0; wait "$HOST_PID" || hst=$?; HOST_PID=
     can_log_stop
@@ -510,7 +514,12 @@ check_scenario() {
     # Frames from several senders on vcan can carry timestamps a few 100 us out of order; the
     # checker wants time order: give it a stably sorted copy, keep the raw log.
     sort -s -k1,1 "$OUT/$CHECK.candump.log" >"$OUT/$CHECK.candump.sorted.log"
-    argil-hil-check "$scn" "$OUT/$CHECK.candump.sorted.log" "$OUT/$CHECK.sim/events.log" >"$OUT/$CHECK.check.log" 2>&1 || cst=$?
+    # A host-side step happened when hil-host performed it: its "T step line=N …" lines join
+    # argil-sim's event log as injections (argil-sim's own "host line=N" lines are only notes).
+    { cat "$OUT/$CHECK.sim/events.log"
+      awk '$2 == "step" && $NF != "unsupported" { $1 = "(" $1 ")"; $2 = "inject"; print }' "$OUT/$CHECK.host.log"
+    } | sort -s -k1,1 >"$OUT/$CHECK.events.log"
+    argil-hil-check "$scn" "$OUT/$CHECK.candump.sorted.log" "$OUT/$CHECK.events.log" >"$OUT/$CHECK.check.log" 2>&1 || cst=$?
     res=$(tail -n 1 "$OUT/$CHECK.check.log")
     bad=$(grep -v '^ok\|^PASS\|passed, ' "$OUT/$CHECK.check.log" | head -n 2 | tr '\n' '|')
     if [ "$hst" = 3 ]; then

@@ -34,6 +34,8 @@ hil_err_t hil_obs_push_frame(hil_obs_t *o, int64_t t_us, const can_frame_t *f)
     o->frame[o->n_frames].t_us = t_us;
     o->frame[o->n_frames].f = *f;
     o->n_frames++;
+    if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
+        o->n_syncs++;
     return HIL_OK;
 }
 
@@ -318,16 +320,87 @@ static bool cw_off(uint16_t cw)
 
 #define MS(us) ((double)(us) / 1000.0)
 
+static bool is_sync(const hil_frame_t *h)
+{
+    return h->f.id == CANOPEN_COB_SYNC && h->f.len <= 1u;
+}
+
+/* Board ticks from t0 to t: SYNC frames in (t0, t]; −1 when the log has none. */
+static int64_t ticks_between(const hil_obs_t *o, int64_t t0, int64_t t)
+{
+    if (o->n_syncs == 0)
+        return -1;
+    int64_t n = 0;
+    for (size_t k = 0; k < o->n_frames && o->frame[k].t_us <= t; k++)
+        n += o->frame[k].t_us > t0 && is_sync(&o->frame[k]);
+    return n;
+}
+
+/* Time of the first SYNC after t (INT64_MAX if none). */
+static int64_t first_sync_after(const hil_obs_t *o, int64_t t)
+{
+    for (size_t k = 0; k < o->n_frames; k++)
+        if (o->frame[k].t_us > t && is_sync(&o->frame[k]))
+            return o->frame[k].t_us;
+    return INT64_MAX;
+}
+
+/* The bound's ticks: "within 3ms" allows 3 ticks at the nominal 1 kHz (at least 1). */
+static int64_t bound_ticks(int64_t within_us)
+{
+    const int64_t n = (within_us + HIL_TICK_US - 1) / HIL_TICK_US;
+    return n > 0 ? n : 1;
+}
+
+/* Last instant inside "within" from t0: t0 + within_us on a log without SYNCs, else just
+ * before the SYNC that opens the tick after the bound's last (INT64_MAX if the log ends). */
+static int64_t bound_end(const hil_obs_t *o, int64_t t0, int64_t within_us)
+{
+    if (o->n_syncs == 0)
+        return t0 + within_us;
+    const int64_t want = bound_ticks(within_us) + 1;
+    int64_t n = 0;
+    for (size_t k = 0; k < o->n_frames; k++)
+        if (o->frame[k].t_us > t0 && is_sync(&o->frame[k]) && ++n == want)
+            return o->frame[k].t_us - 1;
+    return INT64_MAX;
+}
+
+/* "1.234 ms, 2 ticks" (ticks only when the log has SYNCs) into buf; returns buf. */
+static const char *lat(char *buf, size_t n, const hil_obs_t *o, int64_t t0, int64_t t)
+{
+    const int64_t ticks = ticks_between(o, t0, t);
+    if (ticks < 0)
+        snprintf(buf, n, "%.3f ms", MS(t - t0));
+    else
+        snprintf(buf, n, "%.3f ms, %lld tick%s", MS(t - t0), (long long)ticks,
+                 ticks == 1 ? "" : "s");
+    return buf;
+}
+
+/* "3 ticks (3.000 ms at 1 kHz)" or "3.000 ms": the bound as it is asserted. */
+static const char *bnd(char *buf, size_t n, const hil_obs_t *o, int64_t within_us)
+{
+    if (o->n_syncs == 0)
+        snprintf(buf, n, "%.3f ms", MS(within_us));
+    else
+        snprintf(buf, n, "%lld ticks = %.3f ms at 1 kHz", (long long)bound_ticks(within_us),
+                 MS(within_us));
+    return buf;
+}
+
 void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_result_t *r)
 {
     const scn_expect_t *e = &s->expect[i];
     const int64_t t0 = abs_time(s, o, e->t_us);
     const int64_t t_end = e->until == SCN_UNTIL_TIME ? o->start_us + e->until_us
                                                      : abs_time(s, o, scenario_until_us(s, e));
-    const int64_t t_bound = t0 + e->within_us;
+    const int64_t t_bound = bound_end(o, t0, e->within_us);
     const bool gpio = o->n_gpio > 0;
+    char la[48], bo[48];
     r->pass = false;
     r->observed_us = -1;
+    r->observed_ticks = -1;
     size_t rpdos = 0;
     uint8_t node;
     uint16_t cw;
@@ -388,6 +461,7 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                 t_obs = t_low;
         }
         r->observed_us = t_obs - t0;
+        r->observed_ticks = ticks_between(o, t0, t_obs);
         if (e->until != SCN_UNTIL_NONE) {
             r->pass = !any_bad && (!fault || !gpio || t_obs == t0);
             snprintf(r->msg, sizeof(r->msg), "%s from +%.3f ms (%zu RPDOs checked)",
@@ -396,14 +470,15 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         }
         r->pass = t_obs <= t_bound;
         if (any_bad)
-            snprintf(r->msg, sizeof(r->msg), "observed after %.3f ms (bound %.3f ms, %zu RPDOs%s)",
-                     MS(t_obs - t0), MS(e->within_us), rpdos, fault && gpio ? ", DRIVE_ENABLE" : "");
+            snprintf(r->msg, sizeof(r->msg), "observed after %s (bound %s, %zu RPDOs%s)",
+                     lat(la, sizeof(la), o, t0, t_obs), bnd(bo, sizeof(bo), o, e->within_us),
+                     rpdos, fault && gpio ? ", DRIVE_ENABLE" : "");
         else
             snprintf(r->msg, sizeof(r->msg),
-                     "observed after %.3f ms: no offending RPDO after the injection, first "
-                     "RPDO at +%.3f ms (bound %.3f ms%s)",
-                     MS(t_obs - t0), t_first_ok < 0 ? -1.0 : MS(t_first_ok - t0),
-                     MS(e->within_us), fault && gpio ? ", DRIVE_ENABLE" : "");
+                     "observed after %s: no offending RPDO after the injection, first "
+                     "RPDO at +%.3f ms (bound %s%s)",
+                     lat(la, sizeof(la), o, t0, t_obs), t_first_ok < 0 ? -1.0 : MS(t_first_ok - t0),
+                     bnd(bo, sizeof(bo), o, e->within_us), fault && gpio ? ", DRIVE_ENABLE" : "");
         return;
     }
     case SCN_EXP_QUICK_STOP: {
@@ -419,8 +494,8 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         int64_t worst = t0;
         for (int j = 0; j < ARGIL_DRIVES; j++) {
             if (t_node[j] < 0) {
-                snprintf(r->msg, sizeof(r->msg), "drive %d got no QUICK_STOP within %.3f ms",
-                         j + 1, MS(e->within_us));
+                snprintf(r->msg, sizeof(r->msg), "drive %d got no QUICK_STOP within %s",
+                         j + 1, bnd(bo, sizeof(bo), o, e->within_us));
                 return;
             }
             if (t_node[j] > worst)
@@ -428,8 +503,9 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         }
         r->pass = true;
         r->observed_us = worst - t0;
-        snprintf(r->msg, sizeof(r->msg), "every drive got QUICK_STOP after %.3f ms (bound %.3f ms)",
-                 MS(worst - t0), MS(e->within_us));
+        r->observed_ticks = ticks_between(o, t0, worst);
+        snprintf(r->msg, sizeof(r->msg), "every drive got QUICK_STOP after %s (bound %s)",
+                 lat(la, sizeof(la), o, t0, worst), bnd(bo, sizeof(bo), o, e->within_us));
         return;
     }
     case SCN_EXP_ENABLED: {
@@ -443,13 +519,14 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
             if (on[0] && on[1] && on[2] && (!gpio || enable_before(o, h->t_us))) {
                 r->pass = true;
                 r->observed_us = h->t_us - t0;
-                snprintf(r->msg, sizeof(r->msg), "every drive enabled after %.3f ms (bound %.3f ms)",
-                         MS(h->t_us - t0), MS(e->within_us));
+                r->observed_ticks = ticks_between(o, t0, h->t_us);
+                snprintf(r->msg, sizeof(r->msg), "every drive enabled after %s (bound %s)",
+                         lat(la, sizeof(la), o, t0, h->t_us), bnd(bo, sizeof(bo), o, e->within_us));
                 return;
             }
         }
-        snprintf(r->msg, sizeof(r->msg), "drives not all enabled within %.3f ms",
-                 MS(e->within_us));
+        snprintf(r->msg, sizeof(r->msg), "drives not all enabled within %s",
+                 bnd(bo, sizeof(bo), o, e->within_us));
         return;
     }
     case SCN_EXP_TORQUE_NONZERO:
@@ -460,19 +537,25 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
             if (tq != 0) {
                 r->pass = true;
                 r->observed_us = h->t_us - t0;
-                snprintf(r->msg, sizeof(r->msg), "torque %d ‰ on drive %u after %.3f ms", tq,
-                         node, MS(h->t_us - t0));
+                r->observed_ticks = ticks_between(o, t0, h->t_us);
+                snprintf(r->msg, sizeof(r->msg), "torque %d ‰ on drive %u after %s (bound %s)",
+                         tq, node, lat(la, sizeof(la), o, t0, h->t_us),
+                         bnd(bo, sizeof(bo), o, e->within_us));
                 return;
             }
         }
-        snprintf(r->msg, sizeof(r->msg), "no non-zero torque within %.3f ms", MS(e->within_us));
+        snprintf(r->msg, sizeof(r->msg), "no non-zero torque within %s",
+                 bnd(bo, sizeof(bo), o, e->within_us));
         return;
     case SCN_EXP_NO_TORQUE_FRAMES:
     case SCN_EXP_RUNNING: {
         const bool running = e->kind == SCN_EXP_RUNNING;
+        /* A tick ends with its SYNC: the RPDOs of the tick in progress at T were computed from
+         * inputs read before T, so on a log with SYNCs no_torque_frames starts at its end. */
+        const int64_t t_from = running || o->n_syncs == 0 ? t0 : first_sync_after(o, t0);
         for (size_t k = 0; k < o->n_frames; k++) {
             const hil_frame_t *h = &o->frame[k];
-            if (h->t_us < t0 || h->t_us >= t_end || !rpdo(h, &node, &cw, &tq))
+            if (h->t_us < t_from || h->t_us >= t_end || !rpdo(h, &node, &cw, &tq))
                 continue;
             rpdos++;
             if (running ? cw != CIA402_CW_ENABLE_OP : tq != 0) {

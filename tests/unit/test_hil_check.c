@@ -217,12 +217,111 @@ static void test_expectations_pass_and_fail(void **st)
     hil_obs_free(&o);
 }
 
+/* A slow board, as under emulation: a tick every tick_us of wall time from 10 s + phase_us,
+ * each the 3 drives' RPDOs then its SYNC 200 us later (as argil-board sends them). The first
+ * tick after the e-stop at 1.0 s is in flight (inputs read before); the RPDOs go QUICK_STOP with
+ * torque 0 react_ticks ticks after it, DRIVE_ENABLE low 100 us after them. After the rearm at
+ * 2.0 s DRIVE_ENABLE rises and the drives come back on enable_ticks ticks after the first. */
+static void synth_ticks(hil_obs_t *o, int64_t tick_us, int64_t phase_us, int react_ticks,
+                        int enable_ticks)
+{
+    hil_obs_init(o);
+    const int64_t t0 = 10000000, estop = t0 + 1000000, rearm = t0 + 2000000;
+    int64_t t_off = -1, t_on = -1;
+    int since_estop = 0, since_rearm = 0;
+    for (int64_t t = t0 + phase_us; t < t0 + 3000000; t += tick_us) {
+        since_estop += t > estop;
+        since_rearm += t > rearm;
+        if (since_estop == react_ticks + 1 && t_off < 0)
+            t_off = t;
+        if (since_rearm == enable_ticks + 1 && t_on < 0)
+            t_on = t;
+    }
+    assert_true(t_off > 0 && t_on > 0);
+    char ev[256];
+    snprintf(ev, sizeof(ev),
+             "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+             "(%lld.%06lld) gpio_out DRIVE_ENABLE=0\n(12.000000) inject line=4 rearm\n"
+             "(%lld.%06lld) gpio_out DRIVE_ENABLE=1\n",
+             (long long)((t_off + 100) / 1000000), (long long)((t_off + 100) % 1000000),
+             (long long)((t_on - 100) / 1000000), (long long)((t_on - 100) % 1000000));
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(o, &scn, ev, strlen(ev), &line), HIL_OK);
+    for (int64_t t = t0 + phase_us; t < t0 + 3000000; t += tick_us) {
+        can_frame_t f;
+        const bool off = t >= t_off && t < t_on;
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_rpdo_encode(&f, n, off ? CIA402_CW_QUICK_STOP : CIA402_CW_ENABLE_OP,
+                                off ? 0 : 100);
+            assert_int_equal(hil_obs_push_frame(o, t, &f), HIL_OK);
+        }
+        f = (can_frame_t){.id = CANOPEN_COB_SYNC, .len = 0};
+        assert_int_equal(hil_obs_push_frame(o, t + 200, &f), HIL_OK);
+    }
+    assert_true(o->n_syncs > 0);
+}
+
+/* With SYNCs in the log, bounds count board ticks: a board at 333 ticks/s that reacts one tick
+ * after the one in flight meets "within 1ms" though 3 ms of wall time passed; one more fails. */
+static void test_bounds_in_ticks(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    hil_result_t r;
+    synth_ticks(&o, 3000, 1050, 1, 200);     /* tick in flight at 11.000050 */
+    for (uint32_t i = 0; i < scn.n_expects; i++) {
+        hil_check_expect(&scn, &o, i, &r);
+        if (!r.pass)
+            fail_msg("expectation %u failed: %s", i, r.msg);
+    }
+    hil_check_expect(&scn, &o, 0, &r);       /* torque_zero within 1ms */
+    assert_int_equal(r.observed_ticks, 1);
+    assert_int_equal(r.observed_us, 3050);   /* the next tick's RPDOs */
+    assert_non_null(strstr(r.msg, "3.050 ms, 1 tick"));
+    assert_non_null(strstr(r.msg, "bound 1 ticks = 1.000 ms at 1 kHz"));
+    hil_check_expect(&scn, &o, 1, &r);       /* quick_stop within 1ms */
+    assert_int_equal(r.observed_ticks, 1);
+    hil_check_expect(&scn, &o, 2, &r);       /* fault within 2ms: DRIVE_ENABLE low in that tick */
+    assert_int_equal(r.observed_ticks, 1);
+    assert_int_equal(r.observed_us, 3150);
+    hil_check_expect(&scn, &o, 6, &r);       /* enabled within 300ms: 200 ticks, 600 ms wall */
+    assert_int_equal(r.observed_ticks, 200);
+    assert_true(r.observed_us > 595000 && r.observed_us < 610000);
+    hil_obs_free(&o);
+
+    synth_ticks(&o, 3000, 1050, 2, 301);     /* one tick late; back on after 301 ticks */
+    hil_check_expect(&scn, &o, 0, &r);
+    assert_false(r.pass);
+    assert_int_equal(r.observed_ticks, 2);
+    hil_check_expect(&scn, &o, 1, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "no QUICK_STOP within 1 ticks"));
+    hil_check_expect(&scn, &o, 2, &r);       /* 2 ticks meet "within 2ms" */
+    assert_true(r.pass);
+    assert_int_equal(r.observed_ticks, 2);
+    hil_check_expect(&scn, &o, 3, &r);       /* no_torque_frames: the late tick had torque */
+    assert_false(r.pass);
+    hil_check_expect(&scn, &o, 6, &r);
+    assert_false(r.pass);
+    hil_obs_free(&o);
+
+    /* At 1 kHz, ticks aligned with the injection, both measures agree: 1 tick = 1 ms. */
+    synth_ticks(&o, 1000, 0, 0, 100);
+    hil_check_expect(&scn, &o, 0, &r);
+    assert_true(r.pass);
+    assert_int_equal(r.observed_ticks, 1);
+    assert_int_equal(r.observed_us, 1000);
+    hil_obs_free(&o);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_candump_lines),
         cmocka_unit_test(test_event_logs),
         cmocka_unit_test(test_expectations_pass_and_fail),
+        cmocka_unit_test(test_bounds_in_ticks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
