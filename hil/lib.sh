@@ -461,6 +461,42 @@ check_usb_session() {
     pass "argil connect over libusb <-> FunctionFS for $secs s: board ACTIVE, $rows telemetry rows for a span of $span ticks; $(grep -v '^ *$' "$OUT/$CHECK.connect.log" | tail -n 1 | cut -c1-120)"
 }
 
+# usb_replug SECS: the cable pulled and put back under a live `argil connect` session: the
+# gadget is unbound from the UDC ~3 s in (the device leaves the USB host side) and bound again
+# 1 s later. connect must see the link lost, reopen the device, resynchronise (the board says
+# HELLO again, the window is re-sent) and end with the board ACTIVE again, without a restart of
+# either side; telemetry flows after the replug.
+check_usb_replug() {
+    secs=${1:-9}
+    have argil || { skip "argil (the host program) not built"; return; }
+    argil-gadget.sh setup >"$OUT/$CHECK.gadget.log" 2>&1 || { fail "gadget setup: $(tail -n 1 "$OUT/$CHECK.gadget.log")"; return; }
+    board_start --bus sim --link "ffs:$FFS_DIR" || { fail "did not start: $(board_tail)"; return; }
+    i=0; while [ ! -e "$FFS_DIR/ep1" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i + 1)); done
+    echo "$USB_UDC" >"$(gadget_dir)/UDC" 2>"$OUT/$CHECK.bind.err" || { fail "bind $USB_UDC: $(cat "$OUT/$CHECK.bind.err")"; return; }
+    usb_wait present >/dev/null || { fail "$USB_VID:$USB_PID did not appear on the USB host side"; return; }
+    argil connect --device "usb:$USB_VID:$USB_PID" --seconds "$secs" --arm --out "$OUT/$CHECK.out" \
+        --telemetry "$OUT/$CHECK.telemetry.csv" >"$OUT/$CHECK.connect.log" 2>&1 &
+    cpid=$!
+    sleep 3
+    echo "" >"$(gadget_dir)/UDC" 2>"$OUT/$CHECK.unbind.err" || { kill "$cpid"; fail "unbind: $(cat "$OUT/$CHECK.unbind.err")"; return; }
+    gone=$(usb_wait absent) || { kill "$cpid"; fail "the device did not leave the USB host side after unbind"; return; }
+    sleep 1
+    echo "$USB_UDC" >"$(gadget_dir)/UDC" 2>"$OUT/$CHECK.bind.err" || { kill "$cpid"; fail "rebind: $(cat "$OUT/$CHECK.bind.err")"; return; }
+    back=$(usb_wait present) || { kill "$cpid"; fail "the device did not come back after rebind"; return; }
+    st=0; wait "$cpid" || st=$?
+    board_alive || { fail "the daemon died across the replug: $(board_tail)"; return; }
+    [ "$st" = 0 ] || { fail "argil connect exit $st: $(tail -n 3 "$OUT/$CHECK.connect.log" | tr '\n' '|')"; return; }
+    log="$OUT/$CHECK.connect.log"
+    rc=$(sed -n 's/.*reconnects \([0-9]*\),.*/\1/p' "$log" | tail -n 1)
+    act=$(sed -n 's/.*ACTIVE entered \([0-9]*\) times.*/\1/p' "$log" | tail -n 1)
+    hel=$(sed -n 's/.*board HELLOs \([0-9]*\);.*/\1/p' "$log" | tail -n 1)
+    [ "${rc:-0}" -ge 1 ] || { fail "connect saw no reconnect: $(grep 'link  ' "$log" | tail -n 1)"; return; }
+    [ "${hel:-0}" -ge 2 ] || { fail "no resynchronisation (board HELLOs ${hel:-0})"; return; }
+    [ "${act:-0}" -ge 2 ] || { fail "the board was not ACTIVE again after the replug (ACTIVE entered ${act:-0} times)"; return; }
+    grep -q "board  *ACTIVE;" "$log" || { fail "the session did not end ACTIVE: $(grep 'board  ' "$log" | tail -n 1)"; return; }
+    pass "unplug (device gone after $gone ms) and replug (back after $back ms) under argil connect: reconnects $rc, board HELLOs $hel, ACTIVE entered $act times, ended ACTIVE"
+}
+
 # udp_session MODE: the board over real UDP in the VM with tests/sys/board_udp_client (HELLO,
 # window, arm, ACTIVE; host silent -> fade and FAULT; new host -> ACTIVE again). MODE sim:
 # argil-board --bus sim (the arm in-process); MODE can: the arm is argil-sim on the CAN bus.
