@@ -17,44 +17,12 @@
 #include "host/io/io_util.h"
 #include "shared/crc32c.h"
 
-static char g_dir[64];
+#include "tests/unit/test_files.h"
 
 static int setup_dir(void **state)
 {
     (void)state;
-    strcpy(g_dir, "/tmp/argil_test_argil_XXXXXX");
-    return mkdtemp(g_dir) != NULL ? 0 : -1;
-}
-
-static int teardown_dir(void **state)
-{
-    (void)state;
-    char cmd[128];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static uint8_t *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    assert_non_null(fp);
-    fseek(fp, 0, SEEK_END);
-    const long n = ftell(fp);
-    rewind(fp);
-    uint8_t *b = malloc((size_t)n + 1);
-    assert_non_null(b);
-    assert_int_equal(fread(b, 1, (size_t)n, fp), (size_t)n);
-    fclose(fp);
-    *len = (size_t)n;
-    return b;
-}
-
-static void spit(const char *path, const void *data, size_t len)
-{
-    FILE *fp = fopen(path, "wb");
-    assert_non_null(fp);
-    assert_int_equal(fwrite(data, 1, len, fp), len);
-    assert_int_equal(fclose(fp), 0);
+    return test_dir_make("argil_test_argil");
 }
 
 static void make_doc(argil_doc_t *d, bool extras)
@@ -90,7 +58,7 @@ static void test_round_trip(void **state)
 {
     (void)state;
     char p[128], err[256];
-    snprintf(p, sizeof(p), "%s/a.argil", g_dir);
+    snprintf(p, sizeof(p), "%s/a.argil", g_test_dir);
     for (int extras = 0; extras < 2; extras++) {
         argil_doc_t d, r;
         make_doc(&d, extras);
@@ -131,15 +99,15 @@ static void test_atomic(void **state)
 {
     (void)state;
     char p[128], tmp[160], err[256];
-    snprintf(p, sizeof(p), "%s/keep.argil", g_dir);
+    snprintf(p, sizeof(p), "%s/keep.argil", g_test_dir);
     snprintf(tmp, sizeof(tmp), "%s.tmp", p);
     argil_doc_t d, r;
     make_doc(&d, true);
     assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
     size_t len0;
-    uint8_t *before = slurp(p, &len0);
+    uint8_t *before = test_slurp(p, &len0);
     /* a half-written temp file from a crash: the saved file still reads */
-    spit(tmp, before, len0 / 2);
+    test_spit(tmp, before, len0 / 2);
     assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
     argil_doc_free(&r);
     /* a save that fails (NaN in the model) leaves the file byte for byte as it was */
@@ -154,7 +122,7 @@ static void test_atomic(void **state)
     assert_non_null(strstr(err, "fopen"));
     rmdir(tmp);
     size_t len1;
-    uint8_t *after = slurp(p, &len1);
+    uint8_t *after = test_slurp(p, &len1);
     assert_int_equal(len0, len1);
     assert_memory_equal(before, after, len0);
     /* and a successful save replaces it whole, leaving no temp file */
@@ -173,17 +141,17 @@ static void test_any_corruption_refused(void **state)
 {
     (void)state;
     char p[128], q[160], err[256];
-    snprintf(p, sizeof(p), "%s/c.argil", g_dir);
-    snprintf(q, sizeof(q), "%s/bad.argil", g_dir);
+    snprintf(p, sizeof(p), "%s/c.argil", g_test_dir);
+    snprintf(q, sizeof(q), "%s/bad.argil", g_test_dir);
     argil_doc_t d, r;
     make_doc(&d, true);
     assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
     argil_doc_free(&d);
     size_t len;
-    uint8_t *b = slurp(p, &len);
+    uint8_t *b = test_slurp(p, &len);
     for (size_t i = 0; i < len; i += 3) {
         b[i] ^= (uint8_t)(1u << (i % 8));
-        spit(q, b, len);
+        test_spit(q, b, len);
         const argil_err_t e = argil_file_read(q, &r, err, sizeof(err));
         if (e != ARGIL_ERR_PARSE || strstr(err, q) == NULL || strstr(err, "byte ") == NULL)
             fail_msg("flip at byte %zu: %d '%s'", i, e, err);
@@ -191,7 +159,7 @@ static void test_any_corruption_refused(void **state)
         b[i] ^= (uint8_t)(1u << (i % 8));
     }
     for (size_t cut = 0; cut < len; cut += 17) {
-        spit(q, b, cut);
+        test_spit(q, b, cut);
         assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
     }
     free(b);
@@ -233,7 +201,7 @@ static void b_end(build_t *f, const char *path, uint32_t version)
     io_put_u32le(f->b + 24, 0);
     io_put_u32le(f->b + 28, crc32c(0, f->b, 28));
     io_put_u32le(f->b + f->len, crc32c(0, f->b, f->len));
-    spit(path, f->b, f->len + 4);
+    test_spit(path, f->b, f->len + 4);
 }
 
 /* A 1x1x2 GRID payload with the given density and spacing. */
@@ -266,12 +234,12 @@ static void test_each_rule(void **state)
 {
     (void)state;
     char p[128];
-    snprintf(p, sizeof(p), "%s/r.argil", g_dir);
+    snprintf(p, sizeof(p), "%s/r.argil", g_test_dir);
     build_t f;
     uint8_t g[512], x[64] = {0};
     const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
 
-    spit(p, "ARGIL", 5);
+    test_spit(p, "ARGIL", 5);
     expect_rule(p, "byte 5", "shorter than the 32-byte header");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
@@ -282,11 +250,11 @@ static void test_each_rule(void **state)
     assert_float_equal(ok.grid.density[1], 0.5f, 0);
     argil_doc_free(&ok);
     f.b[0] = 'X';
-    spit(p, f.b, f.len + 4);
+    test_spit(p, f.b, f.len + 4);
     expect_rule(p, "byte 0", "not an .argil file");
     b_end(&f, p, 1);
     f.b[20] = 1;
-    spit(p, f.b, f.len + 4);
+    test_spit(p, f.b, f.len + 4);
     expect_rule(p, "byte 28", "header checksum mismatch");
     b_end(&f, p, 2);
     expect_rule(p, "byte 8", "format version 2; this argil reads 1..1");
@@ -296,11 +264,11 @@ static void test_each_rule(void **state)
     f.n_sec = 1;
     b_end(&f, p, 1);
     f.b[f.len + 4] = 0; /* one byte more than declared */
-    spit(p, f.b, f.len + 5);
+    test_spit(p, f.b, f.len + 5);
     expect_rule(p, "byte 16", "declared file length differs");
     b_end(&f, p, 1);
     f.b[40] ^= 1; /* inside the GRID payload: the file checksum catches it first */
-    spit(p, f.b, f.len + 4);
+    test_spit(p, f.b, f.len + 4);
     char at[32];
     snprintf(at, sizeof(at), "byte %zu", f.len);
     expect_rule(p, at, "file checksum mismatch");
@@ -419,7 +387,7 @@ static void test_each_rule(void **state)
     assert_int_equal(argil_file_read(p, &ok, err, sizeof(err)), ARGIL_OK);
     assert_float_equal(ok.grid.material.node_mass, 2.0f, 0);
     argil_doc_free(&ok);
-    spit(p, "", 0);
+    test_spit(p, "", 0);
     expect_rule(p, "byte 0", "shorter than the 32-byte header");
 }
 
@@ -451,7 +419,7 @@ static void test_octb(void **state)
 {
     (void)state;
     char p[128], err[256];
-    snprintf(p, sizeof(p), "%s/o.argil", g_dir);
+    snprintf(p, sizeof(p), "%s/o.argil", g_test_dir);
     argil_doc_t d, r;
     make_doc(&d, false);
     uint32_t links[9] = {1, 0, 0, 0, 0, 0, 0, 0, 0};
@@ -529,5 +497,5 @@ int main(void)
         cmocka_unit_test(test_each_rule),
         cmocka_unit_test(test_octb),
     };
-    return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+    return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }

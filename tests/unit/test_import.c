@@ -20,34 +20,12 @@
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
 
-static char g_dir[64];
+#include "tests/unit/test_files.h"
 
 static int setup_dir(void **state)
 {
     (void)state;
-    strcpy(g_dir, "/tmp/argil_test_import_XXXXXX");
-    return mkdtemp(g_dir) != NULL ? 0 : -1;
-}
-
-static int teardown_dir(void **state)
-{
-    (void)state;
-    char cmd[128];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static void path_of(char *out, size_t n, const char *name)
-{
-    snprintf(out, n, "%s/%s", g_dir, name);
-}
-
-static void spit(const char *path, const void *data, size_t len)
-{
-    FILE *fp = fopen(path, "wb");
-    assert_non_null(fp);
-    assert_int_equal(fwrite(data, 1, len, fp), len);
-    assert_int_equal(fclose(fp), 0);
+    return test_dir_make("argil_test_import");
 }
 
 /* A painted sphere mesh (closed). */
@@ -94,7 +72,7 @@ static void test_round_trips(void **state)
         export_format_t fmt;
     } cases[] = {{"a.ply", EXPORT_PLY_BINARY}, {"b.ply", EXPORT_PLY_ASCII}, {"c.obj", EXPORT_OBJ}};
     for (size_t k = 0; k < 3; k++) {
-        path_of(p, sizeof(p), cases[k].name);
+        test_path(p, sizeof(p), cases[k].name);
         assert_int_equal(mesh_export(p, &m, cases[k].fmt, err, sizeof(err)), ARGIL_OK);
         assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
         assert_true(nrm);
@@ -106,7 +84,7 @@ static void test_round_trips(void **state)
             assert_float_equal(r.normal[i], m.normal[i], 1e-5f);
     }
     /* STL: welded back to the same closed surface with the same volume. */
-    path_of(p, sizeof(p), "d.stl");
+    test_path(p, sizeof(p), "d.stl");
     assert_int_equal(mesh_export(p, &m, EXPORT_STL, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_vert, m.n_vert);
@@ -114,10 +92,10 @@ static void test_round_trips(void **state)
     assert_true(mesh_watertight(&r, NULL, NULL));
     assert_float_equal(mesh_volume_m3(&r), mesh_volume_m3(&m), 1e-12);
     /* ASCII STL of one facet, and a binary STL whose header starts with "solid". */
-    path_of(p, sizeof(p), "e.stl");
+    test_path(p, sizeof(p), "e.stl");
     const char *a = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
                     "   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
-    spit(p, a, strlen(a));
+    test_spit(p, a, strlen(a));
     assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_tri, 1);
     assert_float_equal(r.normal[2], 1.0f, 1e-6f);
@@ -125,24 +103,24 @@ static void test_round_trips(void **state)
     bin[80] = 1;
     for (int k = 0; k < 3; k++)
         memcpy(bin + 96 + 12 * k + 4 * k, &(float){1.0f}, 4);
-    spit(p, bin, sizeof(bin));
+    test_spit(p, bin, sizeof(bin));
     assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_vert, 3);
     /* XYZ with and without normals, comments and blank lines. */
-    path_of(p, sizeof(p), "f.xyz");
+    test_path(p, sizeof(p), "f.xyz");
     const char *x6 = "# cloud\n0 0 1 0 0 1\n\n1 0 0 1 0 0\r\n0 1 0 0 1 0\n";
-    spit(p, x6, strlen(x6));
+    test_spit(p, x6, strlen(x6));
     assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_vert, 3);
     assert_true(nrm);
     assert_float_equal(r.normal[3], 1.0f, 0);
     const char *x3 = "0 0 1\n1.5e-3 -2 0\n";
-    spit(p, x3, strlen(x3));
+    test_spit(p, x3, strlen(x3));
     assert_int_equal(xyz_read(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
     assert_false(nrm);
     assert_float_equal(r.pos[3], 1.5e-3f, 0);
     /* PLY variants: big-endian doubles with an extra element and a quad face; OBJ forms. */
-    path_of(p, sizeof(p), "g.ply");
+    test_path(p, sizeof(p), "g.ply");
     const char *ph = "ply\nformat binary_big_endian 1.0\nelement camera 1\nproperty uchar k\n"
                      "element vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
                      "element face 1\nproperty list uchar uint vertex_index\nend_header\n";
@@ -166,16 +144,16 @@ static void test_round_trips(void **state)
     uint8_t file[512];
     memcpy(file, ph, strlen(ph));
     memcpy(file + strlen(ph), body, o);
-    spit(p, file, strlen(ph) + o);
+    test_spit(p, file, strlen(ph) + o);
     assert_int_equal(ply_load(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_vert, 4);
     assert_int_equal(r.n_tri, 2);
     assert_false(nrm);
     assert_float_equal(r.pos[6], 1.0f, 0);
-    path_of(p, sizeof(p), "h.obj");
+    test_path(p, sizeof(p), "h.obj");
     const char *ob = "mtllib x.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\n"
                      "vn 0 0 1\ng g\ns off\nusemtl m\nf 1/1/1 2/1/1 3/1/1 4/1/1\nf -4 -2 -1 # tri\n";
-    spit(p, ob, strlen(ob));
+    test_spit(p, ob, strlen(ob));
     assert_int_equal(obj_read(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(r.n_tri, 3);
     assert_true(nrm); /* every vertex got vn 1 through the quad */
@@ -196,8 +174,8 @@ static void expect_err(reader_fn fn, const char *name, const void *data, size_t 
                        argil_err_t want, const char *where, const char *rule)
 {
     char p[128], err[512] = "";
-    path_of(p, sizeof(p), name);
-    spit(p, data, len);
+    test_path(p, sizeof(p), name);
+    test_spit(p, data, len);
     mesh_t m;
     mesh_init(&m);
     const argil_err_t got = fn(p, &m, NULL, err, sizeof(err));
@@ -313,12 +291,12 @@ static void test_ply_errors(void **state)
     buf[o + 12] = 3;
     expect_err(ply_load, "e.ply", buf, o + 16, ARGIL_ERR_PARSE, "byte", "file ends inside face 0");
     char p[128], err[256];
-    path_of(p, sizeof(p), "missing.ply");
+    test_path(p, sizeof(p), "missing.ply");
     mesh_t m;
     mesh_init(&m);
     assert_int_equal(ply_load(p, &m, NULL, err, sizeof(err)), ARGIL_ERR_IO);
     assert_non_null(strstr(err, "cannot open"));
-    assert_int_equal(ply_load(g_dir, &m, NULL, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(ply_load(g_test_dir, &m, NULL, err, sizeof(err)), ARGIL_ERR_IO);
     assert_non_null(strstr(err, "not a regular file"));
     assert_int_equal(mesh_import("x.foo", &m, NULL, err, sizeof(err)), ARGIL_ERR_ARG);
     assert_non_null(strstr(err, "unknown extension"));
@@ -421,8 +399,8 @@ static void test_volumes(void **state)
         raw[2 * i] = (uint8_t)(i >> 8);
         raw[2 * i + 1] = (uint8_t)(i * 10);
     }
-    path_of(p, sizeof(p), "v.raw");
-    spit(p, raw, sizeof(raw));
+    test_path(p, sizeof(p), "v.raw");
+    test_spit(p, raw, sizeof(raw));
     volume_t v;
     const int32_t dims[3] = {2, 3, 4};
     vol_type_t t;
@@ -439,8 +417,8 @@ static void test_volumes(void **state)
                          "space directions: (0.5,0,0) (0,0.5,0) (0,0,2)\n"
                          "space origin: (1,2,3)\nkey:=value\n\n");
     memcpy(hdr + n, raw, sizeof(raw));
-    path_of(p, sizeof(p), "v.nrrd");
-    spit(p, hdr, (size_t)n + sizeof(raw));
+    test_path(p, sizeof(p), "v.nrrd");
+    test_spit(p, hdr, (size_t)n + sizeof(raw));
     assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), ARGIL_OK);
     assert_float_equal(v.value[5], 50.0f, 0);
     assert_float_equal(v.spacing_m[2], 2.0f, 1e-6f);
@@ -448,8 +426,8 @@ static void test_volumes(void **state)
     volume_free(&v);
     n = sprintf(hdr, "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n"
                      "endian: big\nspacings: 1 1 1\ndata file: v.raw\n\n");
-    path_of(p, sizeof(p), "d.nhdr");
-    spit(p, hdr, (size_t)n);
+    test_path(p, sizeof(p), "d.nhdr");
+    test_spit(p, hdr, (size_t)n);
     assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), ARGIL_OK);
     assert_float_equal(v.value[1], 10.0f, 0);
     volume_free(&v);
@@ -515,5 +493,5 @@ int main(void)
         cmocka_unit_test(test_stl_errors),    cmocka_unit_test(test_obj_xyz_errors),
         cmocka_unit_test(test_volumes),
     };
-    return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+    return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }

@@ -19,61 +19,24 @@
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
 
+#include "tests/unit/test_files.h"
+
 #define EDGE_X 10
 #define EDGE_Y 9
 #define EDGE_Z 8
 #define N_SAMPLES (EDGE_X * EDGE_Y * EDGE_Z)
 #define MAX_STEPS 40
 
-static char g_dir[64];
-
 static int setup_dir(void **state)
 {
     (void)state;
-    strcpy(g_dir, "/tmp/argil_test_journal_XXXXXX");
-    return mkdtemp(g_dir) != NULL ? 0 : -1;
-}
-
-static int teardown_dir(void **state)
-{
-    (void)state;
-    char cmd[128];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static void path_in(char *out, size_t cap, const char *name)
-{
-    snprintf(out, cap, "%s/%s", g_dir, name);
-}
-
-static uint8_t *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    assert_non_null(fp);
-    fseek(fp, 0, SEEK_END);
-    const long n = ftell(fp);
-    rewind(fp);
-    uint8_t *b = malloc((size_t)n + 1);
-    assert_non_null(b);
-    assert_int_equal(fread(b, 1, (size_t)n, fp), (size_t)n);
-    fclose(fp);
-    *len = (size_t)n;
-    return b;
-}
-
-static void spit(const char *path, const void *data, size_t len)
-{
-    FILE *fp = fopen(path, "wb");
-    assert_non_null(fp);
-    assert_int_equal(fwrite(data, 1, len, fp), len);
-    assert_int_equal(fclose(fp), 0);
+    return test_dir_make("argil_test_journal");
 }
 
 static long file_size(const char *name)
 {
     char p[128];
-    path_in(p, sizeof(p), name);
+    test_path(p, sizeof(p), name);
     struct stat st;
     return stat(p, &st) == 0 ? (long)st.st_size : -1;
 }
@@ -110,7 +73,7 @@ static sess_t *sess_new(const journal_cfg_t *cfg)
     if (cfg)
         c = *cfg;
     char err[512] = "";
-    assert_int_equal(journal_open(&s->j, g_dir, &s->grid, &c, 0.0, 0.0, err, sizeof(err)),
+    assert_int_equal(journal_open(&s->j, g_test_dir, &s->grid, &c, 0.0, 0.0, err, sizeof(err)),
                      ARGIL_OK);
     memcpy(s->after[0], s->grid.density, sizeof(s->after[0]));
     s->mat_after[0] = s->grid.material;
@@ -185,7 +148,7 @@ static void test_round_trip(void **state)
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_density(doc.grid.density, s->grid.density);
     assert_density(doc.grid.rest, s->grid.density);
     assert_int_equal(info.records, 24);
@@ -200,13 +163,13 @@ static void test_round_trip(void **state)
 
     /* The writer's own model file and the recovery's are the same bytes. */
     char a[128], b[128];
-    path_in(a, sizeof(a), "writer.argil");
-    path_in(b, sizeof(b), "recovered.argil");
+    test_path(a, sizeof(a), "writer.argil");
+    test_path(b, sizeof(b), "recovered.argil");
     assert_int_equal(journal_write_model(&s->j, s->grid.density, 24, a, err, sizeof(err)),
                      ARGIL_OK);
     assert_int_equal(argil_file_write(b, &doc, err, sizeof(err)), ARGIL_OK);
     size_t la, lb;
-    uint8_t *ba = slurp(a, &la), *bb = slurp(b, &lb);
+    uint8_t *ba = test_slurp(a, &la), *bb = test_slurp(b, &lb);
     assert_int_equal(la, lb);
     assert_memory_equal(ba, bb, la);
     free(ba);
@@ -215,13 +178,13 @@ static void test_round_trip(void **state)
 
     /* Probe (no base needed) sees the same. */
     journal_info_t p;
-    assert_int_equal(journal_probe(g_dir, &p, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_probe(g_test_dir, &p, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(p.records, 24);
 
     /* A clean end removes the journal and its base. */
-    assert_true(journal_exists(g_dir));
+    assert_true(journal_exists(g_test_dir));
     assert_int_equal(journal_finish(&s->j, err, sizeof(err)), ARGIL_OK);
-    assert_false(journal_exists(g_dir));
+    assert_false(journal_exists(g_test_dir));
     assert_int_equal(file_size("journal-base-0.argil"), -1);
     sess_free(s);
 }
@@ -233,7 +196,7 @@ static void test_no_records_gives_the_base(void **state)
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 0);
     assert_density(doc.grid.density, s->after[0]);
     argil_doc_free(&doc);
@@ -248,9 +211,9 @@ static void test_torn_tail_every_byte(void **state)
     sess_steps(s, 4); /* steps 0..3: four records */
     assert_int_equal(s->records, 4);
     char jp[128];
-    path_in(jp, sizeof(jp), JOURNAL_FILE);
+    test_path(jp, sizeof(jp), JOURNAL_FILE);
     size_t len;
-    uint8_t *full = slurp(jp, &len);
+    uint8_t *full = test_slurp(jp, &len);
     /* Find where the last record starts by walking the length fields. */
     size_t at = JOURNAL_HEADER_BYTES, last = 0;
     while (at < len) {
@@ -260,22 +223,22 @@ static void test_torn_tail_every_byte(void **state)
     assert_int_equal(at, len);
     assert_true(len - last > 100);
     for (size_t cut = last; cut < len; cut++) {
-        spit(jp, full, cut);
+        test_spit(jp, full, cut);
         argil_doc_t doc;
         journal_info_t info;
         char err[512] = "";
-        assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+        assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
         assert_int_equal(info.records, 3);
         assert_int_equal(info.torn_bytes, cut - last);
         assert_density(doc.grid.density, s->after[3]);
         argil_doc_free(&doc);
     }
     /* A cut inside the header is a clear refusal, not a crash. */
-    spit(jp, full, JOURNAL_HEADER_BYTES - 1);
+    test_spit(jp, full, JOURNAL_HEADER_BYTES - 1);
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "shorter than the journal header"));
     assert_null(doc.grid.density);
     free(full);
@@ -288,19 +251,19 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
     sess_t *s = sess_new(NULL);
     sess_steps(s, 4);
     char jp[128];
-    path_in(jp, sizeof(jp), JOURNAL_FILE);
+    test_path(jp, sizeof(jp), JOURNAL_FILE);
     size_t len;
-    uint8_t *full = slurp(jp, &len);
+    uint8_t *full = test_slurp(jp, &len);
     const size_t r1 = JOURNAL_HEADER_BYTES, r2 = r1 + 8 + io_get_u32le(full + r1);
     const size_t r3 = r2 + 8 + io_get_u32le(full + r2);
     const size_t r4 = r3 + 8 + io_get_u32le(full + r3);
     /* A flipped bit inside record 2's values. */
     full[r2 + 70] ^= 0x10;
-    spit(jp, full, len);
+    test_spit(jp, full, len);
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "record 2: checksum mismatch"));
     char want[64];
     snprintf(want, sizeof(want), "byte %zu:", r2);
@@ -313,8 +276,8 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
 
     /* The same flip in the last record, which ends the file, reads as a torn write. */
     full[r4 + 70] ^= 0x10;
-    spit(jp, full, len);
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    test_spit(jp, full, len);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 3);
     assert_int_equal(info.torn_bytes, len - r4);
     assert_density(doc.grid.density, s->after[3]);
@@ -329,19 +292,19 @@ static void test_wrong_base_refused(void **state)
     sess_t *s = sess_new(NULL);
     sess_steps(s, 3);
     char err[512] = "", bp[128];
-    path_in(bp, sizeof(bp), "journal-base-0.argil");
+    test_path(bp, sizeof(bp), "journal-base-0.argil");
     /* Another model under the base's name. */
     grid_fill_sphere(&s->grid, vec3(0, 0, 0), 0.004f);
     assert_int_equal(journal_write_model(&s->j, s->grid.density, 0, bp, err, sizeof(err)),
                      ARGIL_OK);
     argil_doc_t doc;
     journal_info_t info;
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "is not the one this journal continues"));
     assert_null(doc.grid.density);
     /* No base at all. */
     assert_int_equal(unlink(bp), 0);
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_IO);
     assert_non_null(strstr(err, "journal-base-0.argil"));
     assert_null(doc.grid.density);
     sess_free(s);
@@ -362,7 +325,7 @@ static void test_checkpoint_rotation(void **state)
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.checkpoint, 1);
     assert_true(info.first_seq > 1);
     assert_int_equal(info.last_seq, s->records);
@@ -406,8 +369,8 @@ static uint8_t *one_record(size_t *len)
     char err[512] = "", jp[128];
     assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
     sess_free(s);
-    path_in(jp, sizeof(jp), JOURNAL_FILE);
-    return slurp(jp, len);
+    test_path(jp, sizeof(jp), JOURNAL_FILE);
+    return test_slurp(jp, len);
 }
 
 static void fix_record_crc(uint8_t *b, size_t len)
@@ -586,7 +549,7 @@ static void test_box_hint(void **state)
     assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
     argil_doc_t doc;
     journal_info_t info;
-    assert_int_equal(journal_recover(g_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 2);
     assert_density(doc.grid.density, d);
     argil_doc_free(&doc);
@@ -599,12 +562,12 @@ static void test_discard_and_bad_config(void **state)
     sess_t *s = sess_new(NULL);
     sess_steps(s, 3);
     char err[512] = "";
-    assert_true(journal_exists(g_dir));
-    assert_int_equal(journal_discard(g_dir, err, sizeof(err)), ARGIL_OK);
-    assert_false(journal_exists(g_dir));
+    assert_true(journal_exists(g_test_dir));
+    assert_int_equal(journal_discard(g_test_dir, err, sizeof(err)), ARGIL_OK);
+    assert_false(journal_exists(g_test_dir));
     assert_int_equal(file_size("journal-base-0.argil"), -1);
     journal_info_t info;
-    assert_int_equal(journal_probe(g_dir, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(journal_probe(g_test_dir, &info, err, sizeof(err)), ARGIL_ERR_IO);
     sess_free(s);
 
     journal_t j;
@@ -614,15 +577,15 @@ static void test_discard_and_bad_config(void **state)
     journal_cfg_t c;
     journal_cfg_default(&c);
     c.autosave_s = 0.0f;
-    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(journal_open(&j, g_test_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_ERR_ARG);
     journal_cfg_default(&c);
     assert_int_equal(journal_open(&j, "/nonexistent/argil", &g, &c, 0.0, 0.0, err, sizeof(err)),
                      ARGIL_ERR_IO);
     assert_non_null(strstr(err, "/nonexistent/argil"));
     /* A journal already there is never overwritten. */
-    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(journal_open(&j, g_test_dir, &g, &c, 0.0, 0.0, err, sizeof(err)), ARGIL_OK);
     journal_close(&j);
-    assert_int_equal(journal_open(&j, g_dir, &g, &c, 0.0, 0.0, err, sizeof(err)),
+    assert_int_equal(journal_open(&j, g_test_dir, &g, &c, 0.0, 0.0, err, sizeof(err)),
                      ARGIL_ERR_STATE);
     assert_non_null(strstr(err, "unfinished session"));
     grid_free(&g);
@@ -631,17 +594,17 @@ static void test_discard_and_bad_config(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(test_round_trip, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_no_records_gives_the_base, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_torn_tail_every_byte, setup_dir, teardown_dir),
+        cmocka_unit_test_setup_teardown(test_round_trip, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_no_records_gives_the_base, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_torn_tail_every_byte, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_bad_crc_in_the_middle_stops_there, setup_dir,
-                                        teardown_dir),
-        cmocka_unit_test_setup_teardown(test_wrong_base_refused, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_checkpoint_rotation, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_autosave_interval, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, teardown_dir),
-        cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, teardown_dir),
+                                        test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_wrong_base_refused, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_rotation, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_autosave_interval, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, test_dir_teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
