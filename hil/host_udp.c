@@ -12,13 +12,16 @@
  * With a SCENARIO (a hil/scenarios file) it is the scenario's host side instead: the host's
  * protocol peer (host/app/peer.c: tool, windows around the tool over a clay sphere, heartbeats,
  * ARM) so the board goes ACTIVE and sculpts, and at their times the host-side steps: rearm,
- * link lost / restore / delay / duplicate / reorder / garbage. Its clock starts when it starts
- * (start it together with argil-sim), or with "--sync CAN_IF" at the first drive frame on
- * the bus, i.e. when argil-sim's scenario starts. It prints one line per step performed; a step it cannot
- * perform over UDP (overrun, nan_tool) is printed as "unsupported" and the exit status is 3.
- * Its heartbeats come from their own thread every 5 ms of wall time at HIL_FIFO_PRIO, while
- * the peer's loop (global solve limited to 20 Hz here: this host tests the board, the solve is
- * tested elsewhere; windows) runs 20 below, under the board's link thread: on a slow emulated
+ * link lost / restore / delay / duplicate / reorder / garbage / nan_tool (a TOOL frame whose
+ * radius is NaN, CRC valid). "--sync CAN_IF": its clock is the board's, one 1 ms step per SYNC
+ * on the bus from the first drive frame (sim/scn_clock.h, as argil-sim's); "--follow EVENTS"
+ * (argil-sim's event log, same machine): each step is performed when argil-sim's log says its
+ * clock reached it, so both sides keep one clock; else the clock starts with the program. It
+ * prints one line per step performed; a step it cannot perform over UDP (overrun) is printed
+ * as "unsupported" and the exit status is 3. The clock, the steps and the heartbeats (every 5
+ * ms of wall time) run in a thread at HIL_FIFO_PRIO, while the peer's loop (global solve
+ * limited to 1 Hz here: this host tests the board, the solve is tested elsewhere; windows)
+ * runs 9 below, under the board's link thread: on a slow emulated
  * rig neither the solve holds the heartbeats back nor the peer starves the board's link. */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
@@ -26,6 +29,9 @@
 #include <linux/can/raw.h>
 #include <net/if.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
@@ -39,8 +45,10 @@
 #include "firmware/core/safety.h"
 #include "host/app/peer.h"
 #include "host/model/grid.h"
+#include "shared/crc32c.h"
 #include "shared/proto.h"
 #include "sim/scenario.h"
+#include "sim/scn_clock.h"
 #include "sim/sim_device.h"
 
 static double realtime_s(void)
@@ -68,7 +76,9 @@ static void send_msg(int fd, const struct sockaddr_in *to, proto_msg_t *m, uint3
 
 /* ---- scenario host ---- */
 #define HELD_MAX 64u
-#define HOST_LOOP_DROP 20           /* the peer loop's FIFO priority below the heartbeats' */
+#define HOST_LOOP_DROP 9            /* the peer loop's FIFO priority below the heartbeats':
+                                       above argil-sim's and candump's, under the board's link
+                                       thread; with its solve at 1 Hz the loop is short */
 
 typedef struct {
     uint64_t due_us;
@@ -94,6 +104,23 @@ typedef struct {
     atomic_bool board_seen, stop;
     atomic_uint window_version, impulse_seq; /* the peer's, for the beat thread's heartbeats */
     atomic_uint beats;
+    /* the scenario clock and its steps, run by the real-time thread (shost_rt) */
+    const scenario_t *scn;
+    const msg_tool_t *tool;         /* the peer's tool, for nan_tool */
+    int sync_fd;                    /* CAN socket for the clock, -1: wall clock */
+    const char *follow_path;        /* argil-sim's event log: its clock decides the steps */
+    int follow_fd;
+    char follow_buf[4096];
+    size_t follow_len;
+    uint64_t end_seen_us;           /* when argil-sim's end line was read (0: not yet) */
+    int64_t scn_end_us;             /* the clock stops the run here */
+    scn_clock_t clk;
+    bool synced;
+    uint32_t next_step;
+    atomic_uint rearm_ms;           /* ARM heartbeats wanted (ms), for the main loop */
+    atomic_int unsupported;
+    atomic_bool synced_flag, done;
+    atomic_llong now_us;            /* scenario time, for the main loop's prints */
 } shost_t;
 
 static void raw_send(shost_t *h, const uint8_t *f, size_t len)
@@ -150,22 +177,133 @@ static bool shost_send(void *ctx, const uint8_t *f, size_t len)
     return ok;
 }
 
-/* Sends a heartbeat carrying the peer's window version and impulse ack every 5 ms of
- * CLOCK_MONOTONIC until h->stop, whatever the main loop is doing. */
-static void *shost_beat(void *arg)
+static bool shost_step(shost_t *h, const scn_step_t *st, const msg_tool_t *tool,
+                       uint32_t *rearm_ms);
+
+/* Reads the clock's CAN socket: the first drive frame starts the scenario clock, each SYNC
+ * after it is one tick; with nothing more, the wall clock may step (sim/scn_clock.h). */
+static void shost_clock(shost_t *h)
+{
+    struct can_frame cf;
+    while (h->sync_fd >= 0 && read(h->sync_fd, &cf, sizeof(cf)) == (ssize_t)sizeof(cf)) {
+        const uint32_t id = cf.can_id & CAN_SFF_MASK;
+        if (!h->synced && id != 0x080u && h->follow_path == NULL) {
+            h->synced = true;
+            scn_clock_init(&h->clk, true, (int64_t)mono_us());
+            printf("%.6f scenario clock starts (drive frame 0x%03X)\n", realtime_s(),
+                   (unsigned)id);
+        } else if (h->synced && id == 0x080u) {
+            (void)scn_clock_sync(&h->clk, (int64_t)mono_us());
+        }
+    }
+    if (h->synced)
+        (void)scn_clock_idle(&h->clk, (int64_t)mono_us());
+}
+
+/* Performs one host-side step, printed "T step line=N …" once done. */
+static void shost_do(shost_t *h, const scn_step_t *st)
+{
+    uint32_t rearm_ms = 0;
+    pthread_mutex_lock(&h->mu);
+    const bool ok = shost_step(h, st, h->tool, &rearm_ms);
+    pthread_mutex_unlock(&h->mu);
+    if (rearm_ms > 0)
+        atomic_store(&h->rearm_ms, rearm_ms);
+    printf("%.6f step line=%u %s%s\n", realtime_s(), st->line, st->text, ok ? "" : " unsupported");
+    if (!ok)
+        atomic_fetch_add(&h->unsupported, 1);
+}
+
+/* With --follow: reads argil-sim's event log as it grows. Its start line starts the scenario,
+ * each "host line=N" (argil-sim's clock passing a host-side step) is performed at once, and
+ * its end line ends the run 100 ms later: one clock for both sides of the scenario. */
+static void shost_follow(shost_t *h)
+{
+    if (h->follow_fd < 0) {
+        h->follow_fd = open(h->follow_path, O_RDONLY | O_CLOEXEC);
+        if (h->follow_fd < 0)
+            return;
+    }
+    for (;;) {
+        const ssize_t n = read(h->follow_fd, h->follow_buf + h->follow_len,
+                               sizeof(h->follow_buf) - 1u - h->follow_len);
+        if (n <= 0)
+            break;
+        h->follow_len += (size_t)n;
+        h->follow_buf[h->follow_len] = '\0';
+        char *line = h->follow_buf, *nl;
+        while ((nl = strchr(line, '\n')) != NULL) {
+            *nl = '\0';
+            const char *host = strstr(line, ") host line=");
+            if (strstr(line, ") start scenario ") != NULL && !h->synced) {
+                h->synced = true;
+                printf("%.6f scenario clock starts (argil-sim's start line)\n", realtime_s());
+            } else if (host != NULL) {
+                const unsigned long ln = strtoul(host + 12, NULL, 10);
+                for (uint32_t i = 0; i < h->scn->n_steps; i++)
+                    if (h->scn->step[i].line == ln &&
+                        scenario_action_is_host_side(h->scn->step[i].action))
+                        shost_do(h, &h->scn->step[i]);
+            } else if (strstr(line, ") end ") != NULL && h->end_seen_us == 0) {
+                h->end_seen_us = mono_us();
+            }
+            line = nl + 1;
+        }
+        h->follow_len = (size_t)(h->follow_buf + h->follow_len - line);
+        memmove(h->follow_buf, line, h->follow_len);
+        if (h->follow_len == sizeof(h->follow_buf) - 1u)
+            h->follow_len = 0; /* a line longer than the buffer: not one of argil-sim's */
+    }
+}
+
+/* Performs the host-side steps that are due on this host's own clock. */
+static void shost_steps(shost_t *h)
+{
+    const scenario_t *scn = h->scn;
+    while (h->synced && h->next_step < scn->n_steps &&
+           scn->step[h->next_step].t_us <= h->clk.now_us) {
+        const scn_step_t *st = &scn->step[h->next_step++];
+        if (scenario_action_is_host_side(st->action))
+            shost_do(h, st);
+    }
+}
+
+/* The host's real-time side, at HIL_FIFO_PRIO: the scenario clock (it waits on the CAN socket,
+ * so a SYNC is counted as it comes and a step lands in the tick it names, however busy the
+ * peer is) and the host-side steps; and a heartbeat carrying the peer's window version and
+ * impulse ack every 5 ms of CLOCK_MONOTONIC until h->stop, whatever the main loop is doing. */
+static void *shost_rt(void *arg)
 {
     shost_t *h = arg;
     static proto_msg_t m;
     uint32_t seq = 0x20000000u;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    uint64_t next_beat = mono_us() + 5000u;
     while (!atomic_load(&h->stop)) {
-        ts.tv_nsec += 5000000L;
-        if (ts.tv_nsec >= 1000000000L) {
-            ts.tv_nsec -= 1000000000L;
-            ts.tv_sec++;
+        if (h->sync_fd >= 0) {
+            struct pollfd pfd = {.fd = h->sync_fd, .events = POLLIN};
+            const uint64_t now = mono_us();
+            (void)poll(&pfd, 1, next_beat > now ? 1 : 0);
+        } else {
+            const struct timespec nap = {0, 1000000L};
+            nanosleep(&nap, NULL);
         }
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+        shost_clock(h);
+        if (h->follow_path != NULL) {
+            shost_follow(h);
+            if (h->end_seen_us > 0 && mono_us() > h->end_seen_us + 100000u)
+                atomic_store(&h->done, true);
+        } else {
+            shost_steps(h);
+            if (h->synced && h->clk.now_us >= h->scn_end_us)
+                atomic_store(&h->done, true);
+        }
+        atomic_store(&h->synced_flag, h->synced);
+        atomic_store(&h->now_us, (long long)h->clk.now_us);
+        if (mono_us() < next_beat)
+            continue;
+        next_beat += 5000u;
+        if (next_beat < mono_us())
+            next_beat = mono_us() + 5000u; /* late: do not burst */
         if (!atomic_load(&h->board_seen))
             continue;
         memset(&m, 0, sizeof(m));
@@ -227,8 +365,37 @@ static void shost_simple(shost_t *h, uint8_t type, uint8_t command)
         (void)shost_send(h, buf, len);
 }
 
+/* Sends the peer's TOOL with its radius replaced by a NaN and the CRC made valid again (proto
+ * refuses to encode a non-finite field): what a broken host would send. False when the radius
+ * is not where the layout puts it (after kind, shape, filter, flags). */
+static bool shost_send_nan_tool(shost_t *h, const msg_tool_t *tool)
+{
+    static proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = MSG_TOOL;
+    m.u.tool = *tool;
+    m.u.tool.radius_m = 0.00123f; /* a marker to find at the radius's offset */
+    uint8_t buf[PROTO_FRAME_MAX];
+    size_t len = 0;
+    const size_t at = PROTO_HEADER_SIZE + 4u;
+    uint8_t mark[4];
+    memcpy(mark, &m.u.tool.radius_m, 4); /* little-endian host, as the wire */
+    if (proto_encode(&m, 0x30000000u, buf, sizeof(buf), &len) != PROTO_OK ||
+        len < at + 4u + PROTO_CRC_SIZE || memcmp(buf + at, mark, 4) != 0)
+        return false;
+    const float nan = NAN;
+    memcpy(buf + at, &nan, 4);
+    const uint32_t crc = crc32c(0u, buf, len - PROTO_CRC_SIZE);
+    for (int k = 0; k < 4; k++)
+        buf[len - PROTO_CRC_SIZE + (size_t)k] = (uint8_t)(crc >> (8 * k));
+    if (!h->lost)
+        raw_send(h, buf, len);
+    return true;
+}
+
 /* Performs one host-side step; false when this host cannot. */
-static bool shost_step(shost_t *h, const scn_step_t *st, uint32_t *rearm_ms)
+static bool shost_step(shost_t *h, const scn_step_t *st, const msg_tool_t *tool,
+                       uint32_t *rearm_ms)
 {
     switch (st->action) {
     case SCN_REARM: *rearm_ms = 50; return true;         /* ARM for 50 ms of heartbeats */
@@ -258,12 +425,14 @@ static bool shost_step(shost_t *h, const scn_step_t *st, uint32_t *rearm_ms)
             raw_send(h, junk, n);
         return true;
     }
+    case SCN_LINK_NAN: return shost_send_nan_tool(h, tool);
     default: return false;
     }
 }
 
 /* A raw CAN socket on iface that receives only the drives' NMT boot-up/heartbeat frames
- * (0x701-0x77F); -1 with one line on stderr when it cannot be opened. */
+ * (0x701-0x77F) and the board's SYNC (0x080); -1 with one line on stderr when it cannot be
+ * opened. */
 static int sync_can_open(const char *iface)
 {
     const int s = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK, CAN_RAW);
@@ -271,8 +440,12 @@ static int sync_can_open(const char *iface)
         fprintf(stderr, "hil-host: CAN socket for --sync %s: %s\n", iface, strerror(errno));
         return -1;
     }
-    const struct can_filter flt = {.can_id = 0x700u, .can_mask = CAN_SFF_MASK & ~0x7Fu};
-    (void)setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, &flt, sizeof(flt));
+    const struct can_filter flt[2] = {{.can_id = 0x700u, .can_mask = CAN_SFF_MASK & ~0x7Fu},
+                                      {.can_id = 0x080u, .can_mask = CAN_SFF_MASK}};
+    (void)setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, flt, sizeof(flt));
+    const int rcvbuf = 1 << 20; /* every SYNC counts: a starved moment must not drop one */
+    if (setsockopt(s, SOL_SOCKET, SO_RCVBUFFORCE, &rcvbuf, sizeof(rcvbuf)) != 0)
+        (void)setsockopt(s, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof(rcvbuf));
     struct sockaddr_can addr = {.can_family = AF_CAN, .can_ifindex = (int)if_nametoindex(iface)};
     if (addr.can_ifindex == 0 || bind(s, (struct sockaddr *)&addr, sizeof(addr)) != 0) {
         fprintf(stderr, "hil-host: cannot bind CAN interface '%s' for the scenario clock\n", iface);
@@ -285,7 +458,7 @@ static int sync_can_open(const char *iface)
 /* Runs the scenario's host side for `seconds` from its time 0: when sync_fd >= 0, the first
  * drive frame on it (argil-sim's drives boot when its scenario starts), else at once. */
 static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, const char *path,
-                        int sync_fd, int beat_prio)
+                        int sync_fd, const char *follow, int beat_prio)
 {
     static scenario_t scn;
     scn_error_t err;
@@ -310,7 +483,10 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     peer_cfg_t pc;
     peer_cfg_default(&pc);
     pc.window_edge = 16;
-    pc.solve_period_us = 50000u;
+    /* The global solve once a second: this host tests the board, the solve is tested
+     * elsewhere; under TCG a solve takes 100s of ms and held the windows back, so the board
+     * sat ARMED without a window (no ACTIVE, no force) in the VM at 02:29 UTC. */
+    pc.solve_period_us = 1000000u;
     if (peer_init(&peer, &pc, &grid, shost_send, shost_on_tm, &h) != ARGIL_OK)
         return 2;
     static sim_params_t arm_p;
@@ -339,10 +515,28 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     peer_set_tool(&peer, &t);
     peer_request_arm(&peer);
 
-    int unsupported = 0;
-    uint32_t next_step = 0, rearm_ms = 0;
     static uint8_t buf[65536];
-    pthread_mutex_init(&h.mu, NULL);
+    /* Priority inheritance: the peer's loop (20 below) holds the link lock while it sends; a
+     * thread between the two must not keep the heartbeats and steps waiting on it. */
+    pthread_mutexattr_t mattr;
+    pthread_mutexattr_init(&mattr);
+    pthread_mutexattr_setprotocol(&mattr, PTHREAD_PRIO_INHERIT);
+    pthread_mutex_init(&h.mu, &mattr);
+    pthread_mutexattr_destroy(&mattr);
+    /* Until the scenario clock starts, the peer runs (HELLO, windows, ARM) with no steps. With
+     * --sync the clock is the board's: one 1 ms step per SYNC on the bus (sim/scn_clock.h, as
+     * argil-sim's), so host-side steps land at the board tick the scenario names however slow
+     * the board runs; the run ends 100 ms of scenario time after the scenario's end. `seconds`
+     * of wall time bound the whole run. */
+    h.scn = &scn;
+    h.tool = &t;
+    h.sync_fd = sync_fd;
+    h.follow_path = follow;
+    h.follow_fd = -1;
+    h.synced = sync_fd < 0 && follow == NULL;
+    h.scn_end_us = sync_fd >= 0 ? scn.duration_us + 100000 : (int64_t)seconds * 1000000;
+    h.t0_us = mono_us();
+    scn_clock_init(&h.clk, sync_fd >= 0, (int64_t)h.t0_us);
     pthread_t beat;
     pthread_attr_t attr;
     pthread_attr_init(&attr);
@@ -352,46 +546,37 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
         pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
         pthread_attr_setschedparam(&attr, &sp);
     }
-    if (pthread_create(&beat, &attr, shost_beat, &h) != 0) {
-        fprintf(stderr, "hil-host: cannot start the heartbeat thread at FIFO %d\n", beat_prio);
+    if (pthread_create(&beat, &attr, shost_rt, &h) != 0) {
+        fprintf(stderr, "hil-host: cannot start the real-time thread at FIFO %d\n", beat_prio);
         pthread_attr_destroy(&attr);
         return 2;
     }
     pthread_attr_destroy(&attr);
-    h.t0_us = mono_us();
     uint64_t last_tick_us = h.t0_us;
-    /* Until the scenario clock starts, the peer runs (HELLO, windows, ARM) with no steps; the
-     * wait for it is bounded by `seconds` too. */
-    bool synced = sync_fd < 0;
-    uint64_t t_end = h.t0_us + (uint64_t)seconds * 1000000u;
+    const uint64_t t_end = h.t0_us + (uint64_t)seconds * 1000000u;
     uint64_t next = h.t0_us;
-    for (uint32_t ms = 0; mono_us() < t_end; ms++) {
-        struct can_frame cf;
-        if (!synced && read(sync_fd, &cf, sizeof(cf)) == (ssize_t)sizeof(cf)) {
-            synced = true;
-            h.t0_us = mono_us();
-            t_end = h.t0_us + (uint64_t)seconds * 1000000u;
-            printf("%.6f scenario clock starts (drive frame 0x%03X)\n", realtime_s(),
-                   (unsigned)(cf.can_id & CAN_SFF_MASK));
-        }
-        const int64_t now_us = (int64_t)(mono_us() - h.t0_us);
-        while (synced && next_step < scn.n_steps && scn.step[next_step].t_us <= now_us) {
-            const scn_step_t *st = &scn.step[next_step++];
-            if (!scenario_action_is_host_side(st->action))
-                continue;
-            pthread_mutex_lock(&h.mu);
-            const bool ok = shost_step(&h, st, &rearm_ms);
-            pthread_mutex_unlock(&h.mu);
-            printf("%.6f step line=%u %s%s\n", realtime_s(), st->line, st->text,
-                   ok ? "" : " unsupported");
-            unsupported += !ok;
-        }
+    uint32_t last_tm_print = 0, rearm_ms = 0;
+    for (uint32_t ms = 0; mono_us() < t_end && !atomic_load(&h.done); ms++) {
         ssize_t n;
         while ((n = recv(fd, buf, sizeof(buf), 0)) > 0)
             if (!h.lost)
                 peer_receive(&peer, buf, (size_t)n);
+        /* What the board renders, every 250 of its ticks: enough to see a press that gives
+         * no force, and why. */
+        if (h.tm_n > 0 && h.tm.tick - last_tm_print >= 250u) {
+            last_tm_print = h.tm.tick;
+            const float *f = h.tm.force_n;
+            printf("%.6f tick=%u tm %s z=%.1f mm force %.2f N contact %u window %u scn_t=%.3f\n",
+                   realtime_s(), h.tm.tick, safety_state_name((safety_state_t)h.tm.state),
+                   (double)h.tm.pos_m[2] * 1e3,
+                   sqrt((double)(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])), h.tm.flags & 1u,
+                   h.tm.window_version, (double)atomic_load(&h.now_us) / 1e6);
+        }
         if (!peer.board_seen && ms % 50 == 0)
             shost_simple(&h, MSG_HELLO, 0);
+        const uint32_t want = atomic_exchange(&h.rearm_ms, 0u);
+        if (want > 0)
+            rearm_ms = want;
         if (rearm_ms > 0) {
             if (rearm_ms % 5 == 0)
                 shost_simple(&h, MSG_HEARTBEAT, PROTO_CMD_ARM);
@@ -417,26 +602,34 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     }
     atomic_store(&h.stop, true);
     pthread_join(beat, NULL);
-    printf("%.6f telemetry=%u frames_sent=%u dropped=%u windows=%u beats=%u solves=%u\n",
+    printf("%.6f telemetry=%u frames_sent=%u dropped=%u windows=%u beats=%u solves=%u "
+           "clock %s syncs=%u wall_steps=%u scn_t=%.3f\n",
            realtime_s(), h.tm_n, h.frames_sent, h.frames_dropped, peer.stats.windows_sent,
-           atomic_load(&h.beats), peer.stats.solves);
+           atomic_load(&h.beats), peer.stats.solves, sync_fd >= 0 ? "ticks" : "wall", h.clk.syncs,
+           h.clk.wall_steps, (double)h.clk.now_us / 1e6);
     peer_free(&peer);
     grid_free(&grid);
-    if (!synced) {
+    if (h.follow_fd >= 0)
+        close(h.follow_fd);
+    if (!h.synced) {
         fprintf(stderr, "hil-host: no drive frame on the sync interface in %ld s: the scenario never started\n",
                 seconds);
         return 1;
     }
     if (h.tm_n == 0)
         return 1;
-    return unsupported ? 3 : 0;
+    return atomic_load(&h.unsupported) ? 3 : 0;
 }
 
 int main(int argc, char **argv)
 {
     char *end1 = NULL, *end2 = NULL;
     /* "--sync IFACE" after the scenario: its clock starts at the first drive frame on IFACE. */
-    const char *sync_if = NULL;
+    const char *sync_if = NULL, *follow = NULL;
+    if (argc == 8 && strcmp(argv[6], "--follow") == 0) {
+        follow = argv[7];
+        argc = 6;
+    }
     if (argc == 6 && strcmp(argv[4], "--sync") == 0) {
         sync_if = argv[5];
         argc = 4;
@@ -445,8 +638,8 @@ int main(int argc, char **argv)
     const long port = args_ok ? strtol(argv[1], &end1, 10) : 0;
     const long seconds = args_ok ? strtol(argv[2], &end2, 10) : 0;
     if (!args_ok || *end1 || *end2 || port < 1 || port > 65535 || seconds < 1 || seconds > 3600) {
-        fprintf(stderr, "usage: hil-host PORT SECONDS [SCENARIO [--sync CAN_IF]] (port 1-65535, "
-                        "1-3600 s)\n");
+        fprintf(stderr, "usage: hil-host PORT SECONDS [SCENARIO [--sync CAN_IF [--follow "
+                        "EVENT_LOG]]] (port 1-65535, 1-3600 s)\n");
         return 2;
     }
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
@@ -477,7 +670,7 @@ int main(int argc, char **argv)
             close(fd);
             return 1;
         }
-        const int st = run_scenario(fd, &board, seconds, argv[3], sync_fd, prio);
+        const int st = run_scenario(fd, &board, seconds, argv[3], sync_fd, follow, prio);
         if (sync_fd >= 0)
             close(sync_fd);
         close(fd);

@@ -41,6 +41,12 @@ hil_err_t hil_obs_push_frame(hil_obs_t *o, int64_t t_us, const can_frame_t *f)
 
 hil_err_t hil_obs_push_gpio(hil_obs_t *o, int64_t t_us, bool drive_enable)
 {
+    return hil_obs_push_gpio_sampled(o, -1, t_us, drive_enable);
+}
+
+hil_err_t hil_obs_push_gpio_sampled(hil_obs_t *o, int64_t prev_us, int64_t t_us,
+                                    bool drive_enable)
+{
     if (o->n_gpio == o->cap_gpio) {
         const size_t cap = o->cap_gpio ? o->cap_gpio * 2u : 64u;
         hil_gpio_t *p = realloc(o->gpio, cap * sizeof(*p));
@@ -50,6 +56,7 @@ hil_err_t hil_obs_push_gpio(hil_obs_t *o, int64_t t_us, bool drive_enable)
         o->cap_gpio = cap;
     }
     o->gpio[o->n_gpio].t_us = t_us;
+    o->gpio[o->n_gpio].prev_us = prev_us >= 0 && prev_us < t_us ? prev_us : -1;
     o->gpio[o->n_gpio].drive_enable = drive_enable;
     o->n_gpio++;
     return HIL_OK;
@@ -244,13 +251,69 @@ static hil_err_t events_fn(void *vctx, const char *p, size_t n)
     }
     if (word_is(w, wn, "note") || word_is(w, wn, "end") || word_is(w, wn, "host"))
         return HIL_OK;
+    if (word_is(w, wn, "mark")) {
+        /* "mark at S.UUUUUU": exactly six decimals, as argil-sim writes them */
+        static const char key[] = "mark at ";
+        const size_t k = sizeof(key) - 1u;
+        if (wn <= k || memcmp(w, key, k) != 0)
+            return HIL_ERR_EVENT;
+        int64_t sec = 0, frac = 0;
+        size_t j = k, digits = 0;
+        while (j < wn && w[j] >= '0' && w[j] <= '9' && digits < 5u) {
+            sec = sec * 10 + (w[j++] - '0');
+            digits++;
+        }
+        if (digits == 0 || j >= wn || w[j] != '.')
+            return HIL_ERR_EVENT;
+        j++;
+        for (int d = 0; d < 6; d++) {
+            if (j >= wn || w[j] < '0' || w[j] > '9')
+                return HIL_ERR_EVENT;
+            frac = frac * 10 + (w[j++] - '0');
+        }
+        uint32_t sync = 0;
+        static const char sk[] = " sync=";
+        const size_t sn = sizeof(sk) - 1u;
+        if (j + sn < wn && memcmp(w + j, sk, sn) == 0) {
+            j += sn;
+            const size_t d0 = j;
+            while (j < wn && w[j] >= '0' && w[j] <= '9' && j - d0 < 9u)
+                sync = sync * 10u + (uint32_t)(w[j++] - '0');
+            if (j == d0)
+                return HIL_ERR_EVENT;
+        }
+        if (j < wn && w[j] != ' ')
+            return HIL_ERR_EVENT;
+        const int64_t t_s = sec * 1000000 + frac;
+        for (uint32_t m = 0; m < c->o->n_marks; m++)
+            if (c->o->mark_t_us[m] == t_s)
+                return HIL_OK;
+        if (c->o->n_marks == HIL_MARKS_MAX)
+            return HIL_OK; /* more marks than a scenario has times: the rest are not needed */
+        c->o->mark_t_us[c->o->n_marks] = t_s;
+        c->o->mark_us[c->o->n_marks] = t;
+        c->o->mark_sync[c->o->n_marks] = sync;
+        c->o->n_marks++;
+        return HIL_OK;
+    }
     if (word_is(w, wn, "gpio_out")) {
         static const char key[] = "gpio_out DRIVE_ENABLE=";
         const size_t k = sizeof(key) - 1u;
         if (wn < k + 1u || memcmp(w, key, k) != 0 || (w[k] != '0' && w[k] != '1') ||
             (wn > k + 1u && w[k + 1u] != ' '))
             return HIL_ERR_EVENT;
-        return hil_obs_push_gpio(c->o, t, w[k] == '1');
+        /* " prev=(SECONDS.MICROS)": the sample before; anything else after a space is a note */
+        static const char pk[] = " prev=";
+        const size_t pn = sizeof(pk) - 1u;
+        int64_t prev = -1;
+        if (wn > k + 1u + pn && memcmp(w + k + 1u, pk, pn) == 0) {
+            const size_t used = timestamp(w + k + 1u + pn, wn - (k + 1u + pn), &prev);
+            if (used == 0 || (k + 1u + pn + used < wn && w[k + 1u + pn + used] != ' '))
+                return HIL_ERR_EVENT;
+            if (prev > t)
+                return HIL_ERR_ORDER;
+        }
+        return hil_obs_push_gpio_sampled(c->o, prev, t, w[k] == '1');
     }
     if (word_is(w, wn, "inject")) {
         static const char key[] = "inject line=";
@@ -290,13 +353,33 @@ hil_err_t hil_obs_add_events(hil_obs_t *o, const scenario_t *s, const char *text
 }
 
 /* Absolute time of scenario time t_us: the logged injection of a step at exactly that time,
- * else start + t. */
+ * else the rig's mark of that time, else start + t. */
 static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
 {
     for (uint32_t i = 0; i < s->n_steps; i++)
         if (s->step[i].t_us == t_us && o->step_seen[i])
             return o->step_us[i];
+    for (uint32_t m = 0; m < o->n_marks; m++) {
+        if (o->mark_t_us[m] != t_us)
+            continue;
+        uint32_t n = 0;
+        for (size_t k = 0; o->mark_sync[m] > 0 && k < o->n_frames; k++)
+            if (o->frame[k].t_us > o->start_us && o->frame[k].f.id == CANOPEN_COB_SYNC &&
+                o->frame[k].f.len <= 1u && ++n == o->mark_sync[m])
+                return o->frame[k].t_us;
+        return o->mark_us[m];
+    }
     return o->start_us + t_us;
+}
+
+/* True when scenario time t_us is anchored on a host-side step the log holds: the board sees
+ * it only once the host link has delivered it. */
+static bool host_anchored(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
+{
+    for (uint32_t i = 0; i < s->n_steps; i++)
+        if (s->step[i].t_us == t_us && o->step_seen[i])
+            return scenario_action_is_host_side(s->step[i].action);
+    return false;
 }
 
 /* DRIVE_ENABLE level just before t (taken as high when nothing was logged before). */
@@ -353,12 +436,13 @@ static int64_t bound_ticks(int64_t within_us)
 }
 
 /* Last instant inside "within" from t0: t0 + within_us on a log without SYNCs, else just
- * before the SYNC that opens the tick after the bound's last (INT64_MAX if the log ends). */
-static int64_t bound_end(const hil_obs_t *o, int64_t t0, int64_t within_us)
+ * before the SYNC that opens the tick after the bound's last, link ticks later for a host-side
+ * step (INT64_MAX if the log ends). */
+static int64_t bound_end(const hil_obs_t *o, int64_t t0, int64_t within_us, int64_t link)
 {
     if (o->n_syncs == 0)
         return t0 + within_us;
-    const int64_t want = bound_ticks(within_us) + 1;
+    const int64_t want = bound_ticks(within_us) + link + 1;
     int64_t n = 0;
     for (size_t k = 0; k < o->n_frames; k++)
         if (o->frame[k].t_us > t0 && is_sync(&o->frame[k]) && ++n == want)
@@ -379,10 +463,14 @@ static const char *lat(char *buf, size_t n, const hil_obs_t *o, int64_t t0, int6
 }
 
 /* "3 ticks (3.000 ms at 1 kHz)" or "3.000 ms": the bound as it is asserted. */
-static const char *bnd(char *buf, size_t n, const hil_obs_t *o, int64_t within_us)
+static const char *bnd(char *buf, size_t n, const hil_obs_t *o, int64_t within_us,
+                       int64_t link)
 {
     if (o->n_syncs == 0)
         snprintf(buf, n, "%.3f ms", MS(within_us));
+    else if (link > 0)
+        snprintf(buf, n, "%lld ticks = %.3f ms at 1 kHz + %lld for the link",
+                 (long long)bound_ticks(within_us), MS(within_us), (long long)link);
     else
         snprintf(buf, n, "%lld ticks = %.3f ms at 1 kHz", (long long)bound_ticks(within_us),
                  MS(within_us));
@@ -393,9 +481,10 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
 {
     const scn_expect_t *e = &s->expect[i];
     const int64_t t0 = abs_time(s, o, e->t_us);
-    const int64_t t_end = e->until == SCN_UNTIL_TIME ? o->start_us + e->until_us
-                                                     : abs_time(s, o, scenario_until_us(s, e));
-    const int64_t t_bound = bound_end(o, t0, e->within_us);
+    /* A host-side step reaches the board through the link: its bound starts link_ticks later. */
+    const int64_t link = o->n_syncs > 0 && host_anchored(s, o, e->t_us) ? o->link_ticks : 0;
+    const int64_t t_end = abs_time(s, o, scenario_until_us(s, e));
+    const int64_t t_bound = bound_end(o, t0, e->within_us, link);
     const bool gpio = o->n_gpio > 0;
     char la[48], bo[48];
     r->pass = false;
@@ -444,8 +533,8 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                 const hil_gpio_t *g = &o->gpio[k];
                 if (g->t_us < t0 || g->t_us >= t_end)
                     continue;
-                if (!g->drive_enable && level)
-                    t_low = g->t_us;
+                if (!g->drive_enable && level) /* the earliest the edge can have been */
+                    t_low = g->prev_us >= t0 ? g->prev_us + 1 : g->t_us;
                 if (g->drive_enable) {
                     snprintf(r->msg, sizeof(r->msg), "DRIVE_ENABLE back high at +%.3f ms",
                              MS(g->t_us - t0));
@@ -471,14 +560,15 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         r->pass = t_obs <= t_bound;
         if (any_bad)
             snprintf(r->msg, sizeof(r->msg), "observed after %s (bound %s, %zu RPDOs%s)",
-                     lat(la, sizeof(la), o, t0, t_obs), bnd(bo, sizeof(bo), o, e->within_us),
+                     lat(la, sizeof(la), o, t0, t_obs), bnd(bo, sizeof(bo), o, e->within_us, link),
                      rpdos, fault && gpio ? ", DRIVE_ENABLE" : "");
         else
             snprintf(r->msg, sizeof(r->msg),
                      "observed after %s: no offending RPDO after the injection, first "
                      "RPDO at +%.3f ms (bound %s%s)",
                      lat(la, sizeof(la), o, t0, t_obs), t_first_ok < 0 ? -1.0 : MS(t_first_ok - t0),
-                     bnd(bo, sizeof(bo), o, e->within_us), fault && gpio ? ", DRIVE_ENABLE" : "");
+                     bnd(bo, sizeof(bo), o, e->within_us, link),
+                     fault && gpio ? ", DRIVE_ENABLE" : "");
         return;
     }
     case SCN_EXP_QUICK_STOP: {
@@ -495,7 +585,7 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         for (int j = 0; j < ARGIL_DRIVES; j++) {
             if (t_node[j] < 0) {
                 snprintf(r->msg, sizeof(r->msg), "drive %d got no QUICK_STOP within %s",
-                         j + 1, bnd(bo, sizeof(bo), o, e->within_us));
+                         j + 1, bnd(bo, sizeof(bo), o, e->within_us, link));
                 return;
             }
             if (t_node[j] > worst)
@@ -505,7 +595,7 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
         r->observed_us = worst - t0;
         r->observed_ticks = ticks_between(o, t0, worst);
         snprintf(r->msg, sizeof(r->msg), "every drive got QUICK_STOP after %s (bound %s)",
-                 lat(la, sizeof(la), o, t0, worst), bnd(bo, sizeof(bo), o, e->within_us));
+                 lat(la, sizeof(la), o, t0, worst), bnd(bo, sizeof(bo), o, e->within_us, link));
         return;
     }
     case SCN_EXP_ENABLED: {
@@ -521,12 +611,13 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                 r->observed_us = h->t_us - t0;
                 r->observed_ticks = ticks_between(o, t0, h->t_us);
                 snprintf(r->msg, sizeof(r->msg), "every drive enabled after %s (bound %s)",
-                         lat(la, sizeof(la), o, t0, h->t_us), bnd(bo, sizeof(bo), o, e->within_us));
+                         lat(la, sizeof(la), o, t0, h->t_us),
+                         bnd(bo, sizeof(bo), o, e->within_us, link));
                 return;
             }
         }
         snprintf(r->msg, sizeof(r->msg), "drives not all enabled within %s",
-                 bnd(bo, sizeof(bo), o, e->within_us));
+                 bnd(bo, sizeof(bo), o, e->within_us, link));
         return;
     }
     case SCN_EXP_TORQUE_NONZERO:
@@ -540,19 +631,21 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                 r->observed_ticks = ticks_between(o, t0, h->t_us);
                 snprintf(r->msg, sizeof(r->msg), "torque %d ‰ on drive %u after %s (bound %s)",
                          tq, node, lat(la, sizeof(la), o, t0, h->t_us),
-                         bnd(bo, sizeof(bo), o, e->within_us));
+                         bnd(bo, sizeof(bo), o, e->within_us, link));
                 return;
             }
         }
         snprintf(r->msg, sizeof(r->msg), "no non-zero torque within %s",
-                 bnd(bo, sizeof(bo), o, e->within_us));
+                 bnd(bo, sizeof(bo), o, e->within_us, link));
         return;
     case SCN_EXP_NO_TORQUE_FRAMES:
     case SCN_EXP_RUNNING: {
         const bool running = e->kind == SCN_EXP_RUNNING;
         /* A tick ends with its SYNC: the RPDOs of the tick in progress at T were computed from
          * inputs read before T, so on a log with SYNCs no_torque_frames starts at its end. */
-        const int64_t t_from = running || o->n_syncs == 0 ? t0 : first_sync_after(o, t0);
+        int64_t t_from = running || o->n_syncs == 0 ? t0 : first_sync_after(o, t0);
+        for (int64_t k = 0; !running && k < link && t_from != INT64_MAX; k++)
+            t_from = first_sync_after(o, t_from);
         for (size_t k = 0; k < o->n_frames; k++) {
             const hil_frame_t *h = &o->frame[k];
             if (h->t_us < t_from || h->t_us >= t_end || !rpdo(h, &node, &cw, &tq))

@@ -18,9 +18,13 @@ typedef struct {
 } hil_frame_t;
 
 typedef struct {
-    int64_t t_us;
+    int64_t t_us;                  /* the sample that saw the new level */
+    int64_t prev_us;               /* the sample before, which still saw the old one; −1 when
+                                      not logged: the edge lies in (prev_us, t_us] */
     bool drive_enable;
 } hil_gpio_t;
+
+#define HIL_MARKS_MAX (2u * SCN_EXPECTS_MAX + 1u) /* expectation times, until times, the end */
 
 /* What a run recorded. Arrays grow on the heap; free with hil_obs_free. */
 typedef struct {
@@ -33,6 +37,14 @@ typedef struct {
     int64_t start_us;              /* scenario time 0 */
     bool step_seen[SCN_STEPS_MAX];
     int64_t step_us[SCN_STEPS_MAX]; /* when each scenario step was injected */
+    uint32_t link_ticks;           /* set by the caller: board ticks the host link may take to
+                                      deliver a host-side step (UDP, link thread, ring); added
+                                      to the bounds of expectations anchored on one */
+    uint32_t n_marks;              /* "mark at T": when the rig's scenario clock passed T */
+    int64_t mark_t_us[HIL_MARKS_MAX];
+    int64_t mark_us[HIL_MARKS_MAX];
+    uint32_t mark_sync[HIL_MARKS_MAX]; /* "sync=N": the rig's clock passed T at the N-th SYNC
+                                          after the start line (0: not said) */
 } hil_obs_t;
 
 typedef enum {
@@ -51,6 +63,9 @@ void hil_obs_init(hil_obs_t *o);
 void hil_obs_free(hil_obs_t *o);
 hil_err_t hil_obs_push_frame(hil_obs_t *o, int64_t t_us, const can_frame_t *f);
 hil_err_t hil_obs_push_gpio(hil_obs_t *o, int64_t t_us, bool drive_enable);
+/* The same with the time of the sample before (the edge lies between the two). */
+hil_err_t hil_obs_push_gpio_sampled(hil_obs_t *o, int64_t prev_us, int64_t t_us,
+                                    bool drive_enable);
 
 /* One candump -l / -L line "(1700000000.123456) vcan0 201#0F00E803": the time in µs and the
  * frame (standard 3-digit ids, or 8-digit ids carrying CAN_ERR_FLAG for error frames). */
@@ -60,7 +75,12 @@ hil_err_t hil_candump_line(const char *line, size_t len, int64_t *t_us, can_fram
 hil_err_t hil_obs_add_candump(hil_obs_t *o, const char *text, size_t len, uint32_t *err_line);
 
 /* Adds an argil-sim event log: "(T) start …", "(T) inject line=N …", "(T) gpio_out
- * DRIVE_ENABLE=0|1", "(T) note …", "(T) end …". Injections are matched to s's steps by line. */
+ * DRIVE_ENABLE=0|1 [prev=(SECONDS.MICROS)]" (prev: the sample before), "(T) mark at
+ * S.UUUUUU [sync=N] …", "(T) note …", "(T) end …". Injections are
+ * matched to s's steps by line; a mark says when the rig's scenario clock passed scenario time
+ * S (argil-sim's clock follows the board's ticks), so an expectation at S with no step at S is
+ * anchored there instead of at start + S (the first mark of a time counts); with " sync=N" at
+ * the N-th SYNC of the CAN log after the start line, when the log has that many. */
 hil_err_t hil_obs_add_events(hil_obs_t *o, const scenario_t *s, const char *text, size_t len,
                              uint32_t *err_line);
 

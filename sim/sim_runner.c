@@ -99,14 +99,16 @@ static void apply(sim_runner_t *r, const scn_step_t *st)
 }
 
 /* Watches DRIVE_ENABLE (logged on change) and WDOG_KICK (a stale kick cuts the power, as the
- * arm's hardware watchdog does; judged only while sampled at least every 1.5 ms, as a kick that
- * toggles every tick cannot be seen at a slower rate). Returns the levels the drives act on. */
+ * arm's hardware watchdog does; judged only while sampled at least every 1.5 ms and afresh for
+ * each tick, as a kick that toggles every tick cannot be seen at a slower rate). Returns the
+ * levels the drives act on. */
 static uint32_t watch_outputs(sim_runner_t *r, uint32_t gpio_out, uint32_t dt_us)
 {
     if (!r->gpio_observed)
         return GPIO_OUT_DRIVE_ENABLE;
     const uint32_t kick = GPIO_OUT_WDOG_KICK, en = GPIO_OUT_DRIVE_ENABLE;
-    if (!r->have_gpio_out || ((gpio_out ^ r->last_gpio_out) & kick) != 0 || dt_us > 1500u)
+    if (!r->have_gpio_out || ((gpio_out ^ r->last_gpio_out) & kick) != 0 || dt_us > 1500u ||
+        r->outputs_reused)
         r->last_kick_us = r->now_us;
     if (!r->have_gpio_out || ((gpio_out ^ r->last_gpio_out) & en) != 0) {
         emit(r, (gpio_out & en) ? "gpio_out DRIVE_ENABLE=1" : "gpio_out DRIVE_ENABLE=0");

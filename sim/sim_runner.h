@@ -31,6 +31,9 @@ typedef struct {
     bool btn1, btn2;
     bool drive_fault_line_low;    /* DRIVE_FAULT_N pulled low by the scenario */
     bool gpio_observed;           /* the board's outputs are really read (else taken as on) */
+    bool outputs_reused;          /* set by the caller: this tick's gpio_out is the sample of an
+                                     earlier tick (several SYNCs taken in one read), so a kick
+                                     that toggles every tick cannot be judged from it */
     bool have_gpio_out;
     uint32_t last_gpio_out;
     int64_t last_kick_us;         /* WDOG_KICK last changed */

@@ -30,7 +30,11 @@
 
 #define CONNECT_RX_RING_BYTES (1u << 20)  /* ~1 s of board traffic if the solver stalls */
 #define CONNECT_TX_RING_BYTES (1u << 18)
-#define CONNECT_HELLO_PERIOD_US 100000u   /* HELLO again until the board answers */
+#define CONNECT_HELLO_PERIOD_US 100000u   /* HELLO again until the board answers, */
+#define CONNECT_HELLO_PERIOD_MAX_US 800000u /* doubling up to this: each board HELLO restarts
+                                             * the window upload, so on a slow link (the HIL VM
+                                             * under load: replies after > 100 ms) a HELLO every
+                                             * 100 ms drew up to 7 board HELLOs per resync */
 #define CONNECT_REARM_PERIOD_US 100000u
 #define CONNECT_GRID_EDGE 72
 #define CONNECT_SPACING_M 0.00125f
@@ -89,7 +93,7 @@ typedef struct {
     double rtt_ms, rtt_worst_ms;
     uint32_t rtt_samples;
     uint32_t windows_seen;
-} solver_t;
+} conn_solver_t;
 
 static uint64_t mono_us(void)
 {
@@ -147,11 +151,11 @@ static void *link_thread(void *arg)
 
 static bool ring_send(void *ctx, const uint8_t *frame, size_t len)
 {
-    solver_t *s = ctx;
+    conn_solver_t *s = ctx;
     return spsc_push(&s->c->tx, frame, len) == ARGIL_OK;
 }
 
-static void send_simple(solver_t *s, uint8_t type, uint8_t command)
+static void send_simple(conn_solver_t *s, uint8_t type, uint8_t command)
 {
     proto_msg_t m;
     memset(&m, 0, sizeof(m));
@@ -175,7 +179,7 @@ static void send_simple(solver_t *s, uint8_t type, uint8_t command)
 
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
 {
-    solver_t *s = ctx;
+    conn_solver_t *s = ctx;
     if (s->have_tm && t->tick < s->prev_tick)
         s->board_restarts++;
     if (t->state == SAFETY_ACTIVE && (!s->have_tm || s->last_state != SAFETY_ACTIVE))
@@ -210,7 +214,7 @@ static void on_telemetry(void *ctx, const msg_telemetry_t *t)
     s->csv_rows++;
 }
 
-static void status_line(solver_t *s, bool tty, double elapsed_s, uint32_t rx_per_s,
+static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t rx_per_s,
                         uint32_t tx_per_s)
 {
     const link_state_t ls = (link_state_t)atomic_load(&s->c->pub.state);
@@ -398,7 +402,7 @@ static void default_tool(msg_tool_t *t)
 }
 
 /* Opens the CSV (as a .tmp file renamed at the end); one line into err on failure. */
-static argil_err_t open_csv(solver_t *s, const char *path, char *tmp, size_t tmp_len, char *err,
+static argil_err_t open_csv(conn_solver_t *s, const char *path, char *tmp, size_t tmp_len, char *err,
                             size_t err_len)
 {
     snprintf(tmp, tmp_len, "%s.tmp", path);
@@ -423,7 +427,7 @@ int cmd_connect(int argc, char **argv)
     int exit_code = 0;
 
     conn_t *c = calloc(1, sizeof(*c));
-    solver_t *s = calloc(1, sizeof(*s));
+    conn_solver_t *s = calloc(1, sizeof(*s));
     if (!c || !s) {
         free(c);
         free(s);
@@ -507,6 +511,7 @@ int cmd_connect(int argc, char **argv)
     uint64_t last_us = s->t0_us, next_us = s->t0_us, status_at_us = s->t0_us + 1000000u;
     uint64_t last_hello_us = 0, last_rearm_us = 0;
     bool hello_wanted = true, rearm_pending = false;
+    uint32_t hello_period_us = CONNECT_HELLO_PERIOD_US;
     uint32_t seen_resyncs = 0, restarts_seen = 0, rx_at_status = 0, tx_at_status = 0;
     uint32_t windows_at_last = 0;
     bool interrupted = false;
@@ -544,6 +549,7 @@ int cmd_connect(int argc, char **argv)
             restarts_seen = s->board_restarts;
             hello_wanted = true;
             last_hello_us = 0;
+            hello_period_us = CONNECT_HELLO_PERIOD_US;
             rearm_pending = o.arm;
         }
         /* The board says it lost the host (this host stalled, or the link dropped and came
@@ -553,9 +559,11 @@ int cmd_connect(int argc, char **argv)
             if (s->peer.stats.last_fault_code == FAULT_HOST_LOST)
                 rearm_pending = o.arm;
         }
-        if (hello_wanted && s->now_us - last_hello_us >= CONNECT_HELLO_PERIOD_US) {
+        if (hello_wanted && s->now_us - last_hello_us >= hello_period_us) {
             send_simple(s, MSG_HELLO, 0);
             last_hello_us = s->now_us;
+            if (hello_period_us < CONNECT_HELLO_PERIOD_MAX_US)
+                hello_period_us *= 2u;
         }
         /* A link loss faulted the board (host lost): the person asked for --arm, so arm again
          * once the board has its new window. Any other fault stays latched. The board reports

@@ -7,7 +7,9 @@
 #include <string.h>
 
 #include "host/app/commands.h"
+#include "host/io/argil_file.h"
 #include "host/io/mesh_import.h"
+#include "host/mesh/mc_blocks.h"
 #include "host/render/camera.h"
 #include "host/render/offscreen.h"
 #include "host/render/png_write.h"
@@ -20,9 +22,10 @@ static void usage_view(FILE *f)
             "                  [--mode plain|clearcoat] [--backend auto|egl|glfw]\n"
             "                  [--telemetry FILE.csv] [--tool X Y Z R] [--force FX FY FZ]\n"
             "                  [--box X0 Y0 Z0 X1 Y1 Z1] [--key X Y Z] [--fill X Y Z]\n"
-            "                  [--yaw DEG] [--pitch DEG]\n"
+            "                  [--yaw DEG] [--pitch DEG] [--iso2 L]\n"
             "\n"
-            "Draws MODEL (a mesh: .ply .stl .obj, e.g. a session's out/final.ply) lit by a key\n"
+            "Draws MODEL (a mesh: .ply .stl .obj, e.g. a session's out/final.ply, or a .argil\n"
+            "model, meshed at its surface level) lit by a key\n"
             "and a fill light. With --screenshot it renders one frame offscreen (a hidden GLFW\n"
             "window when DISPLAY is set, else EGL surfaceless) and writes a PNG; without it, it\n"
             "opens a window: drag with the left button to turn the model, wheel to zoom, Esc\n"
@@ -43,6 +46,8 @@ static void usage_view(FILE *f)
             "  --key X Y Z, --fill X Y Z  directions toward the key and fill lights in view\n"
             "                     space (+x right, +y up, +z toward you)\n"
             "  --yaw DEG, --pitch DEG  turn the model before the first frame\n"
+            "  --iso2 L           a .argil model's density level L (0.05..0.95; the surface is\n"
+            "                     0.5) drawn as a wireframe over it (Hua & Qin Fig. 12)\n"
             "  -h, --help         this text\n");
 }
 
@@ -139,8 +144,33 @@ static void scene_bounds(const mesh_t *m, const render_scene_t *s, vec3_t *lo, v
     }
 }
 
-static int run_screenshot(const mesh_t *m, render_scene_t *s, camera_t *cam,
-                          render_backend_t backend, int w, int h, const char *png)
+/* Meshes a .argil model at its surface level into m (closed: back faces culled) and, for
+ * iso2 > 0, at that level into wire. */
+static argil_err_t load_model(const char *path, float iso2, mesh_t *m, mesh_t *wire,
+                              render_scene_t *s, char *err, size_t err_len)
+{
+    argil_doc_t d;
+    argil_err_t rc = argil_file_read(path, &d, err, err_len);
+    if (rc != ARGIL_OK)
+        return rc;
+    const grid_t *g = &d.grid;
+    rc = mc_extract_region(g->density, d.rgb, g->dims, g->spacing_m, g->origin_m, g->iso, NULL,
+                           NULL, m);
+    if (rc == ARGIL_OK && iso2 > 0.0f)
+        rc = mc_extract_region(g->density, NULL, g->dims, g->spacing_m, g->origin_m, iso2, NULL,
+                               NULL, wire);
+    if (rc != ARGIL_OK)
+        snprintf(err, err_len, "%s: cannot mesh the model (%s)", path,
+                 rc == ARGIL_ERR_NOMEM ? "out of memory" : "bad field");
+    s->closed_mesh = true;
+    s->show_wire = iso2 > 0.0f;
+    s->wire_on_top = iso2 > g->iso;
+    argil_doc_free(&d);
+    return rc;
+}
+
+static int run_screenshot(const mesh_t *m, const mesh_t *wire, render_scene_t *s,
+                          camera_t *cam, render_backend_t backend, int w, int h, const char *png)
 {
     char err[512] = "";
     offscreen_t *o = calloc(1, sizeof(*o));
@@ -154,7 +184,8 @@ static int run_screenshot(const mesh_t *m, render_scene_t *s, camera_t *cam,
     int status = 1;
     if (offscreen_open(o, backend, w, h, err, sizeof(err)) != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
-    } else if (renderer_set_mesh(&o->renderer, m) != ARGIL_OK) {
+    } else if (renderer_set_mesh(&o->renderer, m) != ARGIL_OK ||
+               renderer_set_wire_mesh(&o->renderer, wire) != ARGIL_OK) {
         fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
     } else {
         camera_matrices(cam, (float)w / (float)h, s->view, s->proj);
@@ -170,8 +201,8 @@ static int run_screenshot(const mesh_t *m, render_scene_t *s, camera_t *cam,
     return status;
 }
 
-static int run_window(const mesh_t *m, render_scene_t *s, camera_t *cam, int w, int h,
-                      const char *title)
+static int run_window(const mesh_t *m, const mesh_t *wire, render_scene_t *s, camera_t *cam,
+                      int w, int h, const char *title)
 {
     char err[512] = "";
     glfw_window_t win;
@@ -186,7 +217,7 @@ static int run_window(const mesh_t *m, render_scene_t *s, camera_t *cam, int w, 
         glfw_window_close(&win);
         return 1;
     }
-    if (renderer_set_mesh(&r, m) != ARGIL_OK) {
+    if (renderer_set_mesh(&r, m) != ARGIL_OK || renderer_set_wire_mesh(&r, wire) != ARGIL_OK) {
         fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
         renderer_free(&r);
         glfw_window_close(&win);
@@ -222,7 +253,7 @@ int cmd_view(int argc, char **argv)
     render_backend_t backend = RENDER_BACKEND_AUTO;
     render_scene_t s;
     render_scene_default(&s);
-    float tool[4] = {0}, force[3] = {0}, box[6] = {0}, yaw = 0.0f, pitch = 0.0f;
+    float tool[4] = {0}, force[3] = {0}, box[6] = {0}, yaw = 0.0f, pitch = 0.0f, iso2 = 0.0f;
     int have_tool = 0, have_force = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
@@ -294,6 +325,13 @@ int cmd_view(int argc, char **argv)
             rc = take_floats(argc, argv, &i, 1, &yaw);
         } else if (strcmp(a, "--pitch") == 0) {
             rc = take_floats(argc, argv, &i, 1, &pitch);
+        } else if (strcmp(a, "--iso2") == 0) {
+            rc = take_floats(argc, argv, &i, 1, &iso2);
+            if (rc == 0 && !(iso2 >= 0.05f && iso2 <= 0.95f)) {
+                fprintf(stderr, "argil view: --iso2 needs a density level 0.05..0.95 (the "
+                                "surface is 0.5)\n");
+                return 2;
+            }
         } else if (a[0] == '-' && a[1] != '\0') {
             fprintf(stderr, "argil view: unknown option '%s' (see --help)\n", a);
             return 2;
@@ -339,10 +377,24 @@ int cmd_view(int argc, char **argv)
     s.box_hi_m = vec3(fmaxf(box[0], box[3]) * 1e-3f, fmaxf(box[1], box[4]) * 1e-3f,
                       fmaxf(box[2], box[5]) * 1e-3f);
 
-    mesh_t m;
+    mesh_t m, wire;
     mesh_init(&m);
+    mesh_init(&wire);
     bool has_normals = false;
-    if (mesh_import(model, &m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+    const size_t len = strlen(model);
+    if (len > 6 && strcmp(model + len - 6, ".argil") == 0) {
+        if (load_model(model, iso2, &m, &wire, &s, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil view: %s\n", err);
+            mesh_free(&m);
+            mesh_free(&wire);
+            return 1;
+        }
+        has_normals = true;
+    } else if (iso2 > 0.0f) {
+        fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
+                        "model, or use 'argil sculpt --iso2')\n", model);
+        return 2;
+    } else if (mesh_import(model, &m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return 1;
     }
@@ -358,8 +410,9 @@ int cmd_view(int argc, char **argv)
     camera_t cam;
     camera_frame(&cam, lo, hi);
     camera_orbit(&cam, yaw * (float)M_PI / 180.0f, pitch * (float)M_PI / 180.0f);
-    const int status = png ? run_screenshot(&m, &s, &cam, backend, w, h, png)
-                           : run_window(&m, &s, &cam, w, h, model);
+    const int status = png ? run_screenshot(&m, &wire, &s, &cam, backend, w, h, png)
+                           : run_window(&m, &wire, &s, &cam, w, h, model);
     mesh_free(&m);
+    mesh_free(&wire);
     return status;
 }

@@ -10,6 +10,7 @@
 #include "host/app/commands.h"
 #include "host/app/sculpt_window.h"
 #include "host/app/session.h"
+#include "host/render/colour_map.h"
 
 static volatile sig_atomic_t g_stop;
 
@@ -65,6 +66,10 @@ static void usage_sculpt(FILE *f)
             "                  (default out; created if missing)\n"
             "  --window N      edge of the board's local density window in samples, 4..32\n"
             "                  (default 16)\n"
+            "  --global-solve bspline|springs\n"
+            "                  the host's global solve: the implicit B-spline model or the\n"
+            "                  explicit density springs on the grid (default bspline;\n"
+            "                  docs/model.md)\n"
             "  --quiet         no progress line and no summary\n"
             "  --screenshot FILE.png\n"
             "                  afterwards, render the final clay with the tool where it ended\n"
@@ -89,6 +94,10 @@ static void usage_sculpt(FILE *f)
             "  --input FILE    scripted keys and mouse for the window (tests, demos)\n"
             "  --linger S      keep the window S seconds after the session ends (default 2)\n"
             "  --width W, --height H  window size in pixels (default 1024 x 768)\n"
+            "  --iso2 L        show the density field's level L (0.05..0.95; the clay is 0.5)\n"
+            "                  as a wireframe over the clay (keys I, [ and ] in the window)\n"
+            "  --colour stiffness|mass|none\n"
+            "                  colour the clay by its painted material (key M)\n"
             "  -h, --help      this text\n");
 }
 
@@ -163,6 +172,31 @@ int cmd_sculpt(int argc, char **argv)
             }
             i++;
             *(a[2] == 'w' ? &wo.width : &wo.height) = (int)px;
+        } else if (strcmp(a, "--global-solve") == 0) {
+            if (!v || (strcmp(v, "bspline") != 0 && strcmp(v, "springs") != 0)) {
+                fprintf(stderr, "argil sculpt: --global-solve needs 'bspline' or 'springs'\n");
+                return 2;
+            }
+            i++;
+            o.global_solve = v[0] == 'b' ? PEER_SOLVE_BSPLINE : PEER_SOLVE_SPRINGS;
+        } else if (strcmp(a, "--iso2") == 0) {
+            char *end = NULL;
+            const double x = v ? strtod(v, &end) : 0.0;
+            if (!v || *end != '\0' || !(x >= 0.05 && x <= 0.95)) {
+                fprintf(stderr, "argil sculpt: --iso2 needs a density level 0.05..0.95 (the "
+                                "clay's is 0.5)\n");
+                return 2;
+            }
+            i++;
+            wo.iso2 = (float)x;
+        } else if (strcmp(a, "--colour") == 0) {
+            colour_map_t cm;
+            if (!v || !colour_map_parse(v, &cm)) {
+                fprintf(stderr, "argil sculpt: --colour needs stiffness, mass or none\n");
+                return 2;
+            }
+            i++;
+            wo.colour = (int)cm;
         } else if (strcmp(a, "--input") == 0) {
             if (!v) {
                 fprintf(stderr, "argil sculpt: --input needs a file (see --help)\n");
@@ -220,10 +254,12 @@ int cmd_sculpt(int argc, char **argv)
     /* The live window when there is a display (headless otherwise: the same files). */
     const char *display = getenv("DISPLAY");
     const bool live = !headless && display != NULL && display[0] != '\0';
-    if (!live && (wo.mouse || wo.input_path || wo.screenshot_every_s > 0.0)) {
+    if (!live && (wo.mouse || wo.input_path || wo.screenshot_every_s > 0.0 || wo.iso2 > 0.0f ||
+                  wo.colour != 0)) {
         fprintf(stderr, "argil sculpt: %s needs the window: a display (DISPLAY) and no "
                         "--headless\n",
-                wo.mouse ? "--mouse" : wo.input_path ? "--input" : "--screenshot-every");
+                wo.mouse ? "--mouse" : wo.input_path ? "--input" : wo.iso2 > 0.0f ? "--iso2"
+                         : wo.colour != 0 ? "--colour" : "--screenshot-every");
         return 2;
     }
     char frames_dir[4096];
@@ -270,6 +306,11 @@ int cmd_sculpt(int argc, char **argv)
                    s.rt.wake_mean_ns / 1000.0, s.rt.wake_max_ns / 1000.0,
                    s.rt.compute_min_ns / 1000.0, s.rt.compute_mean_ns / 1000.0,
                    s.rt.compute_max_ns / 1000.0, s.rt.overruns, s.rt.worst_streak);
+        printf("  global solve        %s, %u steps, CPU time per step median %.2f ms, 99th "
+               "percentile %.2f ms, max %.2f ms; session wall time %.2f s\n",
+               o.global_solve == PEER_SOLVE_BSPLINE ? "B-spline model (implicit)"
+                                                    : "density springs (explicit)",
+               s.solves, s.solve_median_ms, s.solve_p99_ms, s.solve_max_ms, s.real_seconds);
         printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
                (double)s.force_limit_n);
         printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,

@@ -4,12 +4,14 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "firmware/core/safety.h"
 
 void peer_cfg_default(peer_cfg_t *cfg)
 {
     cfg->window_edge = 16;
+    cfg->global_solve = PEER_SOLVE_SPRINGS;
     cfg->heartbeat_period_us = 5000u;
     cfg->solve_period_us = 10000u;
     cfg->window_min_period_us = 20000u;
@@ -18,7 +20,8 @@ void peer_cfg_default(peer_cfg_t *cfg)
 argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
                       peer_telemetry_fn on_telemetry, void *ctx)
 {
-    if (cfg->window_edge < 4 || cfg->window_edge > ARGIL_WINDOW_MAX)
+    if (cfg->window_edge < 4 || cfg->window_edge > ARGIL_WINDOW_MAX ||
+        (cfg->global_solve != PEER_SOLVE_SPRINGS && cfg->global_solve != PEER_SOLVE_BSPLINE))
         return ARGIL_ERR_ARG;
     memset(p, 0, sizeof(*p));
     p->cfg = *cfg;
@@ -34,6 +37,23 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
     for (int a = 0; a < 3; a++) {
         p->dirty_lo[a] = 1;
         p->dirty_hi[a] = 0;
+        p->force_lo[a] = 1;
+        p->force_hi[a] = 0;
+    }
+    if (cfg->global_solve == PEER_SOLVE_BSPLINE) {
+        p->gs = calloc(1, sizeof(*p->gs));
+        if (!p->gs) {
+            peer_free(p);
+            return ARGIL_ERR_NOMEM;
+        }
+        const argil_err_t e = gsolve_init(p->gs, grid);
+        if (e != ARGIL_OK) {
+            free(p->gs);
+            p->gs = NULL;
+            peer_free(p);
+            return e;
+        }
+        p->gs_mat = grid->material;
     }
     return ARGIL_OK;
 }
@@ -42,6 +62,11 @@ void peer_free(peer_t *p)
 {
     free(p->win_samples);
     p->win_samples = NULL;
+    if (p->gs) {
+        gsolve_free(p->gs);
+        free(p->gs);
+        p->gs = NULL;
+    }
 }
 
 static bool send_msg(peer_t *p, const proto_msg_t *m)
@@ -105,6 +130,14 @@ static void apply_impulses(peer_t *p, const msg_impulse_t *im)
         if (grid_add_force(p->grid, x, y, z, e->impulse_ns * inv_dt)) {
             p->stats.impulse_total_ns += fabs((double)e->impulse_ns);
             p->field_dirty = true;
+            const int32_t at[3] = {x, y, z};
+            const bool none = p->force_lo[0] > p->force_hi[0];
+            for (int a = 0; a < 3; a++) {
+                if (none || at[a] < p->force_lo[a])
+                    p->force_lo[a] = at[a];
+                if (none || at[a] + 1 > p->force_hi[a])
+                    p->force_hi[a] = at[a] + 1;
+            }
         } else {
             p->stats.impulses_unmapped++;
         }
@@ -250,10 +283,9 @@ static void remember_settling(peer_t *p, const peer_box_t *box)
     p->settling[p->settling_count++] = *box;
 }
 
-static void solve(peer_t *p)
+static void solve_springs(peer_t *p)
 {
     grid_t *g = p->grid;
-    p->stats.solves++;
     const bool active = p->have_tm && p->last_tm.state == SAFETY_ACTIVE;
     if (active && p->last_tm.tool_kind == TOOL_CARVE && (p->last_tm.buttons & 1u)) {
         int32_t lo[3], hi[3];
@@ -297,6 +329,91 @@ static void solve(peer_t *p)
             k++;
         }
     }
+}
+
+/* Drops the external forces the step did not take (outside its window). */
+static void clear_forces(peer_t *p)
+{
+    grid_t *g = p->grid;
+    if (p->force_lo[0] > p->force_hi[0])
+        return;
+    for (int32_t z = p->force_lo[2]; z < p->force_hi[2]; z++)
+        for (int32_t y = p->force_lo[1]; y < p->force_hi[1]; y++) {
+            const size_t row = (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+            memset(&g->force[row + (size_t)p->force_lo[0]], 0,
+                   (size_t)(p->force_hi[0] - p->force_lo[0]) * sizeof(float));
+        }
+    for (int a = 0; a < 3; a++) {
+        p->force_lo[a] = 1;
+        p->force_hi[a] = 0;
+    }
+}
+
+static void solve_error(peer_t *p, argil_err_t e)
+{
+    p->stats.solve_errors++;
+    p->stats.last_solve_error = e;
+}
+
+/* The global solve on the B-spline model: carving through host/model/tools.c, then one
+ * implicit step in the physical window (the board's window and a margin). */
+static void solve_bspline(peer_t *p)
+{
+    grid_t *g = p->grid;
+    if (memcmp(&p->gs_mat, &g->material, sizeof(p->gs_mat)) != 0) {
+        gsolve_set_material(p->gs, &g->material);
+        p->gs_mat = g->material;
+    }
+    const bool active = p->have_tm && p->last_tm.state == SAFETY_ACTIVE;
+    if (active && p->last_tm.tool_kind == TOOL_CARVE && (p->last_tm.buttons & 1u)) {
+        int32_t lo[3], hi[3];
+        const argil_err_t e = gsolve_carve_sphere(p->gs, g, tool_pos(p), p->tool.radius_m, lo, hi);
+        if (e != ARGIL_OK) {
+            solve_error(p, e);
+        } else if (hi[0] > lo[0]) {
+            mark_dirty(p, lo, hi);
+            p->field_dirty = true;
+        }
+    }
+    if (p->have_current) {
+        peer_box_t box;
+        for (int a = 0; a < 3; a++) {
+            box.lo[a] = p->current.corner[a] - 4;
+            box.hi[a] = p->current.corner[a] + p->current.dims[a] + 4;
+        }
+        p->box = box;
+        p->have_box = true;
+        p->impulse_seq_applied = p->impulse_seq_received;
+        int32_t lo[3], hi[3];
+        float change = 0.0f;
+        const argil_err_t e = gsolve_step(p->gs, g, box.lo, box.hi,
+                                          (float)p->cfg.solve_period_us * 1e-6f, lo, hi, &change);
+        if (e != ARGIL_OK) {
+            solve_error(p, e);
+        } else if (hi[0] > lo[0]) {
+            mark_dirty(p, lo, hi);
+            p->field_dirty = true;
+        }
+    }
+    clear_forces(p);
+}
+
+static void solve(peer_t *p)
+{
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+    p->stats.solves++;
+    if (p->gs)
+        solve_bspline(p);
+    else
+        solve_springs(p);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+    const double ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
+    const double bin = ms * 100.0;
+    p->stats.solve_hist_10us[bin < (double)(PEER_SOLVE_HIST_BINS - 1u) ? (uint32_t)bin
+                                                                      : PEER_SOLVE_HIST_BINS - 1u]++;
+    if (ms > p->stats.solve_max_ms)
+        p->stats.solve_max_ms = ms;
 }
 
 void peer_tick(peer_t *p, uint32_t dt_us)
@@ -359,4 +476,66 @@ void peer_tick(peer_t *p, uint32_t dt_us)
                 p->arm_sent = true;
         }
     }
+}
+
+float peer_material_at(const peer_t *p, peer_material_t ch, vec3_t x_m)
+{
+    if (!p->gs)
+        return 1.0f; /* the springs solve's material is uniform */
+    return gsolve_material_at(p->gs, ch == PEER_MAT_MASS ? GSOLVE_MAT_MASS : GSOLVE_MAT_STIFFNESS,
+                              x_m);
+}
+
+argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, float radius_m,
+                                float scale)
+{
+    if (!p->gs)
+        return ARGIL_ERR_STATE;
+    const argil_err_t e = gsolve_paint(p->gs, ch == PEER_MAT_MASS ? GSOLVE_MAT_MASS
+                                                                   : GSOLVE_MAT_STIFFNESS,
+                                       centre_m, radius_m, scale);
+    if (e == ARGIL_OK) {
+        /* The densities did not change, but the surface there must be re-meshed to show the
+         * new material (colour maps): the painted ball's sample box becomes dirty. */
+        const grid_t *g = p->grid;
+        int32_t lo[3], hi[3];
+        const float c[3] = {centre_m.x - g->origin_m.x, centre_m.y - g->origin_m.y,
+                            centre_m.z - g->origin_m.z};
+        for (int a = 0; a < 3; a++) {
+            const float l = floorf((c[a] - radius_m) / g->spacing_m);
+            const float h = ceilf((c[a] + radius_m) / g->spacing_m) + 1.0f;
+            lo[a] = l < 0.0f ? 0 : l > (float)g->dims[a] ? g->dims[a] : (int32_t)l;
+            hi[a] = h < 0.0f ? 0 : h > (float)g->dims[a] ? g->dims[a] : (int32_t)h;
+        }
+        if (lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2])
+            mark_dirty(p, lo, hi);
+    }
+    return e;
+}
+
+static double hist_ms(const uint32_t *hist, double q)
+{
+    uint64_t total = 0, seen = 0;
+    for (uint32_t i = 0; i < PEER_SOLVE_HIST_BINS; i++)
+        total += hist[i];
+    for (uint32_t i = 0; i < PEER_SOLVE_HIST_BINS; i++) {
+        seen += hist[i];
+        if (total > 0 && (double)seen >= q * (double)total)
+            return (double)i * 0.01;
+    }
+    return 0.0;
+}
+
+void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max)
+{
+    *median = hist_ms(p->stats.solve_hist_10us, 0.5);
+    *p99 = hist_ms(p->stats.solve_hist_10us, 0.99);
+    *max = p->stats.solve_max_ms;
+}
+
+void peer_set_solve_period_us(peer_t *p, uint32_t us)
+{
+    if (us < PEER_SOLVE_PERIOD_MIN_US) us = PEER_SOLVE_PERIOD_MIN_US;
+    if (us > PEER_SOLVE_PERIOD_MAX_US) us = PEER_SOLVE_PERIOD_MAX_US;
+    p->cfg.solve_period_us = us;
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/app/global_solve.h"
 #include "host/model/grid.h"
 #include "shared/proto.h"
 
@@ -34,8 +35,19 @@ typedef bool (*peer_send_fn)(void *ctx, const uint8_t *frame, size_t len);
 /* Receives each telemetry message in arrival order. */
 typedef void (*peer_telemetry_fn)(void *ctx, const msg_telemetry_t *t);
 
+/* What the global solve steps (docs/model.md "In the session"). */
+typedef enum {
+    PEER_SOLVE_SPRINGS = 0,           /* explicit density springs on the dense grid */
+    PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/app/global_solve.h) */
+} peer_global_solve_t;
+
+#define PEER_SOLVE_HIST_BINS 5001u    /* solve step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
+
 typedef struct {
     int32_t window_edge;              /* samples per axis of the board's window */
+    peer_global_solve_t global_solve; /* PEER_SOLVE_SPRINGS by default here (argil connect,
+                                       * hil-host, the SIL rig); argil sculpt's session chooses
+                                       * PEER_SOLVE_BSPLINE (session_opts_default) */
     uint32_t heartbeat_period_us;     /* 5 ms */
     uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
     uint32_t window_min_period_us;    /* refresh an edited window at most this often */
@@ -53,6 +65,10 @@ typedef struct {
     uint16_t last_fault_code;
     uint32_t rt_stats_frames;         /* RT_STATS frames received */
     double impulse_total_ns;          /* Σ|J| applied */
+    uint32_t solve_errors;            /* B-spline steps that failed (the field kept its state) */
+    argil_err_t last_solve_error;
+    uint32_t solve_hist_10us[PEER_SOLVE_HIST_BINS]; /* thread CPU time of each solve step */
+    double solve_max_ms;
 } peer_stats_t;
 
 typedef struct {
@@ -93,11 +109,15 @@ typedef struct {
     uint32_t settling_count;
     peer_stats_t stats;
     proto_msg_t scratch;
+    gsolve_t *gs;                     /* the B-spline model (PEER_SOLVE_BSPLINE), else NULL */
+    spring_material_t gs_mat;         /* grid material the model last took */
+    int32_t force_lo[3], force_hi[3]; /* samples holding external force (lo > hi: none) */
 } peer_t;
 
 void peer_cfg_default(peer_cfg_t *cfg);
 
-/* Sets up the peer over a grid; the grid stays the caller's. */
+/* Sets up the peer over a grid; the grid stays the caller's. With PEER_SOLVE_BSPLINE the model
+ * is seeded from the grid's densities and the grid becomes its view. */
 argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
                       peer_telemetry_fn on_telemetry, void *ctx);
 void peer_free(peer_t *p);
@@ -113,5 +133,25 @@ void peer_request_arm(peer_t *p);
 
 /* Advances the host by dt_us: heartbeats, tool, global solve and carving, windows. */
 void peer_tick(peer_t *p, uint32_t dt_us);
+
+/* Material channels a session can paint and show. */
+typedef enum { PEER_MAT_STIFFNESS, PEER_MAT_MASS } peer_material_t;
+
+/* The material at x relative to the default (1.0 = default): the painted scale of the B-spline
+ * model; 1.0 everywhere with the springs solve (its material is uniform). */
+float peer_material_at(const peer_t *p, peer_material_t ch, vec3_t x_m);
+
+/* Sets the global solve's period, clamped to PEER_SOLVE_PERIOD_MIN_US..PEER_SOLVE_PERIOD_MAX_US. */
+#define PEER_SOLVE_PERIOD_MIN_US 2000u
+#define PEER_SOLVE_PERIOD_MAX_US 50000u
+void peer_set_solve_period_us(peer_t *p, uint32_t us);
+
+/* Paints the stiffness or mass scale toward `scale` within radius of centre (linear falloff);
+ * ARGIL_ERR_STATE with the springs solve (uniform material), ARGIL_ERR_ARG for bad values. */
+argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, float radius_m,
+                                float scale);
+
+/* Median, 99th percentile (10 µs resolution) and max of the solve steps' thread CPU times, ms. */
+void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max);
 
 #endif

@@ -126,6 +126,7 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
     c->line = lineno;
     c->arg_int = 0;
     c->value = 0.0f;
+    c->radius_m = 0.0f;
     c->target_m = vec3(0, 0, 0);
     const char *op = w[0];
     if (strcmp(op, "tool") == 0 || strcmp(op, "shape") == 0 || strcmp(op, "filter") == 0) {
@@ -207,8 +208,27 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
         c->op = SCRIPT_WAIT;
         return ARGIL_OK;
     }
+    if (strcmp(op, "paint") == 0) {
+        float scale, radius_mm;
+        if (n != 5 || (strcmp(w[1], "stiffness") != 0 && strcmp(w[1], "mass") != 0) ||
+            strcmp(w[3], "radius") != 0)
+            FAIL("line %d: 'paint' takes stiffness|mass SCALE radius MM", lineno);
+        if (!parse_float(w[2], &scale) || !parse_float(w[4], &radius_mm))
+            FAIL("line %d: 'paint' scale and radius must be numbers", lineno);
+        if (!(scale >= SCRIPT_PAINT_SCALE_MIN && scale <= SCRIPT_PAINT_SCALE_MAX))
+            FAIL("line %d: paint scale must be within %g … %g, got %s", lineno,
+                 (double)SCRIPT_PAINT_SCALE_MIN, (double)SCRIPT_PAINT_SCALE_MAX, w[2]);
+        if (!(radius_mm >= SCRIPT_PAINT_RADIUS_MIN_MM && radius_mm <= SCRIPT_PAINT_RADIUS_MAX_MM))
+            FAIL("line %d: paint radius must be within %g … %g mm, got %s", lineno,
+                 (double)SCRIPT_PAINT_RADIUS_MIN_MM, (double)SCRIPT_PAINT_RADIUS_MAX_MM, w[4]);
+        c->op = SCRIPT_PAINT;
+        c->arg_int = w[1][0] == 's' ? SCRIPT_PAINT_STIFFNESS : SCRIPT_PAINT_MASS;
+        c->value = scale;
+        c->radius_m = radius_mm * 1e-3f;
+        return ARGIL_OK;
+    }
     FAIL("line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
-         "wait)",
+         "wait, paint)",
          lineno, op);
 }
 
@@ -300,6 +320,14 @@ float script_duration_s(const script_t *s)
     return t;
 }
 
+int script_first_paint_line(const script_t *s)
+{
+    for (size_t i = 0; i < s->count; i++)
+        if (s->cmds[i].op == SCRIPT_PAINT)
+            return s->cmds[i].line;
+    return 0;
+}
+
 void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
 {
     memset(p, 0, sizeof(*p));
@@ -318,10 +346,24 @@ void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
 
 int script_player_step(script_player_t *p, float dt_s)
 {
-    /* Start commands until one takes time (bounded by the script's length). */
+    /* Start commands until one takes time (bounded by the script's length); a paint waits for
+     * the next step when this one already handed over SCRIPT_PAINTS_PENDING_MAX. The paints of
+     * the previous step were the caller's to apply before this call. */
+    p->paints_pending = 0;
     while (!p->active && p->next < p->script->count) {
+        if (p->script->cmds[p->next].op == SCRIPT_PAINT &&
+            p->paints_pending >= (int)SCRIPT_PAINTS_PENDING_MAX)
+            return 0;
         const script_cmd_t *c = &p->script->cmds[p->next++];
         switch (c->op) {
+        case SCRIPT_PAINT: {
+            script_paint_t *pt = &p->paints[p->paints_pending++];
+            pt->channel = c->arg_int;
+            pt->scale = c->value;
+            pt->radius_m = c->radius_m;
+            pt->pos_m = p->pos_m;
+            break;
+        }
         case SCRIPT_TOOL:
             p->tool = c->arg_int;
             p->params_changed = 1;

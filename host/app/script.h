@@ -17,8 +17,16 @@ typedef enum {
     SCRIPT_MOVE,      /* move X_MM Y_MM Z_MM SECONDS */
     SCRIPT_PRESS,     /* press 1|2 */
     SCRIPT_RELEASE,   /* release 1|2 */
-    SCRIPT_WAIT       /* wait SECONDS */
+    SCRIPT_WAIT,      /* wait SECONDS */
+    SCRIPT_PAINT      /* paint stiffness|mass SCALE radius MM: at the hand (B-spline solve) */
 } script_op_t;
+
+typedef enum { SCRIPT_PAINT_STIFFNESS = 0, SCRIPT_PAINT_MASS } script_paint_ch_t;
+#define SCRIPT_PAINT_SCALE_MIN 0.05f
+#define SCRIPT_PAINT_SCALE_MAX 50.0f
+#define SCRIPT_PAINT_RADIUS_MIN_MM 0.5f
+#define SCRIPT_PAINT_RADIUS_MAX_MM 100.0f
+#define SCRIPT_PAINTS_PENDING_MAX 8  /* paints one player step hands over at most */
 
 typedef enum {
     PARAM_RADIUS_MM,
@@ -42,8 +50,17 @@ typedef struct {
     int line;                 /* 1-based line in the file */
     int arg_int;              /* tool kind, shape, filter, button number, or param id */
     vec3_t target_m;          /* move: model space; axis: unit vector */
-    float value;              /* set: value; move/wait: seconds */
+    float value;              /* set: value; move/wait: seconds; paint: scale */
+    float radius_m;           /* paint */
 } script_cmd_t;
+
+/* A material paint the player reached, for the session to apply at the hand's position. */
+typedef struct {
+    int channel;              /* script_paint_ch_t */
+    float scale;
+    float radius_m;
+    vec3_t pos_m;             /* model space */
+} script_paint_t;
 
 typedef struct {
     script_cmd_t *cmds;
@@ -88,7 +105,12 @@ typedef struct {
     vec3_t axis;              /* unit */
     float params[PARAM_COUNT];
     int params_changed;       /* set when tool or a param changed since the last call */
+    script_paint_t paints[SCRIPT_PAINTS_PENDING_MAX]; /* reached by the last step: the */
+    int paints_pending;       /* caller applies them before the next step (which drops them) */
 } script_player_t;
+
+/* The first paint command's line, or 0 when the script has none. */
+int script_first_paint_line(const script_t *s);
 
 void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m);
 /* Advances by dt_s; returns 0 while running, 1 once every command has finished. */

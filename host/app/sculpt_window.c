@@ -21,6 +21,7 @@
 #include "host/mesh/mc_blocks.h"
 #include "host/render/backend_glfw.h"
 #include "host/render/camera.h"
+#include "host/render/colour_map.h"
 #include "host/render/hud.h"
 #include "host/render/png_write.h"
 #include "host/render/renderer.h"
@@ -29,15 +30,35 @@
 #include "host/render/ui_queue.h"
 
 #define FRAME_PERIOD_S (1.0 / 60.0)   /* simulated time between snapshots */
-#define EARLY_PUBLISH_S 0.008        /* least simulated time between snapshots */
+#define EARLY_PUBLISH_S 0.008        /* least simulated time between snapshots of other changes */
+#define SOLVED_PUBLISH_S 0.002       /* ... and after a solve step took in an impulse */
 #define DISPLAY_PERIOD_NS 16666667u   /* the window draws at most this often */
 #define STATS_WINDOW_S 1.0            /* loop rate and worst tick over this much time */
 #define LATENCY_SAMPLES 4096u
+#define INTERACTIVE_NS 300000000u     /* frames skip multisampling this long after a change */
+#define ISO2_STEP 0.1f                /* the second iso-surface's level moves by this per key */
+#define ISO2_MIN 0.05f
+#define ISO2_MAX 0.95f
+
+/* The stages of a change's way to the screen, timed on the wall clock (--report). */
+enum {
+    STAGE_SOLVE,    /* impulse taken in by the host → the solve step that integrated it */
+    STAGE_MESH,     /* → its blocks re-meshed and the snapshot filled */
+    STAGE_HANDOVER, /* → snapshot published → taken by the render thread */
+    STAGE_UPLOAD,   /* → changed geometry uploaded */
+    STAGE_DRAW,     /* → draw calls issued (scene and HUD) */
+    STAGE_SWAP,     /* → swap returned: the frame is shown */
+    STAGE_COUNT
+};
+static const char *const STAGE_NAMES[STAGE_COUNT] = {"solve", "mesh", "hand-over",
+                                                     "upload", "draw", "swap"};
 
 static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull",
                                                         "carve", "probe", "rope"};
 static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussian", "spherical",
                                                            "cylindrical", "conical"};
+
+#define PANEL_SOLVE_STEP (-1)         /* panel row that is no PARAM_*: the solve period */
 
 /* The panel's parameters: ranges as scripts accept them (host/app/script.c), a step factor,
  * and the first value above zero for those that may be 0. */
@@ -54,6 +75,9 @@ static const struct {
     {PARAM_ALPHA, "alpha", 0.0f, 1e7f, 1.5f, 100.0f},
     {PARAM_YIELD_FORCE_N, "yield N", 0.0f, 10.0f, 1.25f, 0.05f},
     {PARAM_MAX_FORCE_N, "max force N", 0.1f, 10.0f, 1.1f, 0.1f},
+    /* The host's global solve step: a peer setting, not a script parameter. */
+    {PANEL_SOLVE_STEP, "solve step ms", PEER_SOLVE_PERIOD_MIN_US * 1e-3f,
+     PEER_SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, PEER_SOLVE_PERIOD_MIN_US * 1e-3f},
 };
 #define PANEL_N ((int)(sizeof(PANEL) / sizeof(PANEL[0])))
 
@@ -73,15 +97,30 @@ typedef struct {
     float link_latency_ms;
     int tool, filter;
     float params[PARAM_COUNT];
+    float solve_step_ms;          /* the host's global solve period */
     bool inverted;
-    double change_t_s;            /* < 0, or when the oldest change this mesh shows arrived */
+    uint64_t pub_seq;             /* snapshots published before this one, plus one */
+    /* The oldest change this snapshot shows that no swapped frame has shown yet (also when it
+     * was first published in a snapshot the window skipped): its publication and, on the
+     * monotonic wall clock, the impulse taken in by the host, the solve step that integrated it
+     * and the end of its re-mesh. */
+    bool has_change;
+    uint64_t change_pub, arrival_ns, solved_ns, meshed_ns;
     uint64_t published_ns;        /* monotonic wall clock at publication */
+    float iso;                    /* the clay's level */
+    bool iso2_on;                 /* the second iso-surface: mesh2 at iso2_level */
+    float iso2_level;
+    mesh_t mesh2;
+    uint64_t mesh2_serial;
+    int colour;                   /* colour_map_t the mesh's vertex colours show */
+    float colour_lo, colour_hi;   /* the ramp's range, relative to the default material */
 } live_frame_t;
 
 typedef struct {
     /* Shared between the threads. */
     triple_buffer_t tb;
     live_frame_t slot[3];
+    _Atomic uint64_t shown_pub;   /* pub_seq of the newest snapshot a swapped frame showed */
     ui_queue_t q;
     atomic_int want_stop, session_done;
     /* Session thread only. */
@@ -90,6 +129,11 @@ typedef struct {
     mc_blocks_t mcb;
     bool mcb_ready, mcb_failed;
     uint64_t serial;
+    mc_blocks_t mcb2;             /* the second iso-surface's mesher (only while shown) */
+    bool mcb2_ready, iso2_on;
+    float iso2_level;
+    uint64_t serial2;
+    int colour;                   /* colour_map_t */
     double next_frame_s, last_t_s, last_publish_s;
     uint64_t wall0_ns;
     bool wall0_set;
@@ -107,6 +151,10 @@ typedef struct {
     bool stopping, final_published;
     uint32_t pending_seq;
     double pending_since_s;       /* < 0: no impulse waiting to be shown */
+    uint64_t pending_arrival_ns, pending_solved_ns; /* wall clock: taken in, integrated (0: not yet) */
+    uint64_t pub_seq;
+    bool carry;                   /* a change published but not yet shown (carry_*) */
+    uint64_t carry_pub, carry_arrival_ns, carry_solved_ns, carry_meshed_ns;
     /* The session's own results. */
     session_opts_t so;
     session_hook_t hook;
@@ -152,7 +200,8 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
     case UI_CMD_PARAM:
         if (c->arg >= 0 && c->arg < PANEL_N) {
             const int k = PANEL[c->arg].param;
-            float v = pl->params[k];
+            float v = k == PANEL_SOLVE_STEP ? (float)f->peer->cfg.solve_period_us * 1e-3f
+                                            : pl->params[k];
             if (c->value > 0.0f)
                 v = v > 0.0f ? v * PANEL[c->arg].factor : PANEL[c->arg].first;
             else
@@ -160,8 +209,12 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
             if (c->value < 0.0f && PANEL[c->arg].lo == 0.0f && v < PANEL[c->arg].first)
                 v = 0.0f;
             v = v < PANEL[c->arg].lo ? PANEL[c->arg].lo : (v > PANEL[c->arg].hi ? PANEL[c->arg].hi : v);
-            pl->params[k] = v;
-            pl->params_changed = 1;
+            if (k == PANEL_SOLVE_STEP) {
+                peer_set_solve_period_us(f->peer, (uint32_t)lroundf(v * 1e3f));
+            } else {
+                pl->params[k] = v;
+                pl->params_changed = 1;
+            }
         }
         break;
     case UI_CMD_INVERT:
@@ -196,7 +249,55 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
         *L->stop = 1;
         L->stopping = true;
         break;
+    case UI_CMD_ISO2:
+        L->iso2_on = c->arg != 0 && c->value >= ISO2_MIN && c->value <= ISO2_MAX;
+        if (L->iso2_on)
+            L->iso2_level = c->value;
+        break;
+    case UI_CMD_COLOUR:
+        if (c->arg >= 0 && c->arg < COLOUR_MAP_COUNT && c->arg != L->colour) {
+            L->colour = c->arg;
+            if (L->serial != 0)
+                L->serial++; /* every slot's mesh is coloured again */
+        }
+        break;
     }
+}
+
+typedef struct {
+    const peer_t *peer;
+    peer_material_t ch;
+} material_sampler_t;
+
+static float sample_material(const void *ctx, vec3_t x_m)
+{
+    const material_sampler_t *s = ctx;
+    return peer_material_at(s->peer, s->ch, x_m);
+}
+
+/* Keeps the second iso-surface's mesher at its level and meshes what changed. */
+static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo[3],
+                        const int32_t hi[3])
+{
+    if (L->mcb2_ready && (!L->iso2_on || L->mcb2.iso != L->iso2_level)) {
+        mc_blocks_free(&L->mcb2);
+        L->mcb2_ready = false;
+    }
+    if (!L->iso2_on)
+        return;
+    if (!L->mcb2_ready) {
+        if (mc_blocks_init(&L->mcb2, g->dims, g->spacing_m, g->origin_m, L->iso2_level) !=
+            ARGIL_OK) {
+            L->iso2_on = false; /* no memory for it: the window shows it off */
+            return;
+        }
+        L->mcb2_ready = true;
+        L->serial2++;
+    } else if (!empty) {
+        mc_blocks_mark(&L->mcb2, lo, hi);
+    }
+    if (mc_blocks_update(&L->mcb2, g->density, NULL) == ARGIL_OK && L->mcb2.blocks_meshed > 0)
+        L->serial2++;
 }
 
 /* Re-meshes what changed and publishes a snapshot. */
@@ -219,21 +320,57 @@ static void publish(live_t *L, session_frame_t *f)
         if (mc_blocks_update(&L->mcb, g->density, NULL) == ARGIL_OK && L->mcb.blocks_meshed > 0)
             L->serial++;
     }
+    update_iso2(L, g, empty, p->dirty_lo, p->dirty_hi);
     for (int a = 0; a < 3; a++) {
         p->dirty_lo[a] = 1;
         p->dirty_hi[a] = 0;
     }
     live_frame_t *fr = &L->slot[triple_buffer_back(&L->tb)];
     if (L->serial != 0 && fr->mesh_serial != L->serial) {
-        if (mc_blocks_assemble(&L->mcb, &fr->mesh) == ARGIL_OK)
+        if (mc_blocks_assemble(&L->mcb, &fr->mesh) == ARGIL_OK) {
             fr->mesh_serial = L->serial;
+            fr->colour = L->colour;
+            fr->colour_lo = fr->colour_hi = 1.0f;
+            if (L->colour != COLOUR_MAP_NONE) {
+                const material_sampler_t ms = {
+                    p, L->colour == COLOUR_MAP_MASS ? PEER_MAT_MASS : PEER_MAT_STIFFNESS};
+                if (colour_map_mesh(&fr->mesh, sample_material, &ms, &fr->colour_lo,
+                                    &fr->colour_hi) != ARGIL_OK)
+                    fr->colour = COLOUR_MAP_NONE;
+            }
+        }
     }
-    fr->change_t_s = -1.0;
+    fr->iso = g->iso;
+    fr->iso2_on = L->iso2_on && L->mcb2_ready;
+    fr->iso2_level = L->iso2_level;
+    if (fr->iso2_on && fr->mesh2_serial != L->serial2) {
+        if (mc_blocks_assemble(&L->mcb2, &fr->mesh2) == ARGIL_OK)
+            fr->mesh2_serial = L->serial2;
+        else
+            fr->iso2_on = false;
+    }
+    const uint64_t meshed_ns = now_ns();
+    fr->pub_seq = ++L->pub_seq;
+    if (L->carry && atomic_load(&L->shown_pub) >= L->carry_pub)
+        L->carry = false; /* a swapped frame has shown it */
     if (L->pending_since_s >= 0.0 && (int32_t)(p->impulse_seq_applied - L->pending_seq) >= 0 &&
         fr->mesh_serial == L->serial) {
-        fr->change_t_s = L->pending_since_s;
+        /* Measured: the oldest change not yet shown (a newer one waits behind it unmeasured,
+         * so the figure errs long, never short). */
+        if (!L->carry) {
+            L->carry = true;
+            L->carry_pub = fr->pub_seq;
+            L->carry_arrival_ns = L->pending_arrival_ns;
+            L->carry_solved_ns = L->pending_solved_ns != 0 ? L->pending_solved_ns : meshed_ns;
+            L->carry_meshed_ns = meshed_ns;
+        }
         L->pending_since_s = -1.0;
     }
+    fr->has_change = L->carry;
+    fr->change_pub = L->carry_pub;
+    fr->arrival_ns = L->carry_arrival_ns;
+    fr->solved_ns = L->carry_solved_ns;
+    fr->meshed_ns = L->carry_meshed_ns;
     fr->t_s = f->t_s;
     fr->active = f->active;
     fr->script_done = f->script_done;
@@ -257,6 +394,7 @@ static void publish(live_t *L, session_frame_t *f)
     fr->tool = f->player->tool;
     fr->filter = f->player->filter;
     memcpy(fr->params, f->player->params, sizeof(fr->params));
+    fr->solve_step_ms = (float)p->cfg.solve_period_us * 1e-3f;
     fr->inverted = L->inverted;
     fr->published_ns = now_ns();
     triple_buffer_publish(&L->tb);
@@ -300,7 +438,12 @@ static void on_tick(void *ctx, session_frame_t *f)
     if (L->pending_since_s < 0.0 && p->impulse_seq_received != L->pending_seq) {
         L->pending_seq = p->impulse_seq_received;
         L->pending_since_s = f->t_s;
+        L->pending_arrival_ns = now_ns();
+        L->pending_solved_ns = 0;
     }
+    if (L->pending_since_s >= 0.0 && L->pending_solved_ns == 0 &&
+        (int32_t)(p->impulse_seq_applied - L->pending_seq) >= 0)
+        L->pending_solved_ns = now_ns();
 
     /* Mouse sculpting: once the board is ACTIVE and there is no script left, the hand is ours. */
     if (L->wo->mouse && f->active && f->script_done) {
@@ -318,13 +461,16 @@ static void on_tick(void *ctx, session_frame_t *f)
         }
     }
 
-    /* A snapshot every frame period, and early (at most every 8 ms) once a solve step has
-     * changed the field, so a stroke reaches the screen without waiting for the period. */
+    /* A snapshot every frame period; at once (at most every 2 ms) when a solve step has taken
+     * in the board's impulse, and early (at most every 8 ms) for any other field change, so a
+     * stroke reaches the screen without waiting for the period. */
     bool changed = true;
     for (int a = 0; a < 3; a++)
         changed &= p->dirty_lo[a] < p->dirty_hi[a];
-    if (f->t_s + 1e-9 >= L->next_frame_s ||
-        (changed && f->t_s - L->last_publish_s >= EARLY_PUBLISH_S)) {
+    const double since_s = f->t_s - L->last_publish_s;
+    const bool solved = L->pending_since_s >= 0.0 && L->pending_solved_ns != 0;
+    if (f->t_s + 1e-9 >= L->next_frame_s || (changed && since_s >= EARLY_PUBLISH_S) ||
+        (solved && since_s >= SOLVED_PUBLISH_S)) {
         L->last_publish_s = f->t_s;
         publish(L, f);
         L->next_frame_s += FRAME_PERIOD_S;
@@ -364,11 +510,18 @@ typedef struct {
     hud_t hud;
     render_target_t shot;
     bool shot_ready;
+    render_target_t aa;           /* 4x multisampled frame for still frames */
+    bool aa_ready, aa_failed;
+    uint64_t last_upload_ns;      /* the newest mesh change uploaded (wall clock) */
     uint8_t *shot_rgb;
     camera_t cam;
     render_scene_t scene;
-    uint64_t uploaded_serial;
+    uint64_t uploaded_serial, uploaded2_serial;
+    uint64_t counted_pub;         /* the newest change whose latency is counted */
     int panel_sel;
+    bool iso2_on;                 /* asked for by the keys (the session confirms in the frame) */
+    float iso2_level;
+    int colour;
     bool quit;                    /* Esc: no lingering after the session */
     /* Input state (from GLFW, or from the input file when one is given). */
     double cx, cy;
@@ -382,6 +535,9 @@ typedef struct {
     size_t n_frame;
     double latency_ms[LATENCY_SAMPLES];
     size_t n_latency;
+    double stage_ms[STAGE_COUNT][LATENCY_SAMPLES]; /* each measured change's path, per stage */
+    double upload_ms[LATENCY_SAMPLES], draw_ms[LATENCY_SAMPLES], swap_ms[LATENCY_SAMPLES];
+    size_t n_upload;              /* frames that uploaded something */
     double fps;
 } view_t;
 
@@ -413,6 +569,21 @@ static void on_key(live_t *L, view_t *v, int key)
         ui_send(L, UI_CMD_PARAM, v->panel_sel, 1.0f);
     } else if (key == GLFW_KEY_LEFT || key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) {
         ui_send(L, UI_CMD_PARAM, v->panel_sel, -1.0f);
+    } else if (key == GLFW_KEY_I || key == GLFW_KEY_LEFT_BRACKET ||
+               key == GLFW_KEY_RIGHT_BRACKET) {
+        /* I shows / hides the second iso-surface; [ and ] move its level (and show it). */
+        if (key == GLFW_KEY_I) {
+            v->iso2_on = !v->iso2_on;
+        } else {
+            const float d = key == GLFW_KEY_LEFT_BRACKET ? -ISO2_STEP : ISO2_STEP;
+            const float lv = roundf((v->iso2_level + d) * 100.0f) / 100.0f;
+            v->iso2_level = lv < ISO2_MIN ? ISO2_MIN : (lv > ISO2_MAX ? ISO2_MAX : lv);
+            v->iso2_on = true;
+        }
+        ui_send(L, UI_CMD_ISO2, v->iso2_on ? 1 : 0, v->iso2_level);
+    } else if (key == GLFW_KEY_M) {
+        v->colour = (v->colour + 1) % COLOUR_MAP_COUNT;
+        ui_send(L, UI_CMD_COLOUR, v->colour, 0.0f);
     } else if (key == GLFW_KEY_ESCAPE) {
         /* In order after the keys before it; straight to the flag if the queue is full. */
         ui_cmd_t c;
@@ -432,21 +603,31 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
     const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
     const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
     const int sel = v->panel_sel;
+    const float sel_v = PANEL[sel].param == PANEL_SOLVE_STEP ? fr->solve_step_ms
+                                                             : pr[PANEL[sel].param];
+    char iso2[32] = "off", colour[96] = "none";
+    if (fr->iso2_on)
+        snprintf(iso2, sizeof(iso2), "%.2f (clay %.2f)", (double)fr->iso2_level, (double)fr->iso);
+    if (fr->colour != COLOUR_MAP_NONE)
+        snprintf(colour, sizeof(colour), "%s, x default: %.3g (left) .. %.3g (right)",
+                 colour_map_name((colour_map_t)fr->colour), (double)fr->colour_lo,
+                 (double)fr->colour_hi);
     snprintf(out, cap,
              "%s  loop %.0f Hz  worst tick %.0f us  link %.1f ms  force %.2f N  t %.2f s  "
              "view %.0f fps%s\n"
              "tool %s%s  beta %s  radius %.1f mm  stiffness %.2f N/mm  clay k %.3g  damping %.3g"
-             "  plastic %.3g Hz  alpha %.3g\n"
+             "  plastic %.3g Hz  alpha %.3g  solve step %.1f ms\n"
+             "iso2 %s  colour %s\n"
              "> %s = %.4g   [1-6 tool  B beta  TAB/UP/DOWN pick  -/+ change  SHIFT add<>remove"
-             "  C shading  ESC quit]",
+             "  C shading  I iso2  [ ] level  M colour  ESC quit]",
              fr->have_tm ? safety_state_name((safety_state_t)fr->tm.state) : "NO BOARD",
              (double)fr->loop_hz, fr->worst_tick_ns / 1000.0, (double)fr->link_latency_ms,
              sqrt((double)fx * fx + (double)fy * fy + (double)fz * fz), fr->t_s, v->fps,
              L->wo->fast ? "  fast" : "", TOOL_NAMES[t], fr->inverted ? " (inverted)" : "",
              FILTER_NAMES[b], (double)pr[PARAM_RADIUS_MM], (double)pr[PARAM_STIFFNESS_N_PER_MM],
              (double)pr[PARAM_CLAY_STIFFNESS], (double)pr[PARAM_CLAY_DAMPING],
-             (double)pr[PARAM_PLASTIC_RATE_HZ], (double)pr[PARAM_ALPHA], PANEL[sel].label,
-             (double)pr[PANEL[sel].param]);
+             (double)pr[PARAM_PLASTIC_RATE_HZ], (double)pr[PARAM_ALPHA],
+             (double)fr->solve_step_ms, iso2, colour, PANEL[sel].label, (double)sel_v);
 }
 
 static void scene_from_frame(view_t *v, const live_frame_t *fr)
@@ -460,6 +641,8 @@ static void scene_from_frame(view_t *v, const live_frame_t *fr)
     s->show_box = fr->have_box;
     s->box_lo_m = fr->box_lo_m;
     s->box_hi_m = fr->box_hi_m;
+    s->show_wire = fr->iso2_on && fr->mesh2_serial != 0;
+    s->wire_on_top = fr->iso2_level > fr->iso; /* an inner level is seen through the clay */
 }
 
 static void draw_all(live_t *L, view_t *v, const live_frame_t *fr, int w, int h)
@@ -470,6 +653,41 @@ static void draw_all(live_t *L, view_t *v, const live_frame_t *fr, int w, int h)
     hud_text(L, v, fr, text, sizeof(text));
     const float scale = w >= 1500 ? 2.0f : 1.0f;
     hud_draw(&v->hud, text, scale, w, h);
+    if (fr->colour != COLOUR_MAP_NONE) {
+        /* The legend: the ramp under the text, lowest value on the left. */
+        const float y = hud_band_height(text, scale) + 4.0f * scale;
+        hud_draw_ramp(&v->hud, colour_ramp_rgb, 32, 4.0f * scale, y, 192.0f * scale,
+                      10.0f * scale, w, h);
+    }
+}
+
+/* Draws one window frame. While the clay is changing (a mesh upload within the last
+ * INTERACTIVE_NS) it is drawn straight into the window without multisampling, which on
+ * llvmpipe costs about half as much and so shows a stroke sooner; once it has been still that
+ * long, frames are drawn 4x multisampled offscreen and resolved into the window. */
+static void draw_frame(live_t *L, view_t *v, const live_frame_t *fr, int w, int h,
+                       uint64_t now)
+{
+    const bool changing = v->last_upload_ns != 0 && now - v->last_upload_ns < INTERACTIVE_NS;
+    if (!changing && !v->aa_failed) {
+        if (v->aa_ready && (v->aa.width != w || v->aa.height != h)) {
+            render_target_free(&v->aa);
+            v->aa_ready = false;
+        }
+        if (!v->aa_ready) {
+            char e[256];
+            v->aa_ready = render_target_init(&v->aa, &v->gl, w, h, 4, e, sizeof(e)) == ARGIL_OK;
+            v->aa_failed = !v->aa_ready;
+        }
+    }
+    if (!changing && v->aa_ready) {
+        render_target_bind(&v->aa);
+        draw_all(L, v, fr, w, h);
+        render_target_present(&v->aa);
+    } else {
+        v->gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        draw_all(L, v, fr, w, h);
+    }
 }
 
 static bool write_shot(live_t *L, view_t *v, const live_frame_t *fr, const char *path, int w,
@@ -545,6 +763,7 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
             on_key(L, v, key);
         uint32_t slot;
         const bool fresh = triple_buffer_take(&L->tb, &slot);
+        const uint64_t taken_ns = now_ns();
         fr = &L->slot[slot];
         if (fresh)
             have_frame = true;
@@ -582,10 +801,19 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
         v->prev_shift = v->shift;
         v->prev_left = v->left;
 
+        bool uploaded = false;
         if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial) {
             if (renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
                 v->uploaded_serial = fr->mesh_serial;
+            uploaded = true;
         }
+        if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial) {
+            if (renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
+                v->uploaded2_serial = fr->mesh2_serial;
+        }
+        const uint64_t uploaded_ns = now_ns();
+        if (uploaded)
+            v->last_upload_ns = uploaded_ns;
         scene_from_frame(v, fr);
         if (w > 0 && h > 0) {
             if (have_frame && fr->t_s + 1e-9 >= next_shot_s && wo->frames_dir) {
@@ -599,9 +827,16 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
                 while (next_shot_s <= fr->t_s + 1e-9)
                     next_shot_s += wo->screenshot_every_s;
             }
-            draw_all(L, v, fr, w, h);
+            draw_frame(L, v, fr, w, h, uploaded_ns);
         }
+        const uint64_t drawn_ns = now_ns();
         glfw_window_swap(&v->win);
+        const uint64_t swapped_ns = now_ns();
+        if (v->n_upload < LATENCY_SAMPLES && uploaded) {
+            v->upload_ms[v->n_upload] = (double)(uploaded_ns - taken_ns) * 1e-6;
+            v->draw_ms[v->n_upload] = (double)(drawn_ns - uploaded_ns) * 1e-6;
+            v->swap_ms[v->n_upload++] = (double)(swapped_ns - drawn_ns) * 1e-6;
+        }
         /* At most 60 frames a second even where swaps do not wait for the display (Xvfb):
          * the session thread keeps the CPU it needs. */
         uint64_t now = now_ns();
@@ -617,11 +852,19 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
             v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms) : 1000.0 / dt_ms;
         if (v->n_frame < LATENCY_SAMPLES)
             v->frame_ms[v->n_frame++] = dt_ms;
-        if (fresh && fr->change_t_s >= 0.0 && v->n_latency < LATENCY_SAMPLES) {
-            /* Simulated time from the impulse's arrival to the snapshot, plus wall time from
-             * the snapshot to this swap (the session runs paced, so the two clocks agree). */
-            v->latency_ms[v->n_latency++] =
-                (fr->t_s - fr->change_t_s) * 1e3 + (double)(now - fr->published_ns) * 1e-6;
+        if (fresh)
+            atomic_store(&L->shown_pub, fr->pub_seq);
+        if (fresh && fr->has_change && fr->change_pub > v->counted_pub &&
+            v->n_latency < LATENCY_SAMPLES) {
+            v->counted_pub = fr->change_pub;
+            /* Wall clock from the impulse's arrival at the host to the return of the first swap
+             * whose frame shows the solve step that integrated it. */
+            const uint64_t at[STAGE_COUNT + 1] = {fr->arrival_ns, fr->solved_ns, fr->meshed_ns,
+                                                  taken_ns, uploaded_ns, drawn_ns, swapped_ns};
+            for (int k = 0; k < STAGE_COUNT; k++)
+                v->stage_ms[k][v->n_latency] =
+                    at[k + 1] >= at[k] ? (double)(at[k + 1] - at[k]) * 1e-6 : 0.0;
+            v->latency_ms[v->n_latency++] = (double)(swapped_ns - fr->arrival_ns) * 1e-6;
         }
         if (atomic_load(&L->session_done)) {
             if (done_at_ns == 0) {
@@ -676,7 +919,9 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     char title[256];
     snprintf(title, sizeof(title), "argil sculpt — %s",
              so->script_path ? so->script_path : "mouse");
-    if (glfw_window_open(&v->win, wo->width, wo->height, true, 4, title, &v->gl, err,
+    /* No samples in the window itself: still frames are drawn multisampled offscreen and
+     * resolved into it (draw_frame). */
+    if (glfw_window_open(&v->win, wo->width, wo->height, true, 0, title, &v->gl, err,
                          err_len) != ARGIL_OK) {
         *window_failed = true;
         ui_input_free(&v->script);
@@ -699,15 +944,25 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     }
     v->gl.Enable(GL_MULTISAMPLE);
     render_scene_default(&v->scene);
+    v->scene.closed_mesh = true; /* mc_blocks meshes are closed, CCW seen from outside */
     camera_frame(&v->cam, vec3(-0.036f, -0.036f, -0.036f), vec3(0.036f, 0.036f, 0.036f));
     camera_orbit(&v->cam, -30.0f * (float)M_PI / 180.0f, 25.0f * (float)M_PI / 180.0f);
 
     triple_buffer_init(&L->tb);
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 3; i++) {
         mesh_init(&L->slot[i].mesh);
+        mesh_init(&L->slot[i].mesh2);
+    }
+    L->iso2_on = wo->iso2 >= ISO2_MIN && wo->iso2 <= ISO2_MAX;
+    L->iso2_level = L->iso2_on ? wo->iso2 : 0.3f;
+    L->colour = wo->colour > 0 && wo->colour < COLOUR_MAP_COUNT ? wo->colour : COLOUR_MAP_NONE;
+    v->iso2_on = L->iso2_on;
+    v->iso2_level = L->iso2_level;
+    v->colour = L->colour;
     ui_queue_init(&L->q);
     atomic_init(&L->want_stop, 0);
     atomic_init(&L->session_done, 0);
+    atomic_init(&L->shown_pub, 0);
     L->wo = wo;
     L->so = *so;
     L->stop = so->stop;
@@ -745,9 +1000,16 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
             const size_t nf = v->n_frame, nl = v->n_latency;
             const double fm = median(v->frame_ms, nf), lm = median(v->latency_ms, nl);
             const double lmax = nl ? v->latency_ms[nl - 1] : 0.0;
+            const double l90 = nl ? v->latency_ms[nl * 9 / 10] : 0.0;
             printf("  live window         %zu frames, frame time median %.1f ms; change to "
-                   "screen median %.1f ms, max %.1f ms (%zu changes)\n",
-                   nf, fm, lm, lmax, nl);
+                   "screen median %.1f ms, p90 %.1f ms, max %.1f ms (%zu changes)\n",
+                   nf, fm, lm, l90, lmax, nl);
+            printf("  latency stages      median ms:");
+            for (int k = 0; k < STAGE_COUNT; k++)
+                printf(" %s %.1f", STAGE_NAMES[k], median(v->stage_ms[k], nl));
+            printf("; frames with an upload: upload %.1f, draw %.1f, swap %.1f (%zu)\n",
+                   median(v->upload_ms, v->n_upload), median(v->draw_ms, v->n_upload),
+                   median(v->swap_ms, v->n_upload), v->n_upload);
             uint32_t slot;
             triple_buffer_take(&L->tb, &slot);
             const live_frame_t *fr = &L->slot[slot];
@@ -761,10 +1023,19 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
                    (double)fr->params[PARAM_CLAY_STIFFNESS],
                    (double)fr->params[PARAM_CLAY_DAMPING],
                    (double)fr->params[PARAM_PLASTIC_RATE_HZ]);
+            char iso2[16] = "off";
+            if (fr->iso2_on)
+                snprintf(iso2, sizeof(iso2), "%.2f", (double)fr->iso2_level);
+            printf("  view at the end     iso2 %s, colour %s (%.3g .. %.3g x default), solve "
+                   "step %.1f ms\n",
+                   iso2, colour_map_name((colour_map_t)fr->colour), (double)fr->colour_lo,
+                   (double)fr->colour_hi, (double)fr->solve_step_ms);
         }
     }
     if (v->shot_ready)
         render_target_free(&v->shot);
+    if (v->aa_ready)
+        render_target_free(&v->aa);
     free(v->shot_rgb);
     hud_free(&v->hud);
     renderer_free(&v->r);
@@ -772,8 +1043,12 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     ui_input_free(&v->script);
     if (L->mcb_ready)
         mc_blocks_free(&L->mcb);
-    for (int i = 0; i < 3; i++)
+    if (L->mcb2_ready)
+        mc_blocks_free(&L->mcb2);
+    for (int i = 0; i < 3; i++) {
         mesh_free(&L->slot[i].mesh);
+        mesh_free(&L->slot[i].mesh2);
+    }
     free(L);
     free(v);
     return rc;

@@ -20,6 +20,8 @@ typedef struct {
     const char *input_path;       /* NULL, or scripted input (docs/render.md) */
     double linger_s;              /* the window stays this long (wall time) after the session */
     bool report;                  /* print the frame-time and latency figures at the end */
+    float iso2;                   /* > 0: show the second iso-surface at this level from the start */
+    int colour;                   /* colour_map_t shown on the clay from the start */
 } sculpt_window_opts_t;
 
 void sculpt_window_opts_default(sculpt_window_opts_t *o);

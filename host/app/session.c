@@ -34,6 +34,7 @@ void session_opts_default(session_opts_t *o)
     o->script_path = "scripts/default.scn";
     o->out_dir = "out";
     o->window_edge = 16;
+    o->global_solve = PEER_SOLVE_BSPLINE;
     o->progress = false;
     o->settle_s = 2.0f;
     o->deadline_faults = true;
@@ -266,6 +267,14 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         rc = script_load(&s->script, opts->script_path, err, err_len);
         if (rc != ARGIL_OK)
             goto done;
+        const int paint_line = script_first_paint_line(&s->script);
+        if (paint_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
+            snprintf(err, err_len, "%s: line %d: 'paint' needs the B-spline model "
+                     "(--global-solve bspline); the springs' material is uniform",
+                     opts->script_path, paint_line);
+            rc = ARGIL_ERR_ARG;
+            goto done;
+        }
     }
 
     /* The device and the board. */
@@ -293,19 +302,27 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         goto done;
     }
     grid_fill_sphere(&s->grid, vec3(0, 0, 0), SESSION_CLAY_RADIUS_M);
-    rc = mesh_field(&s->grid, &mesh, &sum->volume_before_m3);
-    if (rc != ARGIL_OK) {
-        snprintf(err, err_len, "meshing the initial clay failed");
-        goto done;
-    }
 
     peer_cfg_t pcfg;
     peer_cfg_default(&pcfg);
     pcfg.window_edge = opts->window_edge;
-    rc = peer_init(&s->peer, &pcfg, &s->grid, link_send, on_telemetry, s);
-    if (rc != ARGIL_OK) {
+    pcfg.global_solve = opts->global_solve;
+    if (opts->window_edge < 4 || opts->window_edge > ARGIL_WINDOW_MAX) {
         snprintf(err, err_len, "window edge %d refused (4 … %d)", opts->window_edge,
                  ARGIL_WINDOW_MAX);
+        rc = ARGIL_ERR_ARG;
+        goto done;
+    }
+    /* With the B-spline solve the grid becomes the model's view here (seeded from it). */
+    rc = peer_init(&s->peer, &pcfg, &s->grid, link_send, on_telemetry, s);
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "cannot set up the global solve: %s",
+                 rc == ARGIL_ERR_NOMEM ? "out of memory" : "the model refused the grid");
+        goto done;
+    }
+    rc = mesh_field(&s->grid, &mesh, &sum->volume_before_m3);
+    if (rc != ARGIL_OK) {
+        snprintf(err, err_len, "meshing the initial clay failed");
         goto done;
     }
 
@@ -354,6 +371,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     bool started = false, finished = false;
     double started_at_s = 0.0, finished_at_s = 0.0;
     peer_request_arm(&s->peer);
+    const double loop_real0_s = clock_s(CLOCK_MONOTONIC);
     uint64_t tick;
     for (tick = 0; tick < max_ticks; tick++) {
         const double t_s = (double)tick * dt_s;
@@ -373,6 +391,27 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             finished = true;
             finished_at_s = t_s;
         }
+        for (int k = 0; k < s->player.paints_pending; k++) {
+            const script_paint_t *pt = &s->player.paints[k];
+            /* At the stylus tip the board reports (the hand's target before any telemetry). */
+            const vec3_t at = s->peer.have_tm ? vec3(s->peer.last_tm.pos_m[0],
+                                                     s->peer.last_tm.pos_m[1],
+                                                     s->peer.last_tm.pos_m[2])
+                                              : pt->pos_m;
+            const argil_err_t pe = peer_paint_material(
+                &s->peer, pt->channel == SCRIPT_PAINT_MASS ? PEER_MAT_MASS : PEER_MAT_STIFFNESS,
+                at, pt->radius_m, pt->scale);
+            if (pe != ARGIL_OK) {
+                snprintf(err, err_len, "painting %s at %.1f %.1f %.1f mm failed (error %d)",
+                         pt->channel == SCRIPT_PAINT_MASS ? "mass" : "stiffness",
+                         (double)at.x * 1e3, (double)at.y * 1e3, (double)at.z * 1e3, (int)pe);
+                rc = pe;
+                break;
+            }
+        }
+        s->player.paints_pending = 0;
+        if (rc != ARGIL_OK)
+            break;
         if (finished && t_s - finished_at_s >= SESSION_TAIL_S && !hold_open)
             break;
         if (opts->stop && *opts->stop) {
@@ -428,6 +467,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         if (tick % 1000u == 0)
             progress(opts, t_s, total_s);
     }
+    sum->real_seconds = clock_s(CLOCK_MONOTONIC) - loop_real0_s;
     progress(opts, (double)tick * dt_s, (double)tick * dt_s);
     if (opts->progress)
         fputc('\n', stderr);
@@ -450,6 +490,15 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->impulse_frames = s->peer.stats.impulse_frames;
     sum->link_errors = s->peer.stats.decode_errors + s->board.stats.link_errors;
     sum->telemetry_rows = s->csv_rows;
+    sum->solves = s->peer.stats.solves;
+    sum->solve_errors = s->peer.stats.solve_errors;
+    peer_solve_times_ms(&s->peer, &sum->solve_median_ms, &sum->solve_p99_ms, &sum->solve_max_ms);
+    if (rc == ARGIL_OK && s->peer.stats.solve_errors > 0) {
+        snprintf(err, err_len, "the global solve failed %u times (last error %d); the model "
+                 "kept its last good state", s->peer.stats.solve_errors,
+                 (int)s->peer.stats.last_solve_error);
+        rc = ARGIL_ERR_STATE;
+    }
 
     {
         const argil_err_t me = mesh_field(&s->grid, &mesh, &sum->volume_after_m3);

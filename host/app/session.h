@@ -37,6 +37,7 @@ typedef struct {
     const char *script_path;      /* NULL: no script (the hook drives the hand) */
     const char *out_dir;          /* NULL: write nothing */
     int window_edge;              /* 16 or 32 */
+    peer_global_solve_t global_solve; /* what the host's global solve steps (docs/model.md) */
     bool progress;                /* a progress line on stderr */
     float settle_s;               /* time allowed for the board to become ACTIVE */
     bool deadline_faults;         /* an overrun streak faults the board (off only for profiling) */
@@ -80,6 +81,12 @@ typedef struct {
     uint64_t journal_bytes;       /* record bytes appended */
     uint32_t journal_stray_records; /* changes found outside the peer's dirty box (should be 0) */
     double journal_real_s;        /* wall time spent diffing, appending and syncing */
+    uint32_t solves;              /* global solve steps */
+    double solve_median_ms;       /* thread CPU time per solve step (10 µs resolution) */
+    double solve_p99_ms;
+    double solve_max_ms;
+    uint32_t solve_errors;        /* B-spline steps that failed and were skipped */
+    double real_seconds;          /* wall time of the lockstep loop */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);

@@ -6,7 +6,11 @@
  * the board's own framer (firmware/hal/link_framer.c). Unplug → transport down (link LOST,
  * everything else kept); the device is looked for again (hot-plug events where libusb has
  * them, and a fresh scan every USB_RESCAN_US), reopened, and the link state machine asks the
- * host to resynchronise once frames flow. */
+ * host to resynchronise once frames flow.
+ * Lifetimes: a libusb transfer holds a reference to the device it was last submitted on (libusb
+ * ≥ 1.0.25), and the device points at its context. So the transfers live exactly as long as the
+ * device handle: allocated at open, freed at close (after every callback, while the context is
+ * still alive); a context is only ever torn down with no transfer left. */
 #define _POSIX_C_SOURCE 200809L
 #include <dlfcn.h>
 #include <libusb-1.0/libusb.h>
@@ -16,6 +20,7 @@
 
 #include "firmware/hal/link_io.h"
 #include "host/link/link.h"
+#include "host/link/link_usb_api.h"
 #include "host/link/link_usb_desc.h"
 
 #define USB_IN_TRANSFERS 8u          /* bulk IN transfers kept in flight */
@@ -26,34 +31,6 @@
 #define USB_RESCAN_US 500000u        /* while the device is gone, look for it this often */
 #define USB_ERRORS_GONE 50u          /* consecutive transfer errors taken as an unplug */
 #define USB_CTRL_TIMEOUT_MS 1000u
-
-/* The libusb entry points argil uses, resolved from libusb-1.0.so.0. */
-typedef struct {
-    void *lib;
-    __typeof__(libusb_init) *init;
-    __typeof__(libusb_exit) *exit;
-    __typeof__(libusb_get_device_list) *get_device_list;
-    __typeof__(libusb_free_device_list) *free_device_list;
-    __typeof__(libusb_get_device_descriptor) *get_device_descriptor;
-    __typeof__(libusb_get_bus_number) *get_bus_number;
-    __typeof__(libusb_get_port_numbers) *get_port_numbers;
-    __typeof__(libusb_open) *open;
-    __typeof__(libusb_close) *close;
-    __typeof__(libusb_control_transfer) *control_transfer;
-    __typeof__(libusb_set_auto_detach_kernel_driver) *set_auto_detach_kernel_driver;
-    __typeof__(libusb_claim_interface) *claim_interface;
-    __typeof__(libusb_release_interface) *release_interface;
-    __typeof__(libusb_set_interface_alt_setting) *set_interface_alt_setting;
-    __typeof__(libusb_alloc_transfer) *alloc_transfer;
-    __typeof__(libusb_free_transfer) *free_transfer;
-    __typeof__(libusb_submit_transfer) *submit_transfer;
-    __typeof__(libusb_cancel_transfer) *cancel_transfer;
-    __typeof__(libusb_handle_events_timeout_completed) *handle_events_timeout_completed;
-    __typeof__(libusb_has_capability) *has_capability;
-    __typeof__(libusb_hotplug_register_callback) *hotplug_register_callback;
-    __typeof__(libusb_hotplug_deregister_callback) *hotplug_deregister_callback;
-    __typeof__(libusb_error_name) *error_name;
-} usb_api_t;
 
 typedef struct {
     usb_api_t api;
@@ -71,7 +48,7 @@ typedef struct {
     usb_endpoints_t ep;
     uint8_t bus, ports[LINK_SPEC_PORTS_MAX];
     int n_ports;
-    struct libusb_transfer *in[USB_IN_TRANSFERS];
+    struct libusb_transfer *in[USB_IN_TRANSFERS]; /* allocated while h is open, else NULL */
     struct libusb_transfer *out;
     uint32_t in_flight;              /* IN transfers submitted and not yet called back */
     bool in_busy[USB_IN_TRANSFERS];  /* which of them */
@@ -250,6 +227,33 @@ static void submit_out(usb_t *u)
 
 /* ---- device ---- */
 
+/* Frees the transfers. Call only once none is in a libusb flying list: every callback came, or
+ * libusb_close took the rest off the list. Each free drops the transfer's reference to the
+ * device while its context is alive (freeing them after libusb_exit, or resubmitting them in a
+ * new context, made libusb destroy the unplugged device through its freed context: SIGSEGV). */
+static void transfers_free(usb_t *u)
+{
+    for (uint32_t i = 0; i < USB_IN_TRANSFERS; i++) {
+        if (u->in[i])
+            u->api.free_transfer(u->in[i]);
+        u->in[i] = NULL;
+        u->in_busy[i] = false;
+    }
+    if (u->out)
+        u->api.free_transfer(u->out);
+    u->out = NULL;
+    u->out_busy = false;
+    u->in_flight = 0;
+}
+
+static bool transfers_alloc(usb_t *u)
+{
+    for (uint32_t i = 0; i < USB_IN_TRANSFERS; i++)
+        if (!(u->in[i] = u->api.alloc_transfer(0)))
+            return false;
+    return (u->out = u->api.alloc_transfer(0)) != NULL;
+}
+
 static void close_device(usb_t *u)
 {
     if (!u->h)
@@ -267,10 +271,12 @@ static void close_device(usb_t *u)
     }
     if (u->open)
         (void)u->api.release_interface(u->h, u->ep.interface);
-    /* A host controller that has not returned a cancelled transfer within 2 s is not waited
-     * for any longer: the handle is closed regardless (libusb then discards the transfer). */
+    /* A transfer the host controller has not returned within 2 s is not waited for any longer:
+     * libusb_close takes it off libusb's in-flight list and closes the file descriptor (the
+     * kernel discards its URBs), after which freeing it is safe. */
     u->api.close(u->h);
     u->h = NULL;
+    transfers_free(u);
     u->open = false;
     u->closing = false;
     u->txq_len = 0;
@@ -370,6 +376,14 @@ static argil_err_t open_device(usb_t *u, char *err, size_t err_len)
         u->api.close(u->h);
         u->h = NULL;
         return e;
+    }
+    if (!transfers_alloc(u)) {
+        snprintf(err, err_len, "usb %s: out of memory for transfers", who);
+        transfers_free(u);
+        (void)u->api.release_interface(u->h, u->ep.interface);
+        u->api.close(u->h);
+        u->h = NULL;
+        return ARGIL_ERR_NOMEM;
     }
     u->open = true;
     u->gone = false;
@@ -522,12 +536,7 @@ static void usb_close(link_t *l)
     usb_t *u = l->impl;
     if (!u)
         return;
-    close_device(u);
-    for (uint32_t i = 0; i < USB_IN_TRANSFERS; i++)
-        if (u->in[i])
-            u->api.free_transfer(u->in[i]);
-    if (u->out)
-        u->api.free_transfer(u->out);
+    close_device(u); /* frees the transfers: none outlives the context */
     context_stop(u);
     if (u->api.lib)
         dlclose(u->api.lib);
@@ -536,36 +545,21 @@ static void usb_close(link_t *l)
 
 static const link_ops_t USB_OPS = {usb_send, usb_recv, usb_poll, usb_close};
 
-argil_err_t link_usb_open(link_t *l, char *err, size_t err_len)
+argil_err_t link_usb_open_api(link_t *l, const usb_api_t *api, char *err, size_t err_len)
 {
     usb_t *u = calloc(1, sizeof(*u));
     if (!u) {
         snprintf(err, err_len, "out of memory for the USB link");
+        if (api->lib)
+            dlclose(api->lib);
         return ARGIL_ERR_NOMEM;
     }
+    u->api = *api;
     u->link = l;
     link_framer_init(&u->framer);
     l->impl = u;
     l->ops = &USB_OPS;
-    const char *why = api_load(&u->api);
-    if (why) {
-        snprintf(err, err_len, "usb: %s", why);
-        if (u->api.lib)
-            dlclose(u->api.lib);
-        u->api.lib = NULL;
-        free(u);
-        l->impl = NULL;
-        l->ops = NULL;
-        return ARGIL_ERR_IO;
-    }
     argil_err_t e = context_start(u, err, err_len);
-    for (uint32_t i = 0; e == ARGIL_OK && i < USB_IN_TRANSFERS; i++)
-        if (!(u->in[i] = u->api.alloc_transfer(0)))
-            e = ARGIL_ERR_NOMEM;
-    if (e == ARGIL_OK && !(u->out = u->api.alloc_transfer(0)))
-        e = ARGIL_ERR_NOMEM;
-    if (e == ARGIL_ERR_NOMEM)
-        snprintf(err, err_len, "usb: out of memory for transfers");
     if (e == ARGIL_OK)
         e = open_device(u, err, err_len);
     if (e != ARGIL_OK) {
@@ -576,4 +570,18 @@ argil_err_t link_usb_open(link_t *l, char *err, size_t err_len)
     }
     link_attach(l, &USB_OPS, u, true);
     return ARGIL_OK;
+}
+
+argil_err_t link_usb_open(link_t *l, char *err, size_t err_len)
+{
+    usb_api_t api;
+    memset(&api, 0, sizeof(api));
+    const char *why = api_load(&api);
+    if (why) {
+        snprintf(err, err_len, "usb: %s", why);
+        if (api.lib)
+            dlclose(api.lib);
+        return ARGIL_ERR_IO;
+    }
+    return link_usb_open_api(l, &api, err, err_len);
 }

@@ -2,6 +2,8 @@
  * tensor-product separability of A), evaluation with gradient, quasi-interpolating fill. */
 #include "host/model/field.h"
 
+#include "host/model/model_hot.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,12 +70,6 @@ void field_free(field_t *f)
     free(f->scratch);
     f->scratch = NULL;
     f->scratch_n = 0;
-}
-
-float field_profile(float signed_dist_m, float band_m)
-{
-    const float v = 0.5f + 0.5f * signed_dist_m / band_m;
-    return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
 }
 
 vec3_t field_coef_pos(const field_t *f, const int32_t c[3])
@@ -190,8 +186,8 @@ float *field_scratch(field_t *f, size_t n)
     return f->scratch;
 }
 
-void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],
-                        const int32_t slo[3], const int32_t shi[3], float *out, float *tmp)
+MODEL_HOT void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],
+                                  const int32_t slo[3], const int32_t shi[3], float *out, float *tmp)
 {
     int32_t blo[3], bhi[3], nc[3], ns[3];
     field_coefs_of_samples(f, slo, shi, blo, bhi);
@@ -202,15 +198,34 @@ void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], 
     const size_t sy = (size_t)cn[0], sz = (size_t)cn[0] * cn[1];
     const float *P0 = P + (size_t)(blo[0] - clo[0]) + sy * (size_t)(blo[1] - clo[1]) + sz * (size_t)(blo[2] - clo[2]);
     float *T1 = tmp, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
-    /* d = A p with A = A_z ⊗ A_y ⊗ A_x (Hua & Qin eq. 5): one axis at a time */
-    for (int32_t x = 0; x < ns[0]; x++) {
-        float w[4];
-        const int32_t c0 = field_sample_taps(f, slo[0] + x, w) - blo[0];
+    /* d = A p with A = A_z ⊗ A_y ⊗ A_x (Hua & Qin eq. 5): one axis at a time; along x the taps
+     * of CHUNK samples at a time, each row written contiguously */
+    enum { CHUNK = 64 };
+    for (int32_t x0 = 0; x0 < ns[0]; x0 += CHUNK) {
+        const int32_t m = ns[0] - x0 < CHUNK ? ns[0] - x0 : CHUNK;
+        int32_t c0[CHUNK];
+        float w[CHUNK][4];
+        for (int32_t k = 0; k < m; k++)
+            c0[k] = field_sample_taps(f, slo[0] + x0 + k, w[k]) - blo[0];
+        if (f->ratio == 1) { /* one phase: the same weights, taps one coefficient apart (vectorised) */
+            const float w0 = w[0][0], w1 = w[0][1], w2 = w[0][2], w3 = w[0][3];
+            for (int32_t z = 0; z < nc[2]; z++)
+                for (int32_t y = 0; y < nc[1]; y++) {
+                    const float *q = P0 + sy * (size_t)y + sz * (size_t)z + c0[0];
+                    float *dst = T1 + (size_t)x0 + (size_t)ns[0] * ((size_t)y + (size_t)nc[1] * z);
+                    for (int32_t k = 0; k < m; k++)
+                        dst[k] = w0 * q[k] + w1 * q[k + 1] + w2 * q[k + 2] + w3 * q[k + 3];
+                }
+            continue;
+        }
         for (int32_t z = 0; z < nc[2]; z++)
             for (int32_t y = 0; y < nc[1]; y++) {
-                const float *src = P0 + sy * (size_t)y + sz * (size_t)z + c0;
-                T1[(size_t)x + (size_t)ns[0] * ((size_t)y + (size_t)nc[1] * z)] =
-                    w[0] * src[0] + w[1] * src[1] + w[2] * src[2] + w[3] * src[3];
+                const float *src = P0 + sy * (size_t)y + sz * (size_t)z;
+                float *dst = T1 + (size_t)x0 + (size_t)ns[0] * ((size_t)y + (size_t)nc[1] * z);
+                for (int32_t k = 0; k < m; k++) {
+                    const float *q = src + c0[k];
+                    dst[k] = w[k][0] * q[0] + w[k][1] * q[1] + w[k][2] * q[2] + w[k][3] * q[3];
+                }
             }
     }
     const size_t st = (size_t)ns[0];
@@ -471,6 +486,7 @@ argil_err_t field_refine(field_t *f)
             memcpy(keys[nsb++], f->samp.slots[i].key, sizeof(keys[0]));
     sparse_free(&f->coef);
     f->coef = fine;
+    f->lattice_gen++;
     f->coef_spacing_m *= 0.5f;
     f->ratio /= 2;
     for (int32_t ph = 0; ph < f->ratio; ph++)

@@ -37,6 +37,7 @@ typedef struct {
     field_material_t material;
     float wtab[FIELD_RATIO_MAX][4];  /* basis weights of the 4 coefficients per sample phase */
     sparse_t coef, samp;
+    uint32_t lattice_gen;            /* +1 at every field_refine: coefficient indices name new places */
     float *scratch;                  /* grows as needed (host side) */
     size_t scratch_n;
 } field_t;
@@ -49,8 +50,13 @@ void field_free(field_t *f);
 /* Default base material (mass 1e-3 kg, damping 0.05 N s, stiffness 1 N, coupling 2 N). */
 void field_material_default(field_material_t *m);
 
-/* clamp(0.5 + 0.5 sd / band, 0, 1): the density profile across a surface, sd > 0 inside. */
-float field_profile(float signed_dist_m, float band_m);
+/* clamp(0.5 + 0.5 sd / band, 0, 1): the density profile across a surface, sd > 0 inside
+ * (inline: the tools call it per coefficient). */
+static inline float field_profile(float signed_dist_m, float band_m)
+{
+    const float v = 0.5f + 0.5f * signed_dist_m / band_m;
+    return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+}
 
 vec3_t field_coef_pos(const field_t *f, const int32_t c[3]);
 vec3_t field_sample_pos(const field_t *f, const int32_t s[3]);
@@ -110,7 +116,11 @@ argil_err_t field_fill(field_t *f, field_sdf_fn sd, void *ctx, vec3_t lo_m, vec3
  * coefficient is fixed when all the coefficients it is made from were. band_m stays.
  * ARGIL_ERR_ARG for an odd ratio or indices that would leave the sparse range (field unchanged);
  * ARGIL_ERR_NOMEM (unchanged when it happens before the new coefficients replace the old, else
- * some d may still hold the old values: field_refresh them). */
+ * some d may still hold the old values: field_refresh them).
+ * The refinement is global (every span of every block): the working space is one uniform lattice,
+ * so a knot inserted in a region only would need a second, hierarchical level (docs/model.md).
+ * lattice_gen is incremented: undo steps recorded before it are refused (undo_undo, undo_redo),
+ * since their coefficient indices now name other coefficients. Cost: 8x the coefficients. */
 argil_err_t field_refine(field_t *f);
 
 #endif

@@ -3,18 +3,15 @@
  * fixed coefficients and hard rows (eq. 14-16). */
 #include "host/model/solver.h"
 
+#include "host/model/model_hot.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define SOLVER_BOX_MAX ((int64_t)1 << 26)
-/* The separable passes and the spring stencil are simple streaming loops: -O3 vectorises them
- * (gcc's -O2 cost model leaves loops of unknown trip count scalar). */
-#if defined(__GNUC__) && !defined(__clang__)
-#define SOLVER_HOT __attribute__((optimize("O3")))
-#else
-#define SOLVER_HOT /* clang has no per-function optimize attribute (it ignores it, with a warning) */
-#endif
+/* The separable passes and the spring stencil are simple streaming loops: -O3 vectorises them. */
+#define SOLVER_HOT MODEL_HOT_SIMD
 
 void solver_cfg_default(solver_cfg_t *c)
 {
@@ -62,6 +59,12 @@ void solver_free(solver_t *s)
     for (int i = 0; i < 4; i++)
         free(s->w_ns[i]);
     free(s->w_mid);
+    solver_band_t *bands[2] = {&s->band_a, &s->band_at};
+    for (int i = 0; i < 2; i++) {
+        free(bands[i]->lo);
+        free(bands[i]->n);
+        free(bands[i]->w);
+    }
     memset(s, 0, sizeof(*s));
 }
 
@@ -131,7 +134,95 @@ argil_err_t solver_init(solver_t *s, const int32_t nc[3], const int32_t ns[3], c
         s->kscale[i] = 1.0f;
     }
     solver_material_changed(s);
+    /* the taps are set by the caller next: A and Aᵀ gather from them directly until the next
+     * solver_material_changed builds the bands (a band never holds taps older than that call) */
+    s->band_a.nchunk = s->band_at.nchunk = 0;
     return ARGIL_OK;
+}
+
+/* SOLVER_BAND floats as one value (gcc and clang vector extension: one AVX register, or two SSE). */
+typedef float solver_v8_t __attribute__((vector_size(SOLVER_BAND * sizeof(float))));
+
+/* Each of rows rows: dst (dst_n floats) = the band's matrix times src (src_n floats). Every output
+ * sums its inputs in increasing order from 0, the zero weights adding exact zeros, so it equals
+ * the 4-tap gather w0 q0 + w1 q1 + w2 q2 + w3 q3 (and the scatter of Aᵀ) bit for bit. */
+SOLVER_HOT static void solver_band_rows(const solver_band_t *b, const float *restrict src, size_t src_n,
+                                        float *restrict dst, size_t dst_n, size_t rows)
+{
+    for (size_t r = 0; r < rows; r++) {
+        const float *restrict sr = src + r * src_n;
+        float *restrict dr = dst + r * dst_n;
+        const float *restrict wc = b->w;
+        for (size_t c = 0; c < b->nchunk; c++) {
+            solver_v8_t acc = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+            const float *q = sr + b->lo[c];
+            for (int32_t j = 0; j < b->n[c]; j++, wc += SOLVER_BAND) {
+                solver_v8_t w;
+                memcpy(&w, wc, sizeof(w));
+                acc += w * q[j];
+            }
+            const size_t o = SOLVER_BAND * c;
+            if (dst_n - o >= SOLVER_BAND)
+                memcpy(dr + o, &acc, sizeof(acc));
+            else
+                memcpy(dr + o, &acc, sizeof(float) * (dst_n - o));
+        }
+    }
+}
+
+/* Weight of input `in` for output `out` along x: A (transpose = false: out a sample, in a
+ * coefficient) or Aᵀ (out a coefficient, in a sample). */
+static float solver_x_weight(const solver_t *s, bool transpose, int32_t out, int32_t in)
+{
+    const int32_t smp = transpose ? in : out, coef = transpose ? out : in;
+    const int32_t t = coef - s->tap_first[0][smp];
+    return t >= 0 && t < 4 ? s->tap_w[0][4 * smp + t] : 0.0f;
+}
+
+/* Builds the band of A (transpose = false) or Aᵀ along x from the taps; false when out of memory
+ * (the band is then left empty and the gather loops run instead). */
+static bool solver_band_build(solver_t *s, solver_band_t *b, bool transpose)
+{
+    const int32_t nout = transpose ? s->nc[0] : s->ns[0];
+    const size_t nchunk = ((size_t)nout + SOLVER_BAND - 1) / SOLVER_BAND;
+    int32_t *lo = realloc(b->lo, nchunk * sizeof(int32_t)), *n = lo ? realloc(b->n, nchunk * sizeof(int32_t)) : NULL;
+    if (lo != NULL)
+        b->lo = lo;
+    if (n != NULL)
+        b->n = n;
+    if (lo == NULL || n == NULL)
+        return false;
+    size_t total = 0;
+    for (size_t c = 0; c < nchunk; c++) {
+        int32_t a = INT32_MAX, z = INT32_MIN; /* inputs [a, z) the chunk's outputs reach */
+        for (int32_t o = (int32_t)(SOLVER_BAND * c); o < nout && o < (int32_t)(SOLVER_BAND * (c + 1)); o++) {
+            const int32_t first = transpose ? s->tapt_lo[0][o] : s->tap_first[0][o];
+            const int32_t last = transpose ? s->tapt_hi[0][o] : s->tap_first[0][o] + 4;
+            if (first < last) {
+                a = first < a ? first : a;
+                z = last > z ? last : z;
+            }
+        }
+        lo[c] = a < z ? a : 0;
+        n[c] = a < z ? z - a : 0;
+        total += (size_t)n[c];
+    }
+    if (total * SOLVER_BAND > b->w_cap) {
+        float *w = realloc(b->w, total * SOLVER_BAND * sizeof(float));
+        if (w == NULL)
+            return false;
+        b->w = w;
+        b->w_cap = total * SOLVER_BAND;
+    }
+    float *w = b->w;
+    for (size_t c = 0; c < nchunk; c++)
+        for (int32_t j = 0; j < n[c]; j++, w += SOLVER_BAND)
+            for (int32_t k = 0; k < SOLVER_BAND; k++) {
+                const int32_t o = (int32_t)(SOLVER_BAND * c) + k;
+                w[k] = o < nout ? solver_x_weight(s, transpose, o, lo[c] + j) : 0.0f;
+            }
+    b->nchunk = nchunk;
+    return true;
 }
 
 /* d = A x (samples from coefficients), separable: x, then y, then z. */
@@ -140,15 +231,18 @@ SOLVER_HOT static void solver_apply_A(solver_t *s, const float *restrict x, floa
     const int32_t *nc = s->nc, *ns = s->ns;
     float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
     const size_t rows = (size_t)nc[1] * nc[2];
-    for (size_t r = 0; r < rows; r++) {
-        const float *src = x + r * nc[0];
-        float *dst = T1 + r * ns[0];
-        for (int32_t i = 0; i < ns[0]; i++) {
-            const float *w = s->tap_w[0] + 4 * i;
-            const float *q = src + s->tap_first[0][i];
-            dst[i] = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3] * q[3];
+    if (s->band_a.nchunk > 0)
+        solver_band_rows(&s->band_a, x, (size_t)nc[0], T1, (size_t)ns[0], rows);
+    else
+        for (size_t r = 0; r < rows; r++) {
+            const float *src = x + r * nc[0];
+            float *dst = T1 + r * ns[0];
+            for (int32_t i = 0; i < ns[0]; i++) {
+                const float *w = s->tap_w[0] + 4 * i;
+                const float *q = src + s->tap_first[0][i];
+                dst[i] = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3] * q[3];
+            }
         }
-    }
     const size_t st = (size_t)ns[0];
     for (int32_t z = 0; z < nc[2]; z++)
         for (int32_t j = 0; j < ns[1]; j++) {
@@ -244,6 +338,10 @@ SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, flo
             solver_gather(q, gs, gw, n, st, acc);
         }
     const size_t rows = (size_t)nc[1] * nc[2];
+    if (s->band_at.nchunk > 0) {
+        solver_band_rows(&s->band_at, T1, (size_t)ns[0], x, (size_t)nc[0], rows);
+        return;
+    }
     memset(x, 0, sizeof(float) * s->ncoef);
     for (size_t r = 0; r < rows; r++) {
         const float *src = T1 + r * ns[0];
@@ -262,6 +360,7 @@ SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, flo
 
 void solver_material_changed(solver_t *s)
 {
+    s->band_a.nchunk = s->band_at.nchunk = 0; /* the gather loops until the bands are rebuilt */
     for (int a = 0; a < 3; a++) { /* the transpose of the taps: samples each coefficient reaches */
         for (int32_t c = 0; c < s->nc[a]; c++) {
             s->tapt_lo[a][c] = s->ns[a];
@@ -276,6 +375,8 @@ void solver_material_changed(solver_t *s)
                 s->tapt_hi[a][c] = k + 1 > s->tapt_hi[a][c] ? k + 1 : s->tapt_hi[a][c];
             }
     }
+    if (!solver_band_build(s, &s->band_a, false) || !solver_band_build(s, &s->band_at, true))
+        s->band_a.nchunk = s->band_at.nchunk = 0;
     const size_t stride[3] = {1, (size_t)s->ns[0], (size_t)s->ns[0] * s->ns[1]};
     for (int a = 0; a < 3; a++) {
         for (int32_t z = 0; z < s->ns[2]; z++)
@@ -454,7 +555,7 @@ static void solver_expand(const solver_t *s, float *x, bool affine)
 }
 
 /* y = Gᵀ y, with the eliminated and fixed entries zeroed (eq. 15-16). */
-static void solver_reduce(const solver_t *s, float *y)
+SOLVER_HOT static void solver_reduce(const solver_t *s, float *y)
 {
     for (int32_t h = 0; h < s->nhard; h++) {
         const solver_row_t *r = &s->hard[h];
@@ -465,9 +566,9 @@ static void solver_reduce(const solver_t *s, float *y)
                 y[r->idx[j]] -= r->w[j] / r->w[r->pivot] * yp;
         y[piv] = 0.0f;
     }
+    const uint8_t *restrict fx = s->fixed;
     for (size_t i = 0; i < s->ncoef; i++)
-        if (s->fixed[i])
-            y[i] = 0.0f;
+        y[i] = fx[i] ? 0.0f : y[i];
 }
 
 /* y = (2 M~ + dt D~ + 2 dt² K~) x, matrix-free (left side of Hua & Qin eq. 12); sdiag must hold
@@ -487,25 +588,57 @@ static void solver_apply_S(solver_t *s, const float *x, float *y, float dt)
     }
 }
 
-static double solver_dot(const float *a, const float *b, size_t n)
+/* Σ a_i b_i in double, four partial sums (so the loop vectorises; the order is fixed, so the
+ * result is the same on every run and CPU). */
+SOLVER_HOT static double solver_dot(const float *restrict a, const float *restrict b, size_t n)
 {
-    double v = 0.0;
-    for (size_t i = 0; i < n; i++)
-        v += (double)a[i] * b[i];
-    return v;
+    double v[4] = {0.0, 0.0, 0.0, 0.0};
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int k = 0; k < 4; k++)
+            v[k] += (double)a[i + k] * b[i + k];
+    for (; i < n; i++)
+        v[0] += (double)a[i] * b[i];
+    return (v[0] + v[1]) + (v[2] + v[3]);
 }
 
 /* x += alpha q, r -= alpha Sq in one pass; returns |r|² */
-static double solver_cg_update(float *restrict x, float *restrict r, const float *restrict q,
-                               const float *restrict Sq, float alpha, size_t n)
+SOLVER_HOT static double solver_cg_update(float *restrict x, float *restrict r, const float *restrict q,
+                                          const float *restrict Sq, float alpha, size_t n)
 {
-    double rr = 0.0;
     for (size_t i = 0; i < n; i++) {
         x[i] += alpha * q[i];
         r[i] -= alpha * Sq[i];
-        rr += (double)r[i] * r[i];
     }
-    return rr;
+    return solver_dot(r, r, n);
+}
+
+/* q = r + beta q */
+SOLVER_HOT static void solver_cg_dir(float *restrict q, const float *restrict r, float beta, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        q[i] = r[i] + beta * q[i];
+}
+
+/* The sample part of eq. 12's right side, with ke = K (r - d_fixed) on entry:
+ * ke = 2dt² (f + ke) + 4 m dA - (2 m - dt D) dB; and sdiag = 2 m + dt D + 2dt² kdiag. */
+SOLVER_HOT static void solver_rhs_samples(solver_t *s, float dt, const float *restrict dA,
+                                          const float *restrict dB, float *restrict ke)
+{
+    const float c2 = 2.0f * dt * dt;
+    const float *restrict m = s->mass_kg, *restrict dmp = s->damp_n_s, *restrict fn = s->force_n,
+                          *restrict kd = s->kdiag;
+    float *restrict sd = s->sdiag;
+    for (size_t i = 0; i < s->nsamp; i++) {
+        ke[i] = c2 * (fn[i] + ke[i]) + 4.0f * m[i] * dA[i] - (2.0f * m[i] - dt * dmp[i]) * dB[i];
+        sd[i] = 2.0f * m[i] + dt * dmp[i] + c2 * kd[i];
+    }
+}
+
+SOLVER_HOT static void solver_sub(float *restrict out, const float *restrict a, const float *restrict b, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        out[i] = a[i] - b[i];
 }
 
 /* p_prev moved so that (p - p_prev) / dt keeps the velocity when the step changes. */
@@ -542,16 +675,11 @@ argil_err_t solver_step_implicit(solver_t *s)
         solver_apply_A(s, s->p, dA);
         solver_apply_A(s, pp, dB);
         float *e = s->w_ns[0], *ke = s->w_ns[1];
-        for (size_t i = 0; i < s->nsamp; i++)
-            e[i] = s->rest[i] - s->d_fixed[i];
+        solver_sub(e, s->rest, s->d_fixed, s->nsamp);
         solver_apply_K(s, e, ke);
         const float c2 = 2.0f * dt * dt;
-        for (size_t i = 0; i < s->nsamp; i++)
-            ke[i] = c2 * (s->force_n[i] + ke[i]) + 4.0f * s->mass_kg[i] * dA[i] -
-                    (2.0f * s->mass_kg[i] - dt * s->damp_n_s[i]) * dB[i];
+        solver_rhs_samples(s, dt, dA, dB, ke);
         solver_apply_At(s, ke, rhs);
-        for (size_t i = 0; i < s->nsamp; i++)
-            s->sdiag[i] = 2.0f * s->mass_kg[i] + dt * s->damp_n_s[i] + c2 * s->kdiag[i];
         for (int32_t k = 0; k < s->nsoft; k++) {
             const solver_row_t *row = &s->soft[k];
             for (int32_t j = 0; j < row->n; j++)
@@ -562,8 +690,7 @@ argil_err_t solver_step_implicit(solver_t *s)
             x[i] = s->fixed[i] ? s->p[i] : 2.0f * s->p[i] - pp[i];
         solver_expand(s, x, true);
         solver_apply_S(s, x, Sq, dt);
-        for (size_t i = 0; i < s->ncoef; i++)
-            r[i] = rhs[i] - Sq[i];
+        solver_sub(r, rhs, Sq, s->ncoef);
         solver_reduce(s, r);
         solver_reduce(s, rhs);
         const double bnorm = sqrt(solver_dot(rhs, rhs, s->ncoef));
@@ -582,8 +709,7 @@ argil_err_t solver_step_implicit(solver_t *s)
             const double rr_new = solver_cg_update(x, r, q, Sq, (float)(rr / qSq), s->ncoef);
             const double beta = rr_new / rr;
             rr = rr_new;
-            for (size_t i = 0; i < s->ncoef; i++)
-                q[i] = r[i] + (float)beta * q[i];
+            solver_cg_dir(q, r, (float)beta, s->ncoef);
             for (int32_t h = 0; h < s->nhard; h++)
                 q[s->hard[h].idx[s->hard[h].pivot]] = 0.0f;
             it++;

@@ -42,6 +42,17 @@ typedef struct {
     float max_acc;               /* largest |p''| accepted in the last call */
 } solver_stats_t;
 
+/* One axis of A (or Aᵀ) as a band: outputs in chunks of SOLVER_BAND outputs, chunk c reads inputs
+ * [lo[c], lo[c] + n[c]) with SOLVER_BAND weights per input (0 where an output does not reach it),
+ * so the pass runs SOLVER_BAND outputs wide instead of gathering 4 taps per output. Rebuilt by
+ * solver_material_changed; when it cannot allocate, w is NULL and the gather loops are used. */
+#define SOLVER_BAND 8
+typedef struct {
+    int32_t *lo, *n;
+    float *w;
+    size_t nchunk, w_cap;
+} solver_band_t;
+
 typedef struct {
     int32_t nc[3], ns[3];
     size_t ncoef, nsamp;
@@ -66,6 +77,7 @@ typedef struct {
     solver_stats_t stats;
     float *mlump, *dlump;        /* lumped coefficient mass Aᵀ(m ⊙ A1), damping alike (derived) */
     float *w_nc[6], *w_ns[4], *w_mid;   /* scratch */
+    solver_band_t band_a, band_at;      /* A and Aᵀ along x as banded blocks (derived) */
 } solver_t;
 
 void solver_cfg_default(solver_cfg_t *c);
@@ -83,7 +95,8 @@ argil_err_t solver_init_patch(solver_t *s, const bspline_t *b, const int32_t ns[
                               const solver_cfg_t *cfg);
 
 /* Must be called after the taps, the material arrays or k_rest/coupling change (rebuilds the
- * derived arrays). */
+ * derived arrays, among them the x-axis bands of A and Aᵀ: until the first call after
+ * solver_init, A and Aᵀ read the taps directly, the slower way). */
 void solver_material_changed(solver_t *s);
 
 /* d = A p + d_fixed for the current p (nsamp floats). */

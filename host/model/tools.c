@@ -197,6 +197,14 @@ typedef struct {
     float reach_m;
 } tool_union_t;
 
+/* Signed distance of the pose q's tool at x, given d = x - q.pos and dd = |d|²: a sphere needs
+ * no rotation (its distance is rotation-invariant; for the axis-aligned and mirrored poses the
+ * result is the same float as through tool_local). */
+static float tool_pose_sd(const tool_union_t *U, const tool_pose_t *q, vec3_t x, float dd)
+{
+    return U->t->kind == TOOL_SPHERE ? U->t->radius_m - sqrtf(dd) : tool_sd(U->t, tool_local(q, x));
+}
+
 /* Signed distance of the union of all poses at x (-inf when no pose reaches x). */
 static float tool_union_sd(const tool_union_t *U, vec3_t x)
 {
@@ -204,13 +212,60 @@ static float tool_union_sd(const tool_union_t *U, vec3_t x)
     const float r2 = U->reach_m * U->reach_m;
     for (size_t i = 0; i < U->n; i++) {
         const vec3_t d = vec3_sub(x, U->poses[i].pos_m);
-        if (vec3_dot(d, d) > r2)
+        const float dd = vec3_dot(d, d);
+        if (dd > r2)
             continue;
-        const float sd = tool_sd(U->t, tool_local(&U->poses[i], x));
+        const float sd = tool_pose_sd(U, &U->poses[i], x, dd);
         if (sd > best)
             best = sd;
     }
     return best;
+}
+
+/* The same over the poses idx[0..m) only (those whose reach holds the row of x). */
+static float tool_union_sd_of(const tool_union_t *U, const uint32_t *idx, size_t m, vec3_t x)
+{
+    float best = -INFINITY;
+    const float r2 = U->reach_m * U->reach_m;
+    for (size_t k = 0; k < m; k++) {
+        const tool_pose_t *q = &U->poses[idx[k]];
+        const vec3_t d = vec3_sub(x, q->pos_m);
+        const float dd = vec3_dot(d, d);
+        if (dd > r2)
+            continue;
+        const float sd = tool_pose_sd(U, q, x, dd);
+        if (sd > best)
+            best = sd;
+    }
+    return best;
+}
+
+/* The poses whose reach ball meets the coefficient row at (y_m, z_m) (their indices into idx,
+ * count returned) and the part [*x0, *x1) of the row's n coefficients at positions px that
+ * they can reach, one coefficient of margin each side for rounding. */
+static size_t tool_row_poses(const tool_union_t *U, const float *px, int32_t n, float h, float y_m,
+                             float z_m, uint32_t *idx, int32_t *x0, int32_t *x1)
+{
+    const float r2 = U->reach_m * U->reach_m;
+    size_t m = 0;
+    float lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < U->n; i++) {
+        const float dy = y_m - U->poses[i].pos_m.y, dz = z_m - U->poses[i].pos_m.z;
+        const float rem = r2 - (dy * dy + dz * dz);
+        if (!(rem >= -1e-6f * r2))
+            continue;
+        const float half = sqrtf(rem > 0.0f ? rem : 0.0f);
+        lo = fminf(lo, U->poses[i].pos_m.x - half);
+        hi = fmaxf(hi, U->poses[i].pos_m.x + half);
+        idx[m++] = (uint32_t)i;
+    }
+    *x0 = *x1 = 0;
+    if (m == 0 || n == 0)
+        return 0;
+    const double a = floor(((double)lo - px[0]) / h) - 1.0, b = ceil(((double)hi - px[0]) / h) + 2.0;
+    *x0 = a < 0.0 ? 0 : (a > (double)n ? n : (int32_t)a);
+    *x1 = b < 0.0 ? 0 : (b > (double)n ? n : (int32_t)b);
+    return m;
 }
 
 static float tool_clamp01(float v)
@@ -218,9 +273,11 @@ static float tool_clamp01(float v)
     return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
 }
 
-/* New coefficient value from the old one and the union's signed distance at the coefficient. */
-static float tool_action_coef(const field_t *f, const tool_params_t *p, float bound, float pold,
-                              float sd, vec3_t x, const float *nb6)
+/* New coefficient value from the old one and the union's signed distance at the coefficient
+ * (always inlined: the switch on the action is then hoisted out of the callers' loops). */
+__attribute__((always_inline)) static inline float tool_action_coef(const field_t *f, const tool_params_t *p,
+                                                                    float bound, float pold, float sd,
+                                                                    vec3_t x, const float *nb6)
 {
     const float phi = field_profile(sd, f->band_m);
     switch (p->action) {
@@ -279,29 +336,30 @@ static bool tool_coef_fixed_point(tool_action_t a, float pold)
     }
 }
 
-/* Stores new densities dnew for the samples [lo, hi) of sample block key; the rest density moves
- * by the same Δd (a plastic edit); changed values are noted for undo and the block marked dirty.
- * *nchanged counts the samples whose density changed. */
+/* Stores new densities dnew (rows dn_row, planes dn_plane floats apart) for the samples [lo, hi)
+ * of sample block key; the rest density moves by the same Δd (a plastic edit); changed values are
+ * noted for undo and the block marked dirty. *nchanged counts the samples whose density changed. */
 static argil_err_t tool_store_samples(field_t *f, const int32_t key[3], const int32_t lo[3],
-                                      const int32_t hi[3], const float *dnew, undo_t *u,
-                                      size_t *nchanged)
+                                      const int32_t hi[3], const float *dnew, size_t dn_row,
+                                      size_t dn_plane, undo_t *u, size_t *nchanged)
 {
     sparse_block_t *b = sparse_find(&f->samp, key);
     const int32_t n0 = hi[0] - lo[0], n1 = hi[1] - lo[1], n2 = hi[2] - lo[2];
-    const int32_t base[3] = {key[0] * SPARSE_B, key[1] * SPARSE_B, key[2] * SPARSE_B};
+    const int32_t off[3] = {lo[0] - key[0] * SPARSE_B, lo[1] - key[1] * SPARSE_B, lo[2] - key[2] * SPARSE_B};
     const float d_def = f->samp.defaults[FS_D];
+    const size_t rowb = sizeof(float) * (size_t)n0;
     bool any = false;
-    for (int32_t z = 0, i = 0; z < n2 && !any; z++)
-        for (int32_t y = 0; y < n1 && !any; y++)
-            for (int32_t x = 0; x < n0; x++, i++) {
-                const size_t li = (size_t)(lo[0] - base[0] + x) +
-                                  SPARSE_B * ((size_t)(lo[1] - base[1] + y) + SPARSE_B * (size_t)(lo[2] - base[2] + z));
-                const float dold = b != NULL ? b->data[FS_D * SPARSE_BN + li] : d_def;
-                if (memcmp(&dold, &dnew[i], sizeof(float)) != 0) {
-                    any = true;
-                    break;
-                }
+    for (int32_t z = 0; z < n2 && !any; z++)
+        for (int32_t y = 0; y < n1 && !any; y++) {
+            const float *dn = dnew + dn_row * (size_t)y + dn_plane * (size_t)z;
+            if (b != NULL) {
+                const size_t li = (size_t)off[0] + SPARSE_B * ((size_t)(off[1] + y) + SPARSE_B * (size_t)(off[2] + z));
+                any = memcmp(b->data + FS_D * SPARSE_BN + li, dn, rowb) != 0;
+            } else {
+                for (int32_t x = 0; x < n0 && !any; x++)
+                    any = memcmp(&d_def, &dn[x], sizeof(float)) != 0;
             }
+        }
     if (!any)
         return ARGIL_OK;
     if (b == NULL) {
@@ -310,24 +368,27 @@ static argil_err_t tool_store_samples(field_t *f, const int32_t key[3], const in
             return e;
     }
     b->dirty = true;
-    for (int32_t z = 0, i = 0; z < n2; z++)
-        for (int32_t y = 0; y < n1; y++)
-            for (int32_t x = 0; x < n0; x++, i++) {
-                const size_t li = (size_t)(lo[0] - base[0] + x) +
-                                  SPARSE_B * ((size_t)(lo[1] - base[1] + y) + SPARSE_B * (size_t)(lo[2] - base[2] + z));
-                float *d = &b->data[FS_D * SPARSE_BN + li], *r = &b->data[FS_REST * SPARSE_BN + li];
-                if (memcmp(d, &dnew[i], sizeof(float)) == 0)
+    for (int32_t z = 0; z < n2; z++)
+        for (int32_t y = 0; y < n1; y++) {
+            const size_t li = (size_t)off[0] + SPARSE_B * ((size_t)(off[1] + y) + SPARSE_B * (size_t)(off[2] + z));
+            const float *dn = dnew + dn_row * (size_t)y + dn_plane * (size_t)z;
+            float *d = b->data + FS_D * SPARSE_BN + li, *r = b->data + FS_REST * SPARSE_BN + li;
+            if (memcmp(d, dn, rowb) == 0)
+                continue;
+            for (int32_t x = 0; x < n0; x++) {
+                if (memcmp(&d[x], &dn[x], sizeof(float)) == 0)
                     continue;
                 if (u != NULL) { /* one 12-byte change: undo_note_drest recomputes the rest alike */
                     const int32_t ijk[3] = {lo[0] + x, lo[1] + y, lo[2] + z};
-                    const argil_err_t e = undo_note_drest(u, ijk, *d, dnew[i], *r);
+                    const argil_err_t e = undo_note_drest(u, ijk, d[x], dn[x], r[x]);
                     if (e != ARGIL_OK)
                         return e;
                 }
-                *r = *r + (dnew[i] - *d); /* the edit is plastic: the rest shape moves with it */
-                *d = dnew[i];
+                r[x] = r[x] + (dn[x] - d[x]); /* the edit is plastic: the rest shape moves with it */
+                d[x] = dn[x];
                 (*nchanged)++;
             }
+        }
     return ARGIL_OK;
 }
 
@@ -497,8 +558,13 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
     argil_err_t e = ARGIL_OK;
     if (u != NULL && (e = undo_begin(u, f, blo, blo, 0, slo, slo, 0)) != ARGIL_OK)
         return e;
-    const size_t nb = (size_t)bn[0] * bn[1] * bn[2];
-    float *C = field_scratch(f, nc + (nk + 3) / 4 + 2 * nb); /* kept warm between edits */
+    const size_t nb = (size_t)bn[0] * bn[1] * bn[2], naxis = (size_t)bn[0] + bn[1] + bn[2];
+    /* kept warm between edits: C box, block marks, change list, per-axis tables, row poses */
+    /* a run of sample blocks along x: its samples, and field_samples_from's tmp (8 samples reach
+     * at most (8 - 1) / R + 5 coefficients per axis) */
+    const size_t run_ns = (size_t)kn[0] * SPARSE_B, run_nc = (SPARSE_B - 1) / (size_t)R + 5;
+    const size_t run_n = run_ns * SPARSE_B * SPARSE_B, run_tmp_n = run_ns * run_nc * (run_nc + SPARSE_B);
+    float *C = field_scratch(f, nc + (nk + 3) / 4 + 2 * nb + 3 * naxis + U->n + run_n + run_tmp_n);
     if (C == NULL) {
         e = ARGIL_ERR_NOMEM;
         goto out;
@@ -506,6 +572,24 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
     uint8_t *mark = (uint8_t *)(C + nc);
     uint32_t *ch_ci = (uint32_t *)(C + nc + (nk + 3) / 4); /* changed: index in C, new value */
     float *ch_after = (float *)(ch_ci + nb);
+    float *pos = ch_after + nb;                 /* per axis: coefficient positions (m) */
+    int32_t *kr = (int32_t *)(pos + naxis);     /* per axis: first and last sample block reached */
+    uint32_t *row_idx = (uint32_t *)(kr + 2 * naxis);
+    float *run_d = (float *)(row_idx + U->n), *run_tmp = run_d + run_n;
+    const float o[3] = {f->origin_m.x, f->origin_m.y, f->origin_m.z}, hc = f->coef_spacing_m;
+    float *pa[3];
+    int32_t *ka[3];
+    for (int a = 0, at = 0; a < 3; at += bn[a], a++) {
+        pa[a] = pos + at;
+        ka[a] = kr + 2 * at;
+        for (int32_t i = 0; i < bn[a]; i++) {
+            const int32_t c = blo[a] + i;
+            pa[a][i] = o[a] + hc * (float)c; /* as field_coef_pos */
+            const int32_t k0 = sparse_block_of((c - 2) * R + 1) - klo[a], k1 = sparse_block_of((c + 2) * R - 1) - klo[a];
+            ka[a][2 * i] = k0 < 0 ? 0 : k0;
+            ka[a][2 * i + 1] = k1 >= kn[a] ? kn[a] - 1 : k1;
+        }
+    }
     size_t nch = 0;
     memset(mark, 0, nk);
     sparse_read_box(&f->coef, FC_P, clo, cn, C);
@@ -514,23 +598,40 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
         for (int32_t y = 0; y < bn[1]; y++) {
             const size_t row = (size_t)(blo[0] - clo[0]) + sy * (size_t)(blo[1] - clo[1] + y) +
                                sz * (size_t)(blo[2] - clo[2] + z);
-            for (int32_t x = 0; x < bn[0]; x++) {
+            int32_t x0, x1; /* only the part of the row some pose's reach holds */
+            const size_t m = tool_row_poses(U, pa[0], bn[0], hc, pa[1][y], pa[2][z], row_idx, &x0, &x1);
+            const int32_t *kyz = ka[1] + 2 * y, *kzz = ka[2] + 2 * z;
+            int32_t kx_lo = 1, kx_hi = 0; /* blocks along x last marked for this row (none yet) */
+            for (int32_t x = x0; x < x1 && m > 0; x++) {
                 const size_t ci = row + (size_t)x;
                 const float pold = C[ci];
                 if (tool_coef_fixed_point(p->action, pold))
                     continue;
-                const int32_t c[3] = {blo[0] + x, blo[1] + y, blo[2] + z};
-                const vec3_t xc = field_coef_pos(f, c);
-                const float sd = tool_union_sd(U, xc);
+                const vec3_t xc = vec3(pa[0][x], pa[1][y], pa[2][z]);
+                const float sd = tool_union_sd_of(U, row_idx, m, xc);
                 if (sd == -INFINITY)
                     continue;
-                const float nb6[6] = {C[ci - 1], C[ci + 1], C[ci - sy], C[ci + sy], C[ci - sz], C[ci + sz]};
-                const float pnew = tool_action_coef(f, p, bound, pold, sd, xc, nb6);
+                float pnew;
+                if (p->action == TOOL_SMOOTH) { /* the only action that reads the neighbours */
+                    const float nb6[6] = {C[ci - 1], C[ci + 1], C[ci - sy], C[ci + sy], C[ci - sz], C[ci + sz]};
+                    pnew = tool_action_coef(f, p, bound, pold, sd, xc, nb6);
+                } else {
+                    pnew = tool_action_coef(f, p, bound, pold, sd, xc, NULL);
+                }
                 if (pnew == pold)
                     continue;
                 ch_ci[nch] = (uint32_t)ci;
                 ch_after[nch++] = pnew;
-                tool_mark_reach(c, R, klo, kn, mark);
+                /* the sample blocks this coefficient reaches: ((c-2)R, (c+2)R) per axis */
+                const int32_t *kxx = ka[0] + 2 * x;
+                if (kxx[0] >= kx_lo && kxx[1] <= kx_hi)
+                    continue;
+                for (int32_t kz = kzz[0]; kz <= kzz[1]; kz++)
+                    for (int32_t ky = kyz[0]; ky <= kyz[1]; ky++)
+                        for (int32_t kx = kxx[0]; kx <= kxx[1]; kx++)
+                            mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)] = 1;
+                kx_lo = kxx[0];
+                kx_hi = kxx[1];
             }
         }
     if (p->fit == TOOL_FIT_LSQ && nch > 0) {
@@ -544,12 +645,24 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
     }
     /* write the changed coefficients (the lookup cached per block) and note them for undo */
     sparse_block_t *cb = NULL;
+    size_t row0 = 0; /* C index of (0, cy, cz): the list is in increasing index order */
+    int32_t cy = 0, cz = 0;
     for (size_t k = 0; k < nch && e == ARGIL_OK; k++) {
         const size_t ci = ch_ci[k];
         const float before = C[ci];
         C[ci] = ch_after[k];
-        const int32_t c[3] = {clo[0] + (int32_t)(ci % sy), clo[1] + (int32_t)(ci / sy % (size_t)cn[1]),
-                              clo[2] + (int32_t)(ci / sz)};
+        if (ci < row0) { /* not in order: start again from the first row */
+            row0 = 0;
+            cy = cz = 0;
+        }
+        while (ci >= row0 + sy) {
+            row0 += sy;
+            if (++cy == cn[1]) {
+                cy = 0;
+                cz++;
+            }
+        }
+        const int32_t c[3] = {clo[0] + (int32_t)(ci - row0), clo[1] + cy, clo[2] + cz};
         const int32_t key[3] = {sparse_block_of(c[0]), sparse_block_of(c[1]), sparse_block_of(c[2])};
         if (cb == NULL || memcmp(cb->key, key, sizeof(key)) != 0)
             e = sparse_touch(&f->coef, key, &cb);
@@ -561,24 +674,40 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
         if (u != NULL)
             e = undo_note(u, UNDO_STORE_COEF, FC_P, c, before, ch_after[k]);
     }
-    /* d = A p in the reached sample blocks only */
+    /* d = A p in the reached sample blocks only, a run of consecutive marked blocks along x at a
+     * time (one separable pass over the run; each sample's arithmetic is the same as alone) */
     size_t refreshed = 0, changed_samples = 0;
     for (int32_t kz = 0; kz < kn[2] && e == ARGIL_OK; kz++)
-        for (int32_t ky = 0; ky < kn[1] && e == ARGIL_OK; ky++)
-            for (int32_t kx = 0; kx < kn[0] && e == ARGIL_OK; kx++) {
-                if (!mark[(size_t)kx + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz)])
+        for (int32_t ky = 0; ky < kn[1] && e == ARGIL_OK; ky++) {
+            const uint8_t *mrow = mark + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz);
+            for (int32_t kx = 0; kx < kn[0] && e == ARGIL_OK;) {
+                if (!mrow[kx]) {
+                    kx++;
                     continue;
-                const int32_t key[3] = {klo[0] + kx, klo[1] + ky, klo[2] + kz};
+                }
+                int32_t kend = kx + 1;
+                while (kend < kn[0] && mrow[kend])
+                    kend++;
+                const int32_t key0[3] = {klo[0] + kx, klo[1] + ky, klo[2] + kz};
                 int32_t lo[3], hi[3];
                 for (int a = 0; a < 3; a++) {
-                    lo[a] = key[a] * SPARSE_B > slo[a] ? key[a] * SPARSE_B : slo[a];
-                    hi[a] = (key[a] + 1) * SPARSE_B < shi[a] ? (key[a] + 1) * SPARSE_B : shi[a];
+                    const int32_t k1 = a == 0 ? klo[0] + kend - 1 : key0[a];
+                    lo[a] = key0[a] * SPARSE_B > slo[a] ? key0[a] * SPARSE_B : slo[a];
+                    hi[a] = (k1 + 1) * SPARSE_B < shi[a] ? (k1 + 1) * SPARSE_B : shi[a];
                 }
-                float dnew[SPARSE_BN], tmp[2 * SPARSE_B * (SPARSE_B + 3) * (SPARSE_B + 3)];
-                field_samples_from(f, C, clo, cn, lo, hi, dnew, tmp);
-                refreshed += (size_t)(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-                e = tool_store_samples(f, key, lo, hi, dnew, u, &changed_samples);
+                field_samples_from(f, C, clo, cn, lo, hi, run_d, run_tmp);
+                const size_t dn_row = (size_t)(hi[0] - lo[0]), dn_plane = dn_row * (size_t)(hi[1] - lo[1]);
+                refreshed += dn_plane * (size_t)(hi[2] - lo[2]);
+                for (; kx < kend && e == ARGIL_OK; kx++) {
+                    const int32_t key[3] = {klo[0] + kx, key0[1], key0[2]};
+                    const int32_t blo_x = key[0] * SPARSE_B > lo[0] ? key[0] * SPARSE_B : lo[0];
+                    const int32_t bhi_x = (key[0] + 1) * SPARSE_B < hi[0] ? (key[0] + 1) * SPARSE_B : hi[0];
+                    const int32_t bl[3] = {blo_x, lo[1], lo[2]}, bh[3] = {bhi_x, hi[1], hi[2]};
+                    e = tool_store_samples(f, key, bl, bh, run_d + (blo_x - lo[0]), dn_row, dn_plane, u,
+                                           &changed_samples);
+                }
             }
+        }
     if (stats != NULL)
         stats->samples_refreshed += refreshed;
 out:

@@ -14,12 +14,17 @@ static size_t undo_elem_bytes(int store)
     return (store == UNDO_STORE_DREST ? 3 : 2) * sizeof(float);
 }
 
-/* Anonymous memory with every page already faulted in (MAP_POPULATE: ~1.6 us a page here, about
- * a tenth of touching the pages one by one); NULL when the system refuses. */
+/* Anonymous memory with every page already faulted in and written once; NULL when the system
+ * refuses. MAP_POPULATE alone is not enough on this VM: the first write to a populated page still
+ * cost ~4 us (0.6-0.9 ms per 640 kB, the journal of one 128^3/40^3 carve) against 0.03 ms once
+ * the page has been written, so the whole ring is cleared here, at init (~10-20 ms per 64 MB). */
 static uint8_t *undo_map(size_t bytes)
 {
     void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-    return p == MAP_FAILED ? NULL : (uint8_t *)p;
+    if (p == MAP_FAILED)
+        return NULL;
+    memset(p, 0, bytes);
+    return (uint8_t *)p;
 }
 
 argil_err_t undo_init(undo_t *u, size_t budget_bytes)
@@ -153,7 +158,7 @@ static void undo_close_run(undo_t *u)
 }
 
 /* Appends one change to the open step, extending its last run when it continues it along x. */
-static argil_err_t undo_append(undo_t *u, int store, int ch, const int32_t ijk[3], const float *v)
+__attribute__((noinline)) static argil_err_t undo_append(undo_t *u, int store, int ch, const int32_t ijk[3], const float *v)
 {
     undo_run_t *r = &u->run;
     const bool extend = r->n > 0 && r->n < UINT16_MAX && r->ijk[0] + (int64_t)r->n == ijk[0] &&
@@ -184,6 +189,23 @@ static argil_err_t undo_append(undo_t *u, int store, int ch, const int32_t ijk[3
     return ARGIL_OK;
 }
 
+/* The common case of undo_append, small enough to inline: the change continues the open run and
+ * the ring has room before its end; eb is 8 or 12 (a constant at each caller). false: not taken. */
+static inline bool undo_append_fast(undo_t *u, int store, const int32_t ijk[3], const float *v, size_t eb)
+{
+    undo_run_t *r = &u->run;
+    const size_t at = u->cur.off + u->cur.len;
+    if (!(r->n > 0 && r->n < UINT16_MAX && r->ijk[0] + (int64_t)r->n == ijk[0] && r->ijk[1] == ijk[1] &&
+          r->ijk[2] == ijk[2] && r->store == store && u->bytes + u->cur.len + eb <= u->ring_cap &&
+          at + eb <= u->ring_cap))
+        return false;
+    memcpy(u->ring + at, v, eb);
+    u->cur.len += eb;
+    u->cur.n++;
+    r->n++;
+    return true;
+}
+
 argil_err_t undo_note(undo_t *u, int store, int ch, const int32_t ijk[3], float before, float after)
 {
     if (!u->open)
@@ -191,6 +213,8 @@ argil_err_t undo_note(undo_t *u, int store, int ch, const int32_t ijk[3], float 
     if (store != UNDO_STORE_COEF && store != UNDO_STORE_SAMP)
         return ARGIL_ERR_ARG;
     const float v[2] = {before, after};
+    if (u->run.ch == ch && undo_append_fast(u, store, ijk, v, sizeof(v)))
+        return ARGIL_OK;
     return undo_append(u, store, ch, ijk, v);
 }
 
@@ -199,6 +223,8 @@ argil_err_t undo_note_drest(undo_t *u, const int32_t ijk[3], float d_before, flo
     if (!u->open)
         return ARGIL_ERR_STATE;
     const float v[3] = {d_before, d_after, rest_before};
+    if (u->run.ch == FS_D && undo_append_fast(u, UNDO_STORE_DREST, ijk, v, sizeof(v)))
+        return ARGIL_OK;
     return undo_append(u, UNDO_STORE_DREST, FS_D, ijk, v);
 }
 
@@ -253,6 +279,7 @@ argil_err_t undo_begin(undo_t *u, const field_t *f, const int32_t clo[3], const 
         }
     u->cur.off = undo_head(u); /* after the redo steps: they stay unless this step records anything */
     u->cur.len = u->cur.n = 0;
+    u->cur.lattice_gen = f->lattice_gen;
     u->run.n = 0;
     u->open = true;
     return ARGIL_OK;
@@ -360,6 +387,8 @@ argil_err_t undo_undo(undo_t *u, field_t *f)
         return ARGIL_ERR_STATE;
     if (u->done == 0)
         return ARGIL_ERR_EMPTY;
+    if (u->steps[u->done - 1].lattice_gen != f->lattice_gen)
+        return ARGIL_ERR_STATE;
     argil_err_t e = undo_apply(u, f, &u->steps[u->done - 1], false);
     if (e == ARGIL_OK)
         u->done--;
@@ -372,6 +401,8 @@ argil_err_t undo_redo(undo_t *u, field_t *f)
         return ARGIL_ERR_STATE;
     if (u->done == u->nsteps)
         return ARGIL_ERR_EMPTY;
+    if (u->steps[u->done].lattice_gen != f->lattice_gen)
+        return ARGIL_ERR_STATE;
     argil_err_t e = undo_apply(u, f, &u->steps[u->done], true);
     if (e == ARGIL_OK)
         u->done++;

@@ -28,6 +28,7 @@ typedef struct {
 typedef struct {
     size_t off, len;
     size_t n;                 /* changes held */
+    uint32_t lattice_gen;     /* the field's lattice_gen when the step was recorded */
 } undo_step_t;
 
 typedef struct {
@@ -48,9 +49,9 @@ typedef struct {
     size_t run_off;           /* where that header goes */
 } undo_t;
 
-/* An empty journal whose ring of budget_bytes is mapped and faulted in now, so that recording
- * a step never waits on a first-touch page fault. ARGIL_ERR_NOMEM (the journal then grows on
- * demand instead). */
+/* An empty journal whose ring of budget_bytes is mapped and written once now (~10-20 ms per
+ * 64 MB here, and that memory is resident from then on), so that recording a step never waits on
+ * a first-touch page fault. ARGIL_ERR_NOMEM (the journal then grows on demand instead). */
 argil_err_t undo_init(undo_t *u, size_t budget_bytes);
 void undo_free(undo_t *u);
 
@@ -77,7 +78,10 @@ argil_err_t undo_note_drest(undo_t *u, const int32_t ijk[3], float d_before, flo
  * grows. ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
 argil_err_t undo_commit(undo_t *u, const field_t *f);
 
-/* Reverts / re-applies one step; ARGIL_ERR_EMPTY when there is none. Changed blocks become dirty. */
+/* Reverts / re-applies one step; ARGIL_ERR_EMPTY when there is none; ARGIL_ERR_STATE (nothing
+ * changed) when the step was recorded before a knot insertion (field_refine), whose indices now
+ * name other coefficients: the history cannot be crossed back over a refinement. Changed blocks
+ * become dirty. */
 argil_err_t undo_undo(undo_t *u, field_t *f);
 argil_err_t undo_redo(undo_t *u, field_t *f);
 

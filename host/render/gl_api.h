@@ -23,6 +23,7 @@
     X(PFNGLDEPTHMASKPROC, DepthMask)                                                             \
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                                                             \
     X(PFNGLCULLFACEPROC, CullFace)                                                               \
+    X(PFNGLPOLYGONMODEPROC, PolygonMode)                                                         \
     X(PFNGLCREATESHADERPROC, CreateShader)                                                       \
     X(PFNGLSHADERSOURCEPROC, ShaderSource)                                                       \
     X(PFNGLCOMPILESHADERPROC, CompileShader)                                                     \

@@ -100,6 +100,45 @@ void hud_draw(hud_t *h, const char *text, float scale, int width, int height)
     gl->Enable(GL_DEPTH_TEST);
 }
 
+float hud_band_height(const char *text, float scale)
+{
+    size_t lines = 1;
+    for (const char *p = text; *p; p++)
+        lines += *p == '\n';
+    return 4.0f * scale + (float)lines * (HUD_GLYPH_H + 3) * scale - 3.0f * scale;
+}
+
+void hud_draw_ramp(hud_t *h, void (*ramp)(float t, uint8_t rgb[3]), int n_steps, float x,
+                   float y, float bar_w, float bar_h, int width, int height)
+{
+    const gl_api_t *gl = h->gl;
+    if (n_steps < 2)
+        return;
+    gl->Viewport(0, 0, width, height);
+    gl->Disable(GL_DEPTH_TEST);
+    gl->UseProgram(h->prog);
+    const float vp[3] = {(float)width, (float)height, 0.0f};
+    gl->Uniform3fv(gl->GetUniformLocation(h->prog, "u_viewport"), 1, vp);
+    gl->BindVertexArray(h->vao);
+    gl->BindBuffer(GL_ARRAY_BUFFER, h->vbo);
+    const GLint color = gl->GetUniformLocation(h->prog, "u_color");
+    const float step = bar_w / (float)n_steps;
+    for (int i = 0; i < n_steps; i++) {
+        uint8_t rgb[3];
+        ramp((float)i / (float)(n_steps - 1), rgb);
+        const float c[4] = {rgb[0] / 255.0f, rgb[1] / 255.0f, rgb[2] / 255.0f, 1.0f};
+        const float q[4] = {x + step * (float)i, y, x + step * (float)(i + 1), y + bar_h};
+        float v[12];
+        put_quad(v, 0, q);
+        gl->Uniform4fv(color, 1, c);
+        gl->BufferData(GL_ARRAY_BUFFER, sizeof(v), v, GL_STREAM_DRAW);
+        gl->DrawArrays(GL_TRIANGLES, 0, 6);
+    }
+    gl->BindVertexArray(0);
+    gl->UseProgram(0);
+    gl->Enable(GL_DEPTH_TEST);
+}
+
 void hud_free(hud_t *h)
 {
     const gl_api_t *gl = h->gl;

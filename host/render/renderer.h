@@ -29,6 +29,7 @@ typedef struct {
     vec3_t ambient;
     vec3_t background;
     vec3_t clay_rgb;               /* for meshes without per-vertex colour */
+    bool closed_mesh;              /* the clay is closed and CCW outside: back faces are culled */
     bool show_tool;
     vec3_t tool_pos_m;
     float tool_radius_m;
@@ -39,6 +40,9 @@ typedef struct {
     float force_m_per_n;           /* line length per newton */
     bool show_box;
     vec3_t box_lo_m, box_hi_m;
+    bool show_wire;                /* the second iso-surface (renderer_set_wire_mesh) */
+    bool wire_on_top;              /* drawn through the clay (an inner level), else hidden by it */
+    vec3_t wire_rgb;
 } render_scene_t;
 
 /* The defaults: identity camera, plain mode, key light upper-left-front, fill lower-right,
@@ -54,6 +58,8 @@ typedef struct {
     unsigned vao_sphere, vbo_sphere, ibo_sphere;
     size_t sphere_index_count;
     unsigned vao_line, vbo_line;
+    unsigned vao_wire, vbo_wire, ibo_wire;
+    size_t wire_index_count;
 } renderer_t;
 
 /* Compiles the shaders and makes the tool sphere; the GL context must be current.
@@ -62,6 +68,9 @@ argil_err_t renderer_init(renderer_t *r, const gl_api_t *gl, char *err, size_t e
 
 /* Uploads m (positions, normals, colours when it has them) to draw from now on. */
 argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m);
+
+/* Uploads m's positions and triangles as the second iso-surface, drawn as a wireframe. */
+argil_err_t renderer_set_wire_mesh(renderer_t *r, const mesh_t *m);
 
 /* Draws the scene into the bound framebuffer's width × height pixels. */
 void renderer_draw(const renderer_t *r, const render_scene_t *s, int width, int height);
@@ -92,6 +101,9 @@ void render_target_bind(const render_target_t *t);
 /* Resolves the samples and copies the frame into rgb (width × height × 3 bytes, top row
  * first). */
 void render_target_read_rgb(const render_target_t *t, uint8_t *rgb);
+
+/* Resolves t's samples into the default framebuffer (a window of t's size) and binds it. */
+void render_target_present(const render_target_t *t);
 
 void render_target_free(render_target_t *t);
 

@@ -16,7 +16,9 @@ typedef enum {
     UI_CMD_PARAM,                 /* arg: script_param_t, value: the new value */
     UI_CMD_INVERT,                /* arg: 1 while the invert key is held, 0 on release */
     UI_CMD_MOUSE,                 /* arg: 1 while the left button is held; ray in model space */
-    UI_CMD_STOP                   /* end the session (window closed) */
+    UI_CMD_STOP,                  /* end the session (window closed) */
+    UI_CMD_ISO2,                  /* arg: 1 shows the second iso-surface at level value, 0 hides */
+    UI_CMD_COLOUR                 /* arg: colour_map_t, the material shown on the clay */
 } ui_cmd_kind_t;
 
 typedef struct {

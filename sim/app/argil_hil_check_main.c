@@ -53,14 +53,29 @@ static char *slurp(const char *path, size_t *len)
 int main(int argc, char **argv)
 {
     if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
-        puts("usage: argil-hil-check SCENARIO CANDUMP_LOG EVENT_LOG\n"
+        puts("usage: argil-hil-check [--link-ticks N] SCENARIO CANDUMP_LOG EVENT_LOG\n"
              "  Checks each expectation of SCENARIO (hil/scenarios/*.scn) against a candump -l\n"
              "  log and argil-sim's event log; prints one line per expectation and\n"
-             "  'N passed, N failed'. Exit 0 all passed, 1 some failed, 2 bad usage or input.");
+             "  'N passed, N failed'. Exit 0 all passed, 1 some failed, 2 bad usage or input.\n"
+             "  --link-ticks N  board ticks (0-50, default 0) the host link may take to deliver a\n"
+             "                  host-side step: added to the bounds anchored on one");
         return 0;
     }
+    uint32_t link_ticks = 0;
+    if (argc == 6 && strcmp(argv[1], "--link-ticks") == 0) {
+        char *end = NULL;
+        const long v = strtol(argv[2], &end, 10);
+        if (end == argv[2] || *end != '\0' || v < 0 || v > 50) {
+            fprintf(stderr, "argil-hil-check: --link-ticks '%s': expected 0-50\n", argv[2]);
+            return 2;
+        }
+        link_ticks = (uint32_t)v;
+        argv += 2;
+        argc -= 2;
+    }
     if (argc != 4) {
-        fprintf(stderr, "usage: argil-hil-check SCENARIO CANDUMP_LOG EVENT_LOG (try --help)\n");
+        fprintf(stderr, "usage: argil-hil-check [--link-ticks N] SCENARIO CANDUMP_LOG EVENT_LOG "
+                        "(try --help)\n");
         return 2;
     }
     static scenario_t s;
@@ -83,6 +98,7 @@ int main(int argc, char **argv)
     }
     hil_obs_t o;
     hil_obs_init(&o);
+    o.link_ticks = link_ticks;
     uint32_t line = 0;
     hil_err_t e = hil_obs_add_candump(&o, can, can_len, &line);
     if (e != HIL_OK) {

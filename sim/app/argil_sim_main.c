@@ -1,9 +1,10 @@
-/* argil-sim: the simulated arm as a device on a real CAN bus. Every millisecond (absolute
- * clock_nanosleep) it reads the board's frames from a SocketCAN interface and the board's
- * DRIVE_ENABLE / WDOG_KICK outputs, runs sim_runner_tick (the same per-tick function the SIL
- * fault matrix runs: three CiA 402 drives, arm dynamics, hand, scenario, fault injection), and
- * writes the drives' frames and the input lines back. Events go to an event log on
- * CLOCK_REALTIME, so they line up with `candump -l`. Usage: docs/sim.md. */
+/* argil-sim: the simulated arm as a device on a real CAN bus. For each SYNC the board sends (or
+ * each millisecond of wall time with --clock wall, or while the bus is silent) it takes the
+ * board's frames from a SocketCAN interface and the board's DRIVE_ENABLE / WDOG_KICK outputs,
+ * runs sim_runner_tick (the same per-tick function the SIL fault matrix runs: three CiA 402
+ * drives, arm dynamics, hand, scenario, fault injection), and writes the drives' frames and the
+ * input lines back. Events go to an event log on CLOCK_REALTIME, stamped when they took effect,
+ * so they line up with `candump -l`. Usage: docs/sim.md. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
@@ -11,6 +12,7 @@
 #include <glob.h>
 #include <gpiod.h>
 #include <inttypes.h>
+#include <poll.h>
 #include <linux/can.h>
 #include <signal.h>
 #include <stdio.h>
@@ -25,10 +27,10 @@
 #include "firmware/hal/gpio_port.h"
 #include "shared/gpio_lines.h"
 #include "sim/scenario.h"
+#include "sim/scn_clock.h"
 #include "sim/sim_runner.h"
 
 #define TICK_US 1000u
-#define MAX_STEP_US 20000u /* longest device step when ticks come late */
 #define EXIT_RUN 1   /* could not open the bus or GPIO, or I/O failed while running */
 #define EXIT_USAGE 2 /* bad option or scenario */
 
@@ -43,9 +45,9 @@ static void on_signal(int sig)
 static void usage(FILE *to)
 {
     fputs("usage: argil-sim --can IFACE [--gpio-chip CHIP] [--scenario FILE] [--log-dir DIR]\n"
-          "                 [--seconds S] [--help]\n"
+          "                 [--seconds S] [--clock ticks|wall] [--help]\n"
           "  The simulated arm (3 CiA 402 drives, arm dynamics, GPIO, a scripted hand) on a\n"
-          "  SocketCAN interface, in real time at 1 kHz.\n"
+          "  SocketCAN interface, one 1 ms step per SYNC of the board (--clock).\n"
           "  --can IFACE       CAN interface the board is on (vcan0, can0)\n"
           "  --gpio-chip CHIP  GPIO chip with the board's named lines: a gpio-sim chip is driven\n"
           "                    through sysfs (pull/value), any other chip through libgpiod with\n"
@@ -53,8 +55,12 @@ static void usage(FILE *to)
           "                    (e-stop released, drives taken as enabled)\n"
           "  --scenario FILE   hil/scenarios/*.scn: hand moves, faults (docs/sim.md); none: hold\n"
           "  --log-dir DIR     write DIR/events.log (default: events to stdout)\n"
-          "  --seconds S       stop after S seconds (default: the scenario's duration, else\n"
-          "                    until SIGINT/SIGTERM)\n"
+          "  --seconds S       stop after S seconds of scenario time (default: the scenario's\n"
+          "                    duration, else until SIGINT/SIGTERM)\n"
+          "  --clock ticks     (default) one 1 ms step per SYNC the board sends, so the arm and\n"
+          "                    the scenario keep the board's time even when it ticks slower than\n"
+          "                    1 kHz; the wall clock while the bus has no SYNC for 400 ms\n"
+          "  --clock wall      1 ms steps on the wall clock, whatever the board does\n"
           "exit: 0 ran to the end, 1 bus/GPIO could not be opened or failed, 2 bad usage\n",
           to);
 }
@@ -63,13 +69,65 @@ static void usage(FILE *to)
 
 static FILE *event_log;
 
+/* Events of the tick in progress wait here until its I/O is done: an injection is stamped
+ * when its effect is on the bus and the lines (after the tick's frames were sent and the
+ * inputs written), a DRIVE_ENABLE change when the output was read. */
+#define EVENTS_MAX 48u
+typedef struct {
+    int64_t t_us;
+    bool gpio_out;
+    char text[SCN_TEXT_LEN + 48];
+} pending_event_t;
+static pending_event_t pending_ev[EVENTS_MAX];
+static uint32_t n_pending_ev, lost_ev;
+static bool defer_events;
+static struct timespec prev_read; /* the board's outputs read before this tick's read */
+
+static void write_event(const struct timespec *ts, int64_t t_us, const char *event)
+{
+    fprintf(event_log, "(%lld.%06ld) %s t=%" PRId64 ".%06" PRId64 "\n", (long long)ts->tv_sec,
+            ts->tv_nsec / 1000, event, t_us / 1000000, t_us % 1000000);
+}
+
 static void log_event(void *ctx, int64_t t_us, const char *event)
 {
     (void)ctx;
+    if (defer_events) {
+        if (n_pending_ev == EVENTS_MAX) {
+            lost_ev++;
+            return;
+        }
+        pending_event_t *e = &pending_ev[n_pending_ev++];
+        e->t_us = t_us;
+        e->gpio_out = strncmp(event, "gpio_out", 8) == 0;
+        snprintf(e->text, sizeof(e->text), "%s", event);
+        return;
+    }
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
-    fprintf(event_log, "(%lld.%06ld) %s t=%" PRId64 ".%06" PRId64 "\n", (long long)ts.tv_sec,
-            ts.tv_nsec / 1000, event, t_us / 1000000, t_us % 1000000);
+    write_event(&ts, t_us, event);
+}
+
+/* Writes the held events: output changes stamped at `read` (with the read before it), the
+ * rest now. */
+static void flush_events(const struct timespec *read)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t i = 0; i < n_pending_ev; i++)
+            if (pending_ev[i].gpio_out == (pass == 0)) {
+                if (pass == 0 && prev_read.tv_sec > 0) { /* the edge lies after the last read */
+                    char text[sizeof(pending_ev[i].text) + 32];
+                    snprintf(text, sizeof(text), "%s prev=(%lld.%06ld)", pending_ev[i].text,
+                             (long long)prev_read.tv_sec, prev_read.tv_nsec / 1000);
+                    write_event(read, pending_ev[i].t_us, text);
+                } else {
+                    write_event(pass == 0 ? read : &now, pending_ev[i].t_us, pending_ev[i].text);
+                }
+            }
+    n_pending_ev = 0;
+    fflush(event_log); /* hil-host --follow reads it as it grows */
 }
 
 /* ---- GPIO: the device side of the board's named lines ---- */
@@ -263,6 +321,13 @@ static argil_err_t can_send_all(int fd, const can_batch_t *tx, can_socket_stats_
     return data.n ? can_socket_send(fd, &data, st) : ARGIL_OK;
 }
 
+static int64_t mono_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
 static void add_us(struct timespec *t, uint32_t us)
 {
     t->tv_nsec += (long)us * 1000L;
@@ -276,10 +341,12 @@ int main(int argc, char **argv)
 {
     const char *iface = NULL, *chip = NULL, *scn_path = NULL, *log_dir = NULL;
     double seconds = -1.0;
+    bool clock_ticks = true;
     static const struct option opts[] = {
         {"can", required_argument, NULL, 'c'},      {"gpio-chip", required_argument, NULL, 'g'},
         {"scenario", required_argument, NULL, 's'}, {"log-dir", required_argument, NULL, 'l'},
-        {"seconds", required_argument, NULL, 't'},  {"help", no_argument, NULL, 'h'},
+        {"seconds", required_argument, NULL, 't'},  {"clock", required_argument, NULL, 'k'},
+        {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     opterr = 0;
     int c;
@@ -298,6 +365,13 @@ int main(int argc, char **argv)
             }
             break;
         }
+        case 'k':
+            if (strcmp(optarg, "ticks") != 0 && strcmp(optarg, "wall") != 0) {
+                fprintf(stderr, "argil-sim: --clock '%s': expected ticks or wall\n", optarg);
+                return EXIT_USAGE;
+            }
+            clock_ticks = strcmp(optarg, "ticks") == 0;
+            break;
         case 'h': usage(stdout); return 0;
         default:
             fprintf(stderr, "argil-sim: unknown or incomplete option '%s' (try --help)\n",
@@ -345,6 +419,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "argil-sim: %s\n", err);
         return EXIT_RUN;
     }
+    /* Every SYNC is a step of the clock: a starved moment must not cost frames (4 MiB, as the
+     * rig's candump; SO_RCVBUFFORCE needs CAP_NET_ADMIN, else the system's cap applies). */
+    const int rcvbuf = 4 << 20;
+    if (setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &rcvbuf, sizeof(rcvbuf)) != 0)
+        (void)setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof(rcvbuf));
     static sim_gpio_t gpio;
     if (!gpio_open(&gpio, chip, err, sizeof(err))) {
         fprintf(stderr, "argil-sim: %s\n", err);
@@ -362,30 +441,67 @@ int main(int argc, char **argv)
     const int64_t end_us = seconds > 0.0 ? (int64_t)(seconds * 1e6)
                            : scn_path ? scn.duration_us
                                       : INT64_MAX;
-    char line[160];
+    char line[256];
+    {   /* frames queued before the start line are not counted: SYNCs count from here */
+        can_batch_t stale;
+        do {
+            can_socket_stats_t ignored = {0};
+            if (can_socket_receive(fd, &stale, &ignored) != ARGIL_OK)
+                break;
+        } while (stale.n == CAN_BATCH_MAX);
+    }
     snprintf(line, sizeof(line), "start scenario %s can %s gpio %s", scn_path ? scn.name : "none",
              iface, gpio.mode == GPIO_SYSFS ? "gpio-sim" : gpio.mode == GPIO_GPIOD ? "gpiod" : "none");
     log_event(NULL, 0, line);
 
     can_socket_stats_t st;
     memset(&st, 0, sizeof(st));
+    /* The scenario times argil-hil-check anchors its expectations on: each is logged as
+     * "mark at T" when this clock passes it (the end too). */
+    int64_t mark_us[2u * SCN_EXPECTS_MAX + 1u];
+    uint32_t n_marks = 0, next_mark = 0;
+    if (scn_path) {
+        for (uint32_t i = 0; i < scn.n_expects; i++) {
+            mark_us[n_marks++] = scn.expect[i].t_us;
+            if (scn.expect[i].until == SCN_UNTIL_TIME)
+                mark_us[n_marks++] = scn.expect[i].until_us;
+        }
+        mark_us[n_marks++] = scn.duration_us;
+        for (uint32_t i = 1; i < n_marks; i++) /* insertion sort, few entries */
+            for (uint32_t k = i; k > 0 && mark_us[k - 1] > mark_us[k]; k--) {
+                const int64_t tmp = mark_us[k];
+                mark_us[k] = mark_us[k - 1];
+                mark_us[k - 1] = tmp;
+            }
+    }
     uint32_t next_host = 0, late_ticks = 0;
     int rc = 0;
-    struct timespec next, prev;
+    scn_clock_t clk;
+    scn_clock_init(&clk, clock_ticks, mono_us());
+    static can_batch_t held; /* the board's frames since its last SYNC */
+    struct timespec next;
     clock_gettime(CLOCK_MONOTONIC, &next);
-    prev = next;
-    uint32_t dt_us = TICK_US;
-    while (!stop_requested && run.now_us < end_us) {
-        /* host-side steps are the host rig's; log them so the record is complete */
-        while (scn_path && next_host < scn.n_steps && scn.step[next_host].t_us <= run.now_us) {
-            const scn_step_t *s = &scn.step[next_host++];
-            if (scenario_action_is_host_side(s->action)) {
-                snprintf(line, sizeof(line), "host line=%u (for the host side) %s",
-                         (unsigned)s->line, s->text);
-                log_event(NULL, run.now_us, line);
+    defer_events = true;
+    while (!stop_requested && clk.now_us < end_us && rc == 0) {
+        if (clock_ticks) {
+            /* The board's SYNC starts each step: wait for frames (1 ms at most, so a silent
+             * bus still lets the wall clock take over). */
+            struct pollfd pfd = {.fd = fd, .events = POLLIN};
+            (void)poll(&pfd, 1, 1);
+        } else {
+            add_us(&next, TICK_US);
+            struct timespec now;
+            clock_gettime(CLOCK_MONOTONIC, &now);
+            if (now.tv_sec > next.tv_sec ||
+                (now.tv_sec == next.tv_sec && now.tv_nsec > next.tv_nsec)) {
+                late_ticks++;
+                next = now; /* a late tick is not made up by a burst: resynchronise */
+            }
+            while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL) == EINTR &&
+                   !stop_requested) {
             }
         }
-        can_batch_t rx, tx;
+        can_batch_t rx;
         if (can_socket_receive(fd, &rx, &st) != ARGIL_OK) {
             fprintf(stderr, "argil-sim: CAN %s: receive failed (%s)\n", iface,
                     strerror(st.last_errno));
@@ -399,43 +515,92 @@ int main(int argc, char **argv)
             rc = EXIT_RUN;
             break;
         }
-        sim_runner_tick(&run, &rx, out, &tx, dt_us);
-        const argil_err_t se = can_send_all(fd, &tx, &st);
-        if (se == ARGIL_ERR_IO) {
-            fprintf(stderr, "argil-sim: CAN %s: send failed (%s)\n", iface,
-                    strerror(st.last_errno));
-            rc = EXIT_RUN;
-            break;
+        struct timespec t_read;
+        clock_gettime(CLOCK_REALTIME, &t_read);
+        /* One device step per SYNC (with the frames the board sent before it), or one on the
+         * wall clock when the bus has been silent; frames after the last SYNC wait for it. */
+        uint32_t steps_this_read = 0;
+        for (uint32_t i = 0; i <= rx.n && rc == 0; i++) {
+            uint32_t dt_us = 0;
+            if (i < rx.n) {
+                const can_frame_t *f = &rx.f[i];
+                (void)can_batch_push(&held, f);
+                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
+                    dt_us = scn_clock_sync(&clk, mono_us());
+                else if (held.n < CAN_BATCH_MAX)
+                    continue;
+                /* a full batch without SYNC is handed over with a step of 0 */
+            } else {
+                dt_us = scn_clock_idle(&clk, mono_us());
+                if (dt_us == 0)
+                    break;
+                if (dt_us > TICK_US)
+                    late_ticks++;
+            }
+            /* host-side steps are the host rig's; log them so the record is complete */
+            while (scn_path && next_host < scn.n_steps && scn.step[next_host].t_us <= run.now_us) {
+                const scn_step_t *s = &scn.step[next_host++];
+                if (scenario_action_is_host_side(s->action)) {
+                    snprintf(line, sizeof(line), "host line=%u (for the host side) %s",
+                             (unsigned)s->line, s->text);
+                    log_event(NULL, run.now_us, line);
+                }
+            }
+            while (next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
+                /* sync=N: this step began at the board's N-th SYNC since the start line, the
+                 * instant the checker anchors on (this line is stamped later, after the I/O) */
+                if (i < rx.n)
+                    snprintf(line, sizeof(line), "mark at %" PRId64 ".%06" PRId64 " sync=%u",
+                             mark_us[next_mark] / 1000000, mark_us[next_mark] % 1000000,
+                             clk.syncs);
+                else
+                    snprintf(line, sizeof(line), "mark at %" PRId64 ".%06" PRId64,
+                             mark_us[next_mark] / 1000000, mark_us[next_mark] % 1000000);
+                log_event(NULL, run.now_us, line);
+                next_mark++;
+            }
+            can_batch_t tx;
+            run.outputs_reused = steps_this_read++ > 0;
+            sim_runner_tick(&run, &held, out, &tx, dt_us);
+            held.n = 0;
+            const argil_err_t se = can_send_all(fd, &tx, &st);
+            if (se == ARGIL_ERR_IO) {
+                fprintf(stderr, "argil-sim: CAN %s: send failed (%s)\n", iface,
+                        strerror(st.last_errno));
+                rc = EXIT_RUN;
+            } else if (gpio.mode != GPIO_NONE &&
+                       !gpio_write_inputs(&gpio, sim_runner_gpio_in(&run))) {
+                fprintf(stderr, "argil-sim: GPIO: cannot drive the board's inputs (%s)\n",
+                        strerror(errno));
+                rc = EXIT_RUN;
+            }
+            flush_events(&t_read);
+            if (clk.now_us >= end_us)
+                break;
         }
-        if (gpio.mode != GPIO_NONE && !gpio_write_inputs(&gpio, sim_runner_gpio_in(&run))) {
-            fprintf(stderr, "argil-sim: GPIO: cannot drive the board's inputs (%s)\n",
-                    strerror(errno));
-            rc = EXIT_RUN;
-            break;
-        }
-        add_us(&next, TICK_US);
-        struct timespec now;
-        clock_gettime(CLOCK_MONOTONIC, &now);
-        if (now.tv_sec > next.tv_sec || (now.tv_sec == next.tv_sec && now.tv_nsec > next.tv_nsec)) {
-            late_ticks++;
-            next = now; /* a late tick is not made up by a burst: resynchronise */
-        }
-        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL) == EINTR &&
-               !stop_requested) {
-        }
-        /* The arm is physics: the next step covers the wall time that really passed (at
-         * most MAX_STEP_US), so the scenario clock stays on the wall clock when ticks are
-         * late (a loaded machine, an emulated VM). */
-        clock_gettime(CLOCK_MONOTONIC, &now);
-        const int64_t el_us = (int64_t)(now.tv_sec - prev.tv_sec) * 1000000 +
-                              (now.tv_nsec - prev.tv_nsec) / 1000;
-        prev = now;
-        dt_us = el_us < 1 ? 1u : el_us > MAX_STEP_US ? MAX_STEP_US : (uint32_t)el_us;
+        prev_read = t_read;
     }
+    while (scn_path && next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
+        snprintf(line, sizeof(line), "mark at %" PRId64 ".%06" PRId64,
+                 mark_us[next_mark] / 1000000, mark_us[next_mark] % 1000000);
+        log_event(NULL, run.now_us, line);
+        next_mark++;
+    }
+    defer_events = false;
+    {
+        struct timespec now;
+        clock_gettime(CLOCK_REALTIME, &now);
+        flush_events(&now);
+    }
+    if (lost_ev > 0)
+        fprintf(stderr, "argil-sim: %u events not logged (more than %u in one tick)\n",
+                lost_ev, EVENTS_MAX);
     snprintf(line, sizeof(line),
-             "end frames_rx=%u frames_tx=%u tx_busy=%u late_ticks=%u dropped=%u/%u silenced=%u",
+             "end frames_rx=%u frames_tx=%u tx_busy=%u late_ticks=%u dropped=%u/%u silenced=%u "
+             "clock %s syncs=%u wall_steps=%u",
              st.rx_frames, st.tx_frames, st.tx_busy, late_ticks, run.faults.dropped_to_board,
-             run.faults.dropped_from_board, run.faults.silenced);
+             run.faults.dropped_from_board, run.faults.silenced, clock_ticks ? "ticks" : "wall",
+             clk.syncs, clk.wall_steps);
     log_event(NULL, run.now_us, line);
     if (event_log != stdout)
         fclose(event_log);

@@ -83,6 +83,7 @@ int main(int argc, char **argv)
     render_scene_t s;
     render_scene_default(&s);
     s.show_tool = s.show_force = s.show_box = true;
+    s.closed_mesh = true; /* a closed sculpture, as the live window draws its mc_blocks mesh */
     s.tool_pos_m = vec3(0.01f, 0.01f, 0.031f);
     s.force_n = vec3(0.3f, 0.2f, 1.0f);
     s.box_lo_m = vec3(0.0f, 0.0f, 0.02f);

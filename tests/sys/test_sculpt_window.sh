@@ -16,9 +16,11 @@ py=/usr/bin/python3
 # Pixel classes of a window screenshot below the HUD band (HUD_ROWS rows):
 #   "stats PNG": W H CLAY_SHARE TOOL_PX CLAY_LUMA_P5 CLAY_LUMA_P95
 #   "diff A B [X0 Y0 X1 Y1]": pixels that are clay in both and differ by > 25 levels of luma
+#   "wire PNG": pixels of the second iso-surface's wire colour (magenta) below the HUD
+#   "legend PNG": RGB at the left and right ends of the colour legend (row 50, x 8 and 188)
 cat >"$tmp/png.py" <<'PY'
 import struct, sys, zlib
-HUD_ROWS = 40
+HUD_ROWS = 60  # the HUD's four lines and the colour legend under them
 def load(path):
     data = open(path, 'rb').read()
     assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
@@ -53,7 +55,14 @@ def load(path):
 def clay(p): return p[0] > p[2] + 25 and p[0] >= p[1]
 def tool(p): return p[2] > p[0] + 20 and p[1] > p[0] + 10 and not (p[1] > p[0] + 60 and p[1] > p[2] + 60)
 def luma(p): return (299 * p[0] + 587 * p[1] + 114 * p[2]) // 1000
-if sys.argv[1] == 'stats':
+def wire(p): return p[0] > p[1] + 60 and p[2] > p[1] + 60
+if sys.argv[1] == 'wire':
+    w, h, px = load(sys.argv[2])
+    print(sum(1 for row in px[HUD_ROWS:] for p in row if wire(p)))
+elif sys.argv[1] == 'legend':
+    w, h, px = load(sys.argv[2])
+    print(*px[50][8], *px[50][188])
+elif sys.argv[1] == 'stats':
     w, h, px = load(sys.argv[2])
     body = [p for row in px[HUD_ROWS:] for p in row]
     c = sorted(luma(p) for p in body if clay(p))
@@ -76,6 +85,8 @@ else:
 PY
 stats() { "$py" "$tmp/png.py" stats "$1"; }
 diffpx() { "$py" "$tmp/png.py" diff "$@"; }
+wirepx() { "$py" "$tmp/png.py" wire "$1"; }
+legend() { "$py" "$tmp/png.py" legend "$1"; }
 
 # 1. The default session in the window (as fast as it can), a screenshot every simulated second.
 xvfb "$rel" sculpt --script scripts/default.scn --out "$tmp/live" --fast --width 480 \
@@ -155,7 +166,77 @@ after=$(ls "$tmp/mouse/frames" | awk -F'[_.]' '$2 >= 4500 { print; exit }')
 dent=$(diffpx "$tmp/mouse/frames/$before" "$tmp/mouse/frames/$after" 260 180 380 300)
 echo "clay pixels changed under the cursor between $before and $after: $dent"
 [ "$dent" -ge 100 ] || fail "no dent on screen where the mouse pushed ($dent pixels)"
-# 3. Errors: one line each, nothing run.
+# 3. The view's extras (real time, --mouse, Esc at 2.5 s): the second iso-surface as a wireframe
+#    and the stiffness colour map with its legend, from the options and from the keys; the
+#    solve step from the panel.
+mouse_shot() { # NAME INPUT [OPTIONS...]
+    name=$1 input=$2
+    shift 2
+    xvfb timeout 120 "$rel" sculpt --mouse --input "$input" --out "$tmp/$name" --width 480 \
+        --height 360 --linger 0 --screenshot "$tmp/$name.png" "$@" >"$tmp/$name.txt" 2>&1 ||
+        [ $? = 130 ] || { cat "$tmp/$name.txt"; fail "sculpt $name failed"; }
+}
+printf '2.5 key ESC\n' >"$tmp/esc.txt"
+mouse_shot plain "$tmp/esc.txt"
+mouse_shot extras "$tmp/esc.txt" --iso2 0.3 --colour stiffness
+grep -q "view at the end     iso2 0.30, colour stiffness (1 .. 1 x default)" "$tmp/extras.txt" ||
+    { cat "$tmp/extras.txt"; fail "--iso2 0.3 --colour stiffness did not reach the view"; }
+w0=$(wirepx "$tmp/plain.png")
+w1=$(wirepx "$tmp/extras.png")
+echo "wire pixels: $w0 without the second iso-surface, $w1 with --iso2 0.3"
+[ "$w0" -lt 30 ] || fail "wire-coloured pixels without --iso2 ($w0)"
+[ "$w1" -ge 1500 ] || fail "the second iso-surface is not drawn ($w1 wire pixels)"
+set -- $(stats "$tmp/plain.png")
+c0=$3
+set -- $(stats "$tmp/extras.png")
+c1=$3
+echo "clay-coloured share: $c0 plain, $c1 with the stiffness map"
+awk -v a="$c0" -v b="$c1" 'BEGIN { exit !(a > 0.10 && b < 0.02) }' ||
+    fail "the colour map did not recolour the clay ($c0 -> $c1)"
+set -- $(legend "$tmp/extras.png")
+echo "legend ends: ($1 $2 $3) .. ($4 $5 $6)"
+[ "$3" -gt $(($1 + 80)) ] && [ "$4" -gt $(($6 + 80)) ] ||
+    fail "no blue-to-red legend under the HUD"
+set -- $(legend "$tmp/plain.png")
+[ "$3" -lt $(($1 + 80)) ] || fail "a legend is drawn without a colour map"
+# The same from the keys: I (on at 0.3), ] (0.4), M twice (mass), the panel's solve step + 1.
+cat >"$tmp/keys.in" <<'EOF'
+0.5 key I
+0.6 key RBRACKET
+0.7 key M
+0.8 key M
+0.9 key TAB
+0.92 key TAB
+0.94 key TAB
+0.96 key TAB
+0.98 key TAB
+1.0 key TAB
+1.02 key TAB
+1.04 key TAB
+1.1 key PLUS
+2.5 key ESC
+EOF
+mouse_shot keys "$tmp/keys.in"
+grep "view at the end" "$tmp/keys.txt"
+grep -q "view at the end     iso2 0.40, colour mass (1 .. 1 x default), solve step 12.5 ms" \
+    "$tmp/keys.txt" || fail "the keys did not set iso2 0.40, colour mass, solve step 12.5 ms"
+w2=$(wirepx "$tmp/keys.png")
+echo "wire pixels after the keys: $w2"
+[ "$w2" -ge 1500 ] || fail "key I did not show the second iso-surface ($w2 wire pixels)"
+set +e
+"$rel" sculpt --headless --iso2 0.3 --out "$tmp/bad" 2>"$tmp/err"
+st=$?
+"$rel" sculpt --iso2 2 --out "$tmp/bad" 2>>"$tmp/err"
+st2=$?
+"$rel" sculpt --colour hue --out "$tmp/bad" 2>>"$tmp/err"
+st3=$?
+set -e
+cat "$tmp/err"
+[ "$st" = 2 ] && [ "$st2" = 2 ] && [ "$st3" = 2 ] || fail "bad view options: $st $st2 $st3"
+grep -q "iso2 needs the window" "$tmp/err" && grep -q "level 0.05..0.95" "$tmp/err" &&
+    grep -q "stiffness, mass or none" "$tmp/err" || fail "view option error text"
+
+# 4. Errors: one line each, nothing run.
 printf '0.5 key 1\n0.2 key F\n' >"$tmp/bad.txt"
 if xvfb "$rel" sculpt --input "$tmp/bad.txt" --out "$tmp/bad" 2>"$tmp/err"; then
     fail "a bad input file was accepted"

@@ -72,6 +72,59 @@ cmp -s "$tmp/plain.png" "$tmp/clearcoat.png" && fail "clear-coat looks the same 
 set -- $(png_stats "$tmp/sculpt.png" header)
 [ "$1" = 1024 ] && [ "$2" = 768 ] || fail "sculpt.png: $*"
 
+# A .argil model (fitted from the session's mesh) with its density level 0.3 as a wireframe
+# (Hua & Qin Fig. 12): magenta wire pixels appear that the plain view does not have.
+"$rel" fit "$tmp/out/final.ply" -o "$tmp/m.argil" --resolution 40 --quiet || fail "fit failed"
+wire_px() {
+    "$py" - "$1" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+pos, idat = 8, b''
+while pos < len(data):
+    n, kind = struct.unpack('>I4s', data[pos:pos + 8])
+    if kind == b'IHDR':
+        w, h = struct.unpack('>II', data[pos + 8:pos + 16])
+    elif kind == b'IDAT':
+        idat += data[pos + 8:pos + 8 + n]
+    pos += 12 + n
+raw, stride, prev, n = zlib.decompress(idat), w * 3, bytearray(w * 3), 0
+for y in range(h):
+    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+    for i in range(stride):
+        a = line[i - 3] if i >= 3 else 0
+        b, c = prev[i], (prev[i - 3] if i >= 3 else 0)
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + b) & 255
+        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c
+            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    n += sum(1 for i in range(0, stride, 3) if line[i] > line[i + 1] + 60 and line[i + 2] > line[i + 1] + 60)
+    prev = line
+print(n)
+PY
+}
+for lv in none 0.3 0.7; do
+    opt=""
+    [ "$lv" = none ] || opt="--iso2 $lv"
+    env -u DISPLAY "$rel" view "$tmp/m.argil" --screenshot "$tmp/iso_$lv.png" --width 320 \
+        --height 240 $opt || fail "view m.argil $opt failed"
+done
+n0=$(wire_px "$tmp/iso_none.png")
+n3=$(wire_px "$tmp/iso_0.3.png")
+n7=$(wire_px "$tmp/iso_0.7.png")
+echo "view m.argil: wire pixels $n0 plain, $n3 with --iso2 0.3 (outside), $n7 with 0.7 (inside)"
+[ "$n0" -lt 20 ] && [ "$n3" -ge 2000 ] && [ "$n7" -ge 1000 ] ||
+    fail "the second iso-surface is not drawn as a wireframe ($n0 / $n3 / $n7)"
+set -- $(png_stats "$tmp/iso_none.png")
+[ "$3" -gt 200 ] || fail "the .argil model is not drawn ($3 colours)"
+set +e
+env -u DISPLAY "$rel" view "$tmp/out/final.ply" --iso2 0.3 --screenshot "$tmp/x.png" 2>"$tmp/err"
+st=$?
+set -e
+[ "$st" = 2 ] && grep -q "iso2 needs a density field" "$tmp/err" || fail "--iso2 on a mesh: $st"
+
 # Through a hidden GLFW window on Xvfb, when it is installed.
 if command -v xvfb-run >/dev/null 2>&1; then
     xvfb-run -a -s "-screen 0 640x480x24" "$rel" view "$tmp/out/final.ply" --backend glfw \

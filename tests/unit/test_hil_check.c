@@ -107,6 +107,23 @@ static void test_event_logs(void **st)
         {"(5.000000) start scenario tt\n", HIL_ERR_SCENARIO, 1},
         {"(5.000000) note hello\n", HIL_ERR_NO_START, 0},
         {"(5.000000)start\n", HIL_ERR_SYNTAX, 1},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.3\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark 1.300000\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark at x.000000\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.3000001\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark at 123456.000000\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.300000 t=1.300\n", HIL_OK, 0},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.300000 sync=1300 t=1.3\n", HIL_OK, 0},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.300000 sync=x\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) mark at 1.300000 sync=12x\n", HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=0 prev=(5.500000)\n",
+         HIL_OK, 0},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=0 prev=(7.000000)\n",
+         HIL_ERR_ORDER, 2},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=0 prev=5.5\n",
+         HIL_ERR_EVENT, 2},
+        {"(5.000000) start scenario t\n(6.000000) gpio_out DRIVE_ENABLE=0 prev=(5.500000)x\n",
+         HIL_ERR_EVENT, 2},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         hil_obs_t o;
@@ -315,6 +332,101 @@ static void test_bounds_in_ticks(void **st)
     hil_obs_free(&o);
 }
 
+/* A rig whose scenario clock follows the board's ticks logs "mark at T" when it passes T: an
+ * expectation at T with no step there is anchored at the mark, not at start + T. Here the
+ * board ran at half speed: scenario time 0.5-0.9 s was wall time 11.2-11.5 s, after the e-stop
+ * at 11.0 s, so "running" over that window fails; anchored at start + T it would pass. */
+static void test_marks_anchor_expectations(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    hil_result_t r;
+    synth(&o, 1000, false);
+    hil_check_expect(&scn, &o, 4, &r);       /* running 0.5 until 0.9, at start + T */
+    assert_true(r.pass);
+    const char marks[] = "(11.200000) mark at 0.500000 t=0.500\n"
+                         "(11.200500) mark at 0.500000 t=0.501\n" /* a repeat: first counts */
+                         "(11.500000) mark at 0.900000 t=0.900\n";
+    uint32_t line = 0;
+    hil_obs_t m;
+    hil_obs_init(&m);
+    const char ev[] = "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+                      "(11.001000) gpio_out DRIVE_ENABLE=0 t=1.001\n";
+    assert_int_equal(hil_obs_add_events(&m, &scn, ev, strlen(ev), &line), HIL_OK);
+    assert_int_equal(hil_obs_add_events(&m, &scn, marks, strlen(marks), &line), HIL_OK);
+    assert_int_equal(m.n_marks, 2);
+    assert_int_equal(m.mark_us[0], 11200000);
+    assert_int_equal(m.mark_t_us[1], 900000);
+    for (size_t k = 0; k < o.n_frames; k++)
+        assert_int_equal(hil_obs_push_frame(&m, o.frame[k].t_us, &o.frame[k].f), HIL_OK);
+    hil_check_expect(&scn, &m, 4, &r);
+    assert_false(r.pass);
+    if (strstr(r.msg, "controlword 0x0002") == NULL)
+        fail_msg("%s", r.msg);
+    hil_obs_free(&m);
+    hil_obs_free(&o);
+}
+
+/* At 333 ticks/s: a mark with sync=N is anchored at the N-th SYNC after the start line however
+ * late the line itself was written; a DRIVE_ENABLE edge logged with the sample before it may
+ * have happened just after that sample; a host-side step's bound gets the link's ticks. */
+static void test_sync_marks_gpio_window_link_ticks(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    hil_result_t r;
+    synth_ticks(&o, 3000, 1050, 2, 200);     /* reacts one tick late: fault in 2 ticks */
+    /* SYNCs at 10.001250 + k * 3 ms: the 100th after the start is at 10.298250. Marks written
+     * late (at 11.5 s, after the e-stop) with their SYNC anchor "running 0.5 until 0.9" there. */
+    const char mark[] = "(11.500000) mark at 0.500000 sync=100 t=0.5\n"
+                        "(11.500001) mark at 0.900000 sync=120 t=0.9\n";
+    uint32_t line = 0;
+    assert_int_equal(hil_obs_add_events(&o, &scn, mark, strlen(mark), &line), HIL_OK);
+    assert_int_equal(o.mark_sync[0], 100);
+    hil_check_expect(&scn, &o, 4, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    assert_non_null(strstr(r.msg, "held for 60.000 ms"));
+    o.mark_sync[0] = o.mark_sync[1] = 0;     /* by the lines' own times: after the e-stop */
+    hil_check_expect(&scn, &o, 4, &r);
+    assert_false(r.pass);
+    /* fault within 2ms passed with the edge at its sample; a sample taken a tick later with
+     * the one before in the bound still passes, one without fails */
+    hil_check_expect(&scn, &o, 2, &r);
+    assert_true(r.pass);
+    hil_obs_t g;
+    hil_obs_init(&g);
+    char ev[320];
+    int64_t t_low = -1;
+    for (size_t k = 0; k < o.n_gpio; k++)
+        if (!o.gpio[k].drive_enable)
+            t_low = o.gpio[k].t_us;
+    assert_true(t_low > 0);
+    const int64_t late = t_low + 6000;       /* seen two samples (6 ms, 2 ticks) later */
+    snprintf(ev, sizeof(ev),
+             "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+             "(%lld.%06lld) gpio_out DRIVE_ENABLE=0 prev=(%lld.%06lld)\n",
+             (long long)(late / 1000000), (long long)(late % 1000000),
+             (long long)((t_low - 100) / 1000000), (long long)((t_low - 100) % 1000000));
+    assert_int_equal(hil_obs_add_events(&g, &scn, ev, strlen(ev), &line), HIL_OK);
+    assert_int_equal(g.gpio[0].prev_us, t_low - 100);
+    for (size_t k = 0; k < o.n_frames; k++)
+        assert_int_equal(hil_obs_push_frame(&g, o.frame[k].t_us, &o.frame[k].f), HIL_OK);
+    hil_check_expect(&scn, &g, 2, &r);
+    assert_true(r.pass);
+    g.gpio[0].prev_us = -1;                   /* without it the late sample fails the bound */
+    hil_check_expect(&scn, &g, 2, &r);
+    assert_false(r.pass);
+    hil_obs_free(&g);
+    /* The e-stop is device side: link ticks do not widen its bound ... */
+    o.link_ticks = 6;
+    hil_check_expect(&scn, &o, 0, &r);       /* torque_zero within 1ms, 2 ticks: fails */
+    assert_false(r.pass);
+    hil_obs_free(&o);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -322,6 +434,8 @@ int main(void)
         cmocka_unit_test(test_event_logs),
         cmocka_unit_test(test_expectations_pass_and_fail),
         cmocka_unit_test(test_bounds_in_ticks),
+        cmocka_unit_test(test_marks_anchor_expectations),
+        cmocka_unit_test(test_sync_marks_gpio_window_link_ticks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* Undo journal on its own: bit-for-bit undo/redo of snapshotted and noted changes, the memory
- * budget dropping the oldest steps first, a new edit clearing redo, state errors. */
+ * budget dropping the oldest steps first, a new edit clearing redo, state errors, and the history
+ * cut at a knot insertion. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -252,6 +253,41 @@ static void test_ring_wraps_bit_exact(void **state)
     field_free(&f);
 }
 
+/* Knot insertion (field_refine) moves every coefficient index: a step recorded before it would
+ * write coarse values into fine places, so undo and redo refuse it and change nothing; steps
+ * recorded after it undo as usual. */
+static void test_refine_cuts_the_history(void **state)
+{
+    (void)state;
+    field_t f;
+    assert_int_equal(field_init(&f, 0.02f, 2, vec3(0, 0, 0)), ARGIL_OK);
+    undo_t u;
+    assert_int_equal(undo_init(&u, 1u << 20), ARGIL_OK);
+    edit(&u, &f, 0, 6, 0.5f); /* coarse coefficients (-6..-1, 0, -1) = 0.5 */
+    edit(&u, &f, 1, 6, 0.7f);
+    assert_int_equal(undo_undo(&u, &f), ARGIL_OK); /* one redo step left */
+    assert_int_equal(field_refine(&f), ARGIL_OK);
+    assert_true(f.lattice_gen == 1 && f.ratio == 1);
+    /* fine 2c sits on coarse c: coarse (-4, 0, -1) is fine (-8, 0, -2), (p + 6p + p) / 8 along x
+     * inside the row, 6p / 8 along y and z (a single row): 0.5 * 36 / 64 */
+    const float fine_before = sparse_get(&f.coef, FC_P, -8, 0, -2);
+    assert_float_equal(fine_before, 0.28125f, 1e-6);
+    assert_int_equal(undo_undo(&u, &f), ARGIL_ERR_STATE);
+    assert_int_equal(undo_redo(&u, &f), ARGIL_ERR_STATE);
+    assert_true(sparse_get(&f.coef, FC_P, -8, 0, -2) == fine_before); /* nothing written */
+    /* an edit after the refinement is one step like any other */
+    edit(&u, &f, 5, 4, 0.9f);
+    assert_true(at(&f, 0, 5) == 0.9f);
+    assert_int_equal(undo_undo(&u, &f), ARGIL_OK);
+    assert_true(at(&f, 0, 5) == 0.0f);
+    assert_int_equal(undo_redo(&u, &f), ARGIL_OK);
+    assert_true(at(&f, 0, 5) == 0.9f);
+    assert_int_equal(undo_undo(&u, &f), ARGIL_OK);
+    assert_int_equal(undo_undo(&u, &f), ARGIL_ERR_STATE); /* the pre-refinement step stays refused */
+    undo_free(&u);
+    field_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -259,6 +295,7 @@ int main(void)
         cmocka_unit_test(test_new_edit_clears_redo),
         cmocka_unit_test(test_noted_and_snapshotted_changes_are_bit_exact),
         cmocka_unit_test(test_ring_wraps_bit_exact),
+        cmocka_unit_test(test_refine_cuts_the_history),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

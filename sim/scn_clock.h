@@ -1,0 +1,40 @@
+/* The scenario clock of a rig whose board may tick slower than 1 kHz (an emulated VM): one tick
+ * of 1 ms per SYNC the board sends, so the arm, the scripted hand and the host-side steps
+ * advance with the board's own clock and every tick sees the motion of 1 ms, as on a real
+ * board; while the bus carries no SYNC for longer than SCN_CLOCK_SILENCE_US (bus-off, a
+ * stopped board) the clock follows the wall clock. On a board that holds its 1 kHz both
+ * agree. argil-sim and hil-host keep one each. */
+#ifndef ARGIL_SCN_CLOCK_H
+#define ARGIL_SCN_CLOCK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define SCN_CLOCK_TICK_US 1000u        /* one board tick at the nominal 1 kHz */
+#define SCN_CLOCK_SILENCE_US 400000    /* no SYNC this long: follow the wall clock (longer
+                                          than a stall of the emulated board: 250 ms seen) */
+#define SCN_CLOCK_MAX_STEP_US 20000u   /* longest step taken on the wall clock */
+
+typedef struct {
+    bool ticks;              /* true: SYNC-driven; false: always the wall clock */
+    int64_t now_us;          /* scenario time */
+    int64_t last_wall_us;    /* wall time of the last step (or of the start) */
+    bool silent;             /* following the wall clock until the next SYNC */
+    uint32_t syncs;          /* SYNCs counted */
+    uint32_t wall_steps;     /* steps taken on the wall clock */
+} scn_clock_t;
+
+/* Starts at scenario time 0, wall time wall_us; ticks: SYNC-driven, else wall clock only. */
+void scn_clock_init(scn_clock_t *c, bool ticks, int64_t wall_us);
+
+/* A SYNC seen at wall_us: returns the step (SCN_CLOCK_TICK_US) the clock took, 0 on a
+ * wall-clock-only clock. */
+uint32_t scn_clock_sync(scn_clock_t *c, int64_t wall_us);
+
+/* Nothing (more) on the bus at wall_us: returns the step the clock takes now on the wall clock
+ * (the wall time it has not taken yet, 1..SCN_CLOCK_MAX_STEP_US per call, so a silence is
+ * counted whole, from the last SYNC), or 0 while it waits for the next SYNC (SYNC-driven and
+ * silent for at most SCN_CLOCK_SILENCE_US) or is up to date. */
+uint32_t scn_clock_idle(scn_clock_t *c, int64_t wall_us);
+
+#endif
