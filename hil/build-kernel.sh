@@ -21,7 +21,9 @@ kroot="$out/kroot"   # image + headers debs unpacked here (dpkg-deb -x), never i
 major=${abi%%-*}; major=${major%.*}
 
 # Modules the VM needs (their dependencies are added by modprobe --show-depends).
-MODULES="can-raw vcan configfs dummy_hcd libcomposite usb_f_fs"
+# kvaser_pci: the SJA1000 CAN controllers qemu emulates (two on one emulated bus: can0, can1),
+# real CAN hardware drivers with bit timing, error counters and bus-off.
+MODULES="can-raw vcan configfs dummy_hcd libcomposite usb_f_fs kvaser_pci"
 
 unpack() { # package -> kroot, once
     stamp="$kroot/.unpacked-$1"
@@ -82,12 +84,14 @@ for flav in amd64 rt-amd64; do
     fi
 
     # modules.dep for this tree, then the ordered load list for the VM's init.
-    if [ ! -s "$d/modules.order" ]; then
+    # (made again when the module list changes)
+    if [ ! -s "$d/modules.order" ] || [ "$(cat "$d/modules.want" 2>/dev/null)" != "$MODULES" ]; then
         depmod -b "$kroot" "$kv"
         for m in $MODULES; do modprobe -d "$kroot" -S "$kv" --show-depends "$m"; done >"$d/show-depends"
         # "insmod /abs/path.ko [opts]" in load order; "builtin x" needs nothing.
         awk '$1 == "insmod" && !seen[$2]++ { print $2 }' "$d/show-depends" |
             sed "s|^$kroot/||" >"$d/modules.order"
+        echo "$MODULES" >"$d/modules.want"
         say "modules  $kv: $(wc -l <"$d/modules.order") to load ($(grep -c builtin "$d/show-depends" || true) built in)"
     fi
 

@@ -13,6 +13,8 @@
 #      one vCPU under TCG they starve each other and the scenarios see "host lost"/"drive
 #      heartbeat lost" before sculpting. The bounds are in board ticks, so the two vCPUs
 #      stalling independently does not matter).
+# Besides vcan0 the VM has two emulated Kvaser PCIcan (SJA1000) controllers on one emulated CAN
+# bus: can0 and can1 with the kernel's real controller drivers (check can_controller).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 build=${1:?usage: hil/hil.sh BUILD_DIR [std|rt ...]}
@@ -51,6 +53,7 @@ for rig in $rigs; do
     { timeout "${HIL_TIMEOUT_S:-400}" qemu-system-x86_64 -accel tcg -M q35 -smp "${HIL_SMP:-2}" \
         -m "${HIL_MEM_MB:-256}" -nodefaults -nographic -no-reboot -net none -serial stdio \
         -device isa-debug-exit,iobase=0xf4,iosize=0x04 \
+        -object can-bus,id=canbus0 -device kvaser_pci,canbus=canbus0 -device kvaser_pci,canbus=canbus0 \
         -kernel "$b/$kv/vmlinux" -initrd "$img" \
         -append "console=ttyS0 quiet loglevel=3 panic=-1 noirqdebug argil.rig=$rig" </dev/null 2>&1 || st=$?
       echo "HIL-QEMU-STATUS $st"; } | tr -d '\r' | tee "$run/console.log" |

@@ -45,6 +45,17 @@ for b in $bins; do
         cp -L "$lib" "$r$lib"
     done
 done
+# iproute2's ip as ip-full (busybox's ip stays "ip"): it sets a real CAN controller's bit rate.
+if [ -x /bin/ip ]; then
+    cp /bin/ip "$r/usr/bin/ip-full"
+    ldd /bin/ip | awk '/=> \// { print $3 } /^\t\/[^ ]+ \(/ { print $1 }' | while read -r lib; do
+        [ -e "$r$lib" ] && continue
+        mkdir -p "$r$(dirname "$lib")"
+        cp -L "$lib" "$r$lib"
+    done
+else
+    say "iproute2 not installed: the VM's CAN controllers (can0, can1) stay down"
+fi
 # argil opens libusb with dlopen (no ldd entry): bring it and what it needs.
 if [ -f "$r/usr/bin/argil" ]; then
     usb=$(ldconfig -p | awk '/libusb-1.0.so.0 .*x86-64/ { print $NF; exit }')

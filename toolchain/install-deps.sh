@@ -23,8 +23,9 @@ RENDER_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-
 # make bench: callgrind, and scikit-image's and OpenVDB's marching cubes for comparison.
 BENCH_PKGS="valgrind python3-skimage python3-openvdb"
 # make hil (hil/README.md): qemu boots Debian's kernel; busybox-static, can-utils and gpiod go
-# into its initramfs; cpio packs it, kmod's depmod/modprobe resolve the module closure.
-HIL_PKGS="qemu-system-x86 busybox-static cpio kmod can-utils gpiod xz-utils"
+# into its initramfs; cpio packs it, kmod's depmod/modprobe resolve the module closure;
+# iproute2's ip sets the emulated CAN controllers' bit rate (busybox's ip has no "type can").
+HIL_PKGS="qemu-system-x86 busybox-static cpio kmod can-utils gpiod xz-utils iproute2"
 CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64"
 
 check_only=0
