@@ -459,6 +459,7 @@ int cmd_connect(int argc, char **argv)
     const float half = 0.5f * (float)(CONNECT_GRID_EDGE - 1) * CONNECT_SPACING_M;
     peer_cfg_t pc;
     peer_cfg_default(&pc);
+    pc.adaptive_region = true; /* real time: a slow solve narrows its region, never the board */
     if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
             ARGIL_OK ||
         peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
@@ -668,6 +669,15 @@ int cmd_connect(int argc, char **argv)
                    ? safety_fault_name((fault_code_t)s->peer.stats.last_fault_code)
                    : "",
                s->peer.stats.faults ? ")" : "");
+        {
+            double med = 0, p99 = 0, mx = 0;
+            peer_solve_times_ms(&s->peer, &med, &p99, &mx);
+            printf("  global solve        %u steps, CPU time per step median %.2f ms, 99th "
+                   "percentile %.2f ms, max %.2f ms; region narrowed %u times (margin %d..%d "
+                   "samples)\n",
+                   s->peer.stats.solves, med, p99, mx, s->peer.stats.region_shrinks,
+                   (int)s->peer.stats.margin_min, PEER_MARGIN_MAX);
+        }
         if (s->rtt_samples > 0)
             printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
                    s->rtt_worst_ms, s->rtt_samples);

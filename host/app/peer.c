@@ -15,6 +15,7 @@ void peer_cfg_default(peer_cfg_t *cfg)
     cfg->heartbeat_period_us = 5000u;
     cfg->solve_period_us = 10000u;
     cfg->window_min_period_us = 20000u;
+    cfg->adaptive_region = false;
 }
 
 argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
@@ -30,6 +31,8 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
     p->on_telemetry = on_telemetry;
     p->ctx = ctx;
     p->next_version = 1;
+    p->margin = PEER_MARGIN_MAX;
+    p->stats.margin_min = PEER_MARGIN_MAX;
     p->win_samples = malloc((size_t)cfg->window_edge * cfg->window_edge * cfg->window_edge *
                             sizeof(float));
     if (!p->win_samples)
@@ -301,8 +304,8 @@ static void solve_springs(peer_t *p)
         return;
     peer_box_t box;
     for (int a = 0; a < 3; a++) {
-        box.lo[a] = p->current.corner[a] - 4;
-        box.hi[a] = p->current.corner[a] + p->current.dims[a] + 4;
+        box.lo[a] = p->current.corner[a] - p->margin;
+        box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
     }
     if (p->have_box && memcmp(&box, &p->box, sizeof(box)) != 0)
         remember_settling(p, &p->box);
@@ -378,8 +381,8 @@ static void solve_bspline(peer_t *p)
     if (p->have_current) {
         peer_box_t box;
         for (int a = 0; a < 3; a++) {
-            box.lo[a] = p->current.corner[a] - 4;
-            box.hi[a] = p->current.corner[a] + p->current.dims[a] + 4;
+            box.lo[a] = p->current.corner[a] - p->margin;
+            box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
         }
         p->box = box;
         p->have_box = true;
@@ -398,6 +401,30 @@ static void solve_bspline(peer_t *p)
     clear_forces(p);
 }
 
+/* A solver that falls behind lowers its region, never the board's rate: the margin around the
+ * board's window shrinks while steps overrun their budget and grows back after a run of fast
+ * steps (the board's own window is always solved). */
+void peer_adapt_region(peer_t *p, double step_ms)
+{
+    const double period_ms = (double)p->cfg.solve_period_us * 1e-3;
+    if (step_ms > 0.8 * period_ms) {
+        p->fast_steps = 0;
+        if (p->margin > 0) {
+            p->margin--;
+            p->stats.region_shrinks++;
+            if (p->margin < p->stats.margin_min)
+                p->stats.margin_min = p->margin;
+        }
+    } else if (step_ms < 0.4 * period_ms) {
+        if (++p->fast_steps >= PEER_MARGIN_GROW_STEPS && p->margin < PEER_MARGIN_MAX) {
+            p->margin++;
+            p->fast_steps = 0;
+        }
+    } else {
+        p->fast_steps = 0;
+    }
+}
+
 static void solve(peer_t *p)
 {
     struct timespec t0, t1;
@@ -414,6 +441,8 @@ static void solve(peer_t *p)
                                                                       : PEER_SOLVE_HIST_BINS - 1u]++;
     if (ms > p->stats.solve_max_ms)
         p->stats.solve_max_ms = ms;
+    if (p->cfg.adaptive_region)
+        peer_adapt_region(p, ms);
 }
 
 void peer_tick(peer_t *p, uint32_t dt_us)

@@ -51,7 +51,15 @@ typedef struct {
     uint32_t heartbeat_period_us;     /* 5 ms */
     uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
     uint32_t window_min_period_us;    /* refresh an edited window at most this often */
+    bool adaptive_region;             /* real-time hosts (argil connect): a solve step that takes
+                                       * over 80 % of its period (thread CPU time) shrinks the
+                                       * solve's margin around the board's window by a sample
+                                       * (PEER_MARGIN_MAX → 0); 50 steps under 40 % grow it back.
+                                       * Off for lockstep sessions, which must stay reproducible. */
 } peer_cfg_t;
+
+#define PEER_MARGIN_MAX 4             /* samples of margin around the board's window */
+#define PEER_MARGIN_GROW_STEPS 50u    /* fast steps in a row before the margin grows again */
 
 typedef struct {
     uint32_t frames_rx;
@@ -69,6 +77,8 @@ typedef struct {
     argil_err_t last_solve_error;
     uint32_t solve_hist_10us[PEER_SOLVE_HIST_BINS]; /* thread CPU time of each solve step */
     double solve_max_ms;
+    uint32_t region_shrinks;          /* adaptive_region: times the margin was lowered */
+    int32_t margin_min;               /* the smallest margin used (samples) */
 } peer_stats_t;
 
 typedef struct {
@@ -112,6 +122,9 @@ typedef struct {
     gsolve_t *gs;                     /* the B-spline model (PEER_SOLVE_BSPLINE), else NULL */
     spring_material_t gs_mat;         /* grid material the model last took */
     int32_t force_lo[3], force_hi[3]; /* samples holding external force (lo > hi: none) */
+    int32_t margin;                   /* samples of the solve's margin (PEER_MARGIN_MAX unless
+                                       * adaptive_region lowered it) */
+    uint32_t fast_steps;              /* solve steps in a row under 40 % of the period */
 } peer_t;
 
 void peer_cfg_default(peer_cfg_t *cfg);
@@ -153,5 +166,10 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
 
 /* Median, 99th percentile (10 µs resolution) and max of the solve steps' thread CPU times, ms. */
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max);
+
+/* adaptive_region's rule after a solve step of step_ms (thread CPU time): over 80 % of the
+ * solve period lowers the margin by one sample (not below 0); PEER_MARGIN_GROW_STEPS steps in a
+ * row under 40 % raise it by one (not above PEER_MARGIN_MAX). Called by the peer itself. */
+void peer_adapt_region(peer_t *p, double step_ms);
 
 #endif
