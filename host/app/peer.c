@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "firmware/core/safety.h"
+#include "host/app/histogram.h"
 
 void peer_cfg_default(peer_cfg_t *cfg)
 {
@@ -542,23 +543,10 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
     return e;
 }
 
-static double hist_ms(const uint32_t *hist, double q)
-{
-    uint64_t total = 0, seen = 0;
-    for (uint32_t i = 0; i < PEER_SOLVE_HIST_BINS; i++)
-        total += hist[i];
-    for (uint32_t i = 0; i < PEER_SOLVE_HIST_BINS; i++) {
-        seen += hist[i];
-        if (total > 0 && (double)seen >= q * (double)total)
-            return (double)i * 0.01;
-    }
-    return 0.0;
-}
-
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max)
 {
-    *median = hist_ms(p->stats.solve_hist_10us, 0.5);
-    *p99 = hist_ms(p->stats.solve_hist_10us, 0.99);
+    *median = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.5) * 0.01;
+    *p99 = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.99) * 0.01;
     *max = p->stats.solve_max_ms;
 }
 

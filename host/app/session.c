@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "firmware/core/board_hal.h"
+#include "host/app/histogram.h"
 #include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
@@ -169,20 +170,6 @@ static argil_err_t copy_file(const char *from, const char *to, char *err, size_t
         return ARGIL_ERR_IO;
     }
     return ARGIL_OK;
-}
-
-/* The smallest bin value (µs) at or below which the fraction q of the samples lie. */
-static uint32_t hist_percentile_us(const uint32_t *hist, double q)
-{
-    uint64_t total = 0, seen = 0;
-    for (uint32_t i = 0; i < COMPUTE_HIST_BINS; i++)
-        total += hist[i];
-    for (uint32_t i = 0; i < COMPUTE_HIST_BINS; i++) {
-        seen += hist[i];
-        if (total > 0 && (double)seen >= q * (double)total)
-            return i;
-    }
-    return 0;
 }
 
 static void progress(const session_opts_t *o, double t_s, double total_s)
@@ -480,8 +467,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->deadline_misses = s->board.stats.deadline_misses;
     sum->rt_stats_frames = s->peer.stats.rt_stats_frames;
     sum->rt = s->peer.last_rt;
-    sum->median_compute_ns = hist_percentile_us(s->compute_hist_us, 0.5) * 1000u;
-    sum->p99_compute_ns = hist_percentile_us(s->compute_hist_us, 0.99) * 1000u;
+    sum->median_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.5) * 1000u;
+    sum->p99_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.99) * 1000u;
     sum->peak_force_n = s->board.stats.peak_force_n;
     sum->force_limit_n = s->board.cfg.max_force_n;
     sum->final_state = s->board.safety.state;
