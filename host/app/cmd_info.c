@@ -26,6 +26,46 @@ static int has_ext(const char *p, const char *e)
     return dot != NULL && strcasecmp(dot, e) == 0;
 }
 
+/* One line per painted material channel: how many samples differ from the base material, the
+ * range of their values and the sample box they lie in (docs/files.md, section MTLS). */
+static void print_painted(const grid_t *g)
+{
+    static const char *const names[GRID_MAT_N] = {"stiffness", "mass", "damping", "rest length"};
+    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    bool any = false;
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        const float *m = g->mat[ch];
+        if (m == NULL)
+            continue;
+        const float def = grid_mat_default((grid_mat_t)ch);
+        size_t count = 0;
+        float lo = INFINITY, hi = -INFINITY;
+        int32_t b0[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, b1[3] = {-1, -1, -1};
+        for (size_t i = 0; i < n; i++) {
+            if (memcmp(&m[i], &def, sizeof(float)) == 0)
+                continue;
+            count++;
+            lo = fminf(lo, m[i]);
+            hi = fmaxf(hi, m[i]);
+            const int32_t s[3] = {(int32_t)(i % (size_t)g->dims[0]),
+                                  (int32_t)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
+                                  (int32_t)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]))};
+            for (int a = 0; a < 3; a++) {
+                b0[a] = s[a] < b0[a] ? s[a] : b0[a];
+                b1[a] = s[a] > b1[a] ? s[a] : b1[a];
+            }
+        }
+        if (count == 0)
+            continue;
+        any = true;
+        printf("  painted   %s %s %.6g .. %.6g on %zu samples, box (%d, %d, %d) .. (%d, %d, %d)\n",
+               names[ch], ch == GRID_MAT_RESTLEN ? "offset" : "scale", (double)lo, (double)hi,
+               count, b0[0], b0[1], b0[2], b1[0], b1[1], b1[2]);
+    }
+    if (!any)
+        printf("  painted   nothing (the base material everywhere)\n");
+}
+
 int cmd_info(int argc, char **argv)
 {
     if (argc != 1 || strcmp(argv[0], "-h") == 0 || strcmp(argv[0], "--help") == 0) {
@@ -41,7 +81,7 @@ int cmd_info(int argc, char **argv)
             return 1;
         }
         const grid_t *g = &d.grid;
-        printf("%s: argil model, format version %u\n", path, ARGIL_FILE_VERSION);
+        printf("%s: argil model, format version %u\n", path, d.file_version);
         printf("  grid      %d x %d x %d samples, spacing %.4g mm, origin (%.4g, %.4g, %.4g) mm\n",
                g->dims[0], g->dims[1], g->dims[2], g->spacing_m * 1e3, g->origin_m.x * 1e3,
                g->origin_m.y * 1e3, g->origin_m.z * 1e3);
@@ -50,6 +90,7 @@ int cmd_info(int argc, char **argv)
         printf("  material  mass %g, stiffness %g, coupling %g, damping %g, plastic %g Hz\n",
                g->material.node_mass, g->material.stiffness, g->material.coupling,
                g->material.damping, g->material.plastic_rate_hz);
+        print_painted(g);
         printf("  tool      kind %u, radius %.4g mm, strength %.3g\n", d.tool.tool_kind,
                d.tool.radius_m * 1e3, d.tool.strength);
         if (d.has_rbf)

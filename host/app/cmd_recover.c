@@ -182,6 +182,12 @@ int cmd_recover(int argc, char **argv)
     printf("  base snapshot       %s/%s (checkpoint %u)\n", dir, info.base_name, info.checkpoint);
     printf("  journal records     %u (numbers %u..%u), %llu samples replayed\n", info.records,
            info.first_seq, info.last_seq, (unsigned long long)info.samples);
+    printf("  painted material    %llu values replayed; %s\n",
+           (unsigned long long)info.mat_samples,
+           doc.grid.mat[GRID_MAT_STIFFNESS] || doc.grid.mat[GRID_MAT_MASS] ||
+                   doc.grid.mat[GRID_MAT_DAMPING] || doc.grid.mat[GRID_MAT_RESTLEN]
+               ? "the model holds painted channels"
+               : "the model holds none");
     printf("  model as of         edit %u, %.3f s into the session\n", info.edits,
            info.last_sim_s);
     printf("  last record written %s (unix ms %llu)\n", when,

@@ -50,7 +50,69 @@ static uint64_t get_u64(const uint8_t *p)
 typedef struct {
     const argil_doc_t *d;
     size_t n; /* samples */
+    uint32_t mat_runs[GRID_MAT_N];    /* MTLS runs per painted channel (0: not written) */
+    uint64_t mat_samples[GRID_MAT_N]; /* samples inside those runs */
 } af_wctx_t;
+
+static bool af_same(float a, float b)
+{
+    return memcmp(&a, &b, sizeof(float)) == 0;
+}
+
+/* The next MTLS run of channel m at or after *pos: [start, end) from a painted sample to a
+ * painted sample, bridging at most ARGIL_FILE_RUN_GAP unpainted ones; false when none is left. */
+static bool af_next_run(const float *m, size_t n, float def, size_t *pos, size_t *start,
+                        size_t *end)
+{
+    size_t i = *pos;
+    while (i < n && af_same(m[i], def))
+        i++;
+    if (i >= n) {
+        *pos = n;
+        return false;
+    }
+    *start = i;
+    size_t last = i;
+    for (i = last + 1; i < n && i - last - 1 <= ARGIL_FILE_RUN_GAP; i++)
+        if (!af_same(m[i], def))
+            last = i;
+    *end = last + 1;
+    *pos = last + 1;
+    return true;
+}
+
+uint32_t argil_file_mat_runs(const float *m, size_t n, float def, uint64_t *samples)
+{
+    uint32_t runs = 0;
+    *samples = 0;
+    if (m == NULL)
+        return 0;
+    size_t pos = 0, a, b;
+    while (af_next_run(m, n, def, &pos, &a, &b)) {
+        runs++;
+        *samples += b - a;
+    }
+    return runs;
+}
+
+/* MTLS: channel count, then per painted channel its id, run count and runs (start, count,
+ * count values). */
+static uint64_t af_mtls_bytes(const af_wctx_t *c)
+{
+    uint64_t bytes = 4;
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        if (c->mat_runs[ch] > 0)
+            bytes += 8u + 8u * (uint64_t)c->mat_runs[ch] + 4u * c->mat_samples[ch];
+    return bytes;
+}
+
+static uint32_t af_mtls_channels(const af_wctx_t *c)
+{
+    uint32_t k = 0;
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        k += c->mat_runs[ch] > 0;
+    return k;
+}
 
 typedef struct {
     FILE *f;
@@ -116,7 +178,8 @@ static const char *af_write_body(FILE *f, const void *vctx)
     const argil_doc_t *d = c->d;
     const grid_t *g = &d->grid;
     af_out_t o = {f, 0, 0, false};
-    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0) + (d->has_octree != 0);
+    const bool mtls = af_mtls_channels(c) > 0;
+    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0) + (d->has_octree != 0) + mtls;
     uint64_t total = ARGIL_FILE_HEADER_BYTES + 4;
     total += AF_SEC_OVERHEAD + af_grid_bytes(c->n);
     total += AF_SEC_OVERHEAD + 20 + AF_SEC_OVERHEAD + 16 + AF_SEC_OVERHEAD + 20;
@@ -126,9 +189,11 @@ static const char *af_write_body(FILE *f, const void *vctx)
         total += AF_SEC_OVERHEAD + 28u + 16u * (uint64_t)d->rbf.n;
     if (d->has_octree)
         total += AF_SEC_OVERHEAD + af_octb_bytes(&d->octree);
+    if (mtls)
+        total += AF_SEC_OVERHEAD + af_mtls_bytes(c);
     uint8_t h[ARGIL_FILE_HEADER_BYTES] = {0};
     memcpy(h, AF_MAGIC, 8);
-    io_put_u32le(h + 8, ARGIL_FILE_VERSION);
+    io_put_u32le(h + 8, mtls ? ARGIL_FILE_VERSION_MTLS : 1u);
     io_put_u32le(h + 12, n_sec);
     put_u64(h + 16, total);
     io_put_u32le(h + 28, crc32c(0, h, 28));
@@ -173,6 +238,27 @@ static const char *af_write_body(FILE *f, const void *vctx)
     if (d->rgb != NULL) {
         af_begin(&o, "COLR", 3u * (uint64_t)c->n);
         af_put(&o, d->rgb, 3 * c->n);
+        af_end(&o);
+    }
+    if (mtls) {
+        af_begin(&o, "MTLS", af_mtls_bytes(c));
+        io_put_u32le(b, af_mtls_channels(c));
+        af_put(&o, b, 4);
+        for (int ch = 0; ch < GRID_MAT_N; ch++) {
+            if (c->mat_runs[ch] == 0)
+                continue;
+            io_put_u32le(b, (uint32_t)ch);
+            io_put_u32le(b + 4, c->mat_runs[ch]);
+            af_put(&o, b, 8);
+            const float *mv = g->mat[ch], def = grid_mat_default((grid_mat_t)ch);
+            size_t pos = 0, r0, r1;
+            while (af_next_run(mv, c->n, def, &pos, &r0, &r1)) {
+                io_put_u32le(b, (uint32_t)r0);
+                io_put_u32le(b + 4, (uint32_t)(r1 - r0));
+                af_put(&o, b, 8);
+                af_put_f32s(&o, mv + r0, r1 - r0);
+            }
+        }
         af_end(&o);
     }
     if (d->has_rbf) {
@@ -258,7 +344,20 @@ argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, 
         io_err(err, err_len, "argil_file_write: %s: RBF has too many centres", path);
         return ARGIL_ERR_ARG;
     }
-    const af_wctx_t c = {d, n};
+    af_wctx_t c = {d, n, {0}, {0}};
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        const float *m = g->mat[ch];
+        if (m == NULL)
+            continue;
+        for (size_t i = 0; i < n; i++)
+            if (!grid_mat_valid((grid_mat_t)ch, m[i])) {
+                io_err(err, err_len, "argil_file_write: %s: painted material channel %d holds "
+                       "%g at sample %zu (out of range)", path, ch, (double)m[i], i);
+                return ARGIL_ERR_NONFINITE;
+            }
+        c.mat_runs[ch] = argil_file_mat_runs(m, n, grid_mat_default((grid_mat_t)ch),
+                                             &c.mat_samples[ch]);
+    }
     return io_write_atomic(path, af_write_body, &c, "argil_file_write", err, err_len);
 }
 
@@ -380,6 +479,67 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     return ARGIL_OK;
 }
 
+/* Decodes the MTLS section (len bytes at p, file offset off) into the grid's painted channels
+ * (n samples). Every value is checked before the channel it belongs to is allocated. */
+static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
+                           size_t n, argil_doc_t *d)
+{
+    if (len < 4)
+        return af_fail(c, off, "MTLS section shorter than its 4-byte channel count");
+    const uint32_t k = io_get_u32le(p);
+    if (k < 1 || k > GRID_MAT_N)
+        return af_fail(c, off, "MTLS channel count not in 1..4");
+    uint64_t at = 4;
+    int64_t prev_ch = -1;
+    for (uint32_t i = 0; i < k; i++) {
+        if (len - at < 8)
+            return af_fail(c, off + (size_t)at, "MTLS channel head runs past the section");
+        const uint32_t ch = io_get_u32le(p + at), runs = io_get_u32le(p + at + 4);
+        if (ch >= GRID_MAT_N || (int64_t)ch <= prev_ch)
+            return af_fail(c, off + (size_t)at, "MTLS channel id not 0..3 (stiffness, mass, "
+                                                "damping, rest length) in increasing order");
+        if (runs < 1)
+            return af_fail(c, off + (size_t)at + 4, "MTLS channel with no runs");
+        prev_ch = (int64_t)ch;
+        at += 8;
+        const uint64_t first = at;
+        uint64_t next_start = 0;
+        /* Check the runs... */
+        for (uint32_t r = 0; r < runs; r++) {
+            if (len - at < 8)
+                return af_fail(c, off + (size_t)at, "MTLS run head runs past the section");
+            const uint64_t start = io_get_u32le(p + at), count = io_get_u32le(p + at + 4);
+            if (count < 1 || start < next_start || start + count > (uint64_t)n)
+                return af_fail(c, off + (size_t)at, "MTLS run empty, overlapping or out of order, "
+                                                    "or beyond the grid's samples");
+            if ((len - at - 8) / 4 < count)
+                return af_fail(c, off + (size_t)at, "MTLS run values run past the section");
+            for (uint64_t v = 0; v < count; v++) {
+                const size_t vo = (size_t)(at + 8 + 4 * v);
+                if (!grid_mat_valid((grid_mat_t)ch, io_get_f32le(p + vo)))
+                    return af_fail(c, off + vo, "MTLS value out of range (finite; mass scale > 0, "
+                                                "stiffness and damping scales >= 0)");
+            }
+            next_start = start + count;
+            at += 8 + 4 * count;
+        }
+        /* ... then store them. */
+        float *m = grid_mat_alloc(&d->grid, (grid_mat_t)ch);
+        if (m == NULL) {
+            io_err(c->err, c->err_len, "%s: out of memory", c->path);
+            return ARGIL_ERR_NOMEM;
+        }
+        for (uint64_t q = first, r = 0; r < runs; r++) {
+            const size_t start = io_get_u32le(p + q), count = io_get_u32le(p + q + 4);
+            af_get_f32s(p + q + 8, m + start, count);
+            q += 8 + 4 * (uint64_t)count;
+        }
+    }
+    if (at != len)
+        return af_fail(c, off + (size_t)at, "bytes after the last MTLS channel");
+    return ARGIL_OK;
+}
+
 static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, argil_doc_t *d)
 {
     if (len < ARGIL_FILE_HEADER_BYTES + 4)
@@ -406,9 +566,9 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
     bool seen_grid = false, seen_matl = false, seen_tool = false, seen_stat = false;
     spring_material_t matl;
     spring_material_default(&matl);
-    const uint8_t *colr = NULL;
-    uint64_t colr_len = 0;
-    size_t colr_off = 0;
+    const uint8_t *colr = NULL, *mtls = NULL;
+    uint64_t colr_len = 0, mtls_len = 0;
+    size_t colr_off = 0, mtls_off = 0;
     for (uint32_t s = 0; s < n_sec; s++) {
         const size_t end = len - 4;
         if (end - pos < AF_SEC_OVERHEAD)
@@ -495,6 +655,14 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
                 return af_fail(c, off, "RBF3 holds NaN or Inf");
         } else if (strcmp(tag, "OCTB") == 0) {
             e = af_octb(c, p, sl, pos, off, d);
+        } else if (strcmp(tag, "MTLS") == 0) {
+            if (mtls != NULL)
+                return af_fail(c, pos, "second MTLS section");
+            if (version < ARGIL_FILE_VERSION_MTLS)
+                return af_fail(c, pos, "MTLS section (painted material) in a version-1 file");
+            mtls = p;
+            mtls_len = sl;
+            mtls_off = off;
         }
         /* other tags: a later minor revision's optional data, checked and skipped */
         if (e != ARGIL_OK)
@@ -517,6 +685,12 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
         }
         memcpy(d->rgb, colr, 3 * n);
     }
+    if (mtls != NULL) {
+        const argil_err_t e = af_mtls(c, mtls, mtls_len, mtls_off, n, d);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    d->file_version = version;
     return ARGIL_OK;
 }
 

@@ -14,7 +14,12 @@
 #include "host/model/grid.h"
 #include "shared/argil_err.h"
 
-#define ARGIL_FILE_VERSION 1u
+/* The newest format this argil reads and writes. A file is written as version 1 unless it holds
+ * painted material (section MTLS, version 2), so an older argil still reads an unpainted model
+ * and refuses, rather than silently drops, a painted one. */
+#define ARGIL_FILE_VERSION 2u
+#define ARGIL_FILE_VERSION_MTLS 2u  /* first version with the painted-material section MTLS */
+#define ARGIL_FILE_RUN_GAP 2u       /* unpainted samples bridged inside one MTLS run */
 #define ARGIL_FILE_HEADER_BYTES 32u
 #define ARGIL_FILE_SECTIONS_MAX 64u
 
@@ -32,7 +37,8 @@ typedef struct {
 } argil_state_t;
 
 typedef struct {
-    grid_t grid;            /* densities (rest = density on load), material, iso, band */
+    grid_t grid;            /* densities (rest = density on load), material, iso, band, and
+                             * the painted material channels grid.mat (section MTLS) */
     uint8_t *rgb;           /* 3 per sample, or NULL */
     argil_tool_settings_t tool;
     argil_state_t state;
@@ -40,6 +46,7 @@ typedef struct {
     rbf_model_t rbf;
     bool has_octree;
     octfit_model_t octree; /* Hua & Qin §4 hierarchical fit (section OCTB) */
+    uint32_t file_version; /* the format version argil_file_read found (0: not read) */
 } argil_doc_t;
 
 /* An empty document (no grid allocated), default tool and identity device transform. */
@@ -48,9 +55,15 @@ void argil_doc_init(argil_doc_t *d);
 /* Frees everything the document owns and leaves it as after argil_doc_init. */
 void argil_doc_free(argil_doc_t *d);
 
-/* Writes d to path atomically (path.tmp + fsync + rename). ARGIL_ERR_ARG (no grid, non-finite
- * values), IO / NOMEM with err naming the path and the failing call. */
+/* Writes d to path atomically (path.tmp + fsync + rename). ARGIL_ERR_ARG (no grid),
+ * ARGIL_ERR_NONFINITE (NaN or Inf, or a painted material value out of grid_mat_valid's range),
+ * IO / NOMEM with err naming the path and the failing call. Painted channels are stored as runs
+ * of their painted samples only. */
 argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, size_t err_len);
+
+/* The number of runs channel m (n samples, unpainted value def) is stored as, and the samples
+ * inside them; runs bridge up to ARGIL_FILE_RUN_GAP unpainted samples. 0 runs: nothing painted. */
+uint32_t argil_file_mat_runs(const float *m, size_t n, float def, uint64_t *samples);
 
 /* Reads path into d (initialised by the call; empty on error). ARGIL_ERR_PARSE with err naming
  * the path, the byte offset and the rule broken (magic, version, length, checksum, section,

@@ -1,4 +1,5 @@
-/* Autosave journal: base .argil snapshot + CRC'd records of changed density samples; the writer
+/* Autosave journal: base .argil snapshot + CRC'd records of changed density and painted material
+ * samples; the writer
  * buffers records and makes them durable at a bounded interval, the reader replays them. */
 #define _POSIX_C_SOURCE 200809L
 #include "journal.h"
@@ -102,26 +103,54 @@ static bool write_all(int fd, const uint8_t *p, size_t len)
     return true;
 }
 
-/* The base's identity: CRC-32C of its densities as little-endian binary32. (Not a CRC over the
- * file: a CRC over data followed by its own CRC is a constant, so over an .argil, whose sections
- * each end in their CRC, it would not depend on the sections' contents at all.) */
-static uint32_t density_crc(const float *density, size_t n)
+static uint32_t f32s_crc(uint32_t crc, const float *v, size_t n)
 {
     uint8_t chunk[1024];
-    uint32_t crc = 0;
     size_t i = 0;
     while (i < n) {
         size_t k = 0;
         for (; k < sizeof(chunk) / 4 && i < n; k++, i++)
-            io_put_f32le(chunk + 4 * k, density[i]);
+            io_put_f32le(chunk + 4 * k, v[i]);
         crc = crc32c(crc, chunk, 4 * k);
+    }
+    return crc;
+}
+
+/* True when channel m (n samples) holds any value other than ch's default, bit for bit. */
+static bool mat_painted(const float *m, size_t n, grid_mat_t ch)
+{
+    if (m == NULL)
+        return false;
+    const float def = grid_mat_default(ch);
+    for (size_t i = 0; i < n; i++)
+        if (!same_bits(&m[i], &def, sizeof(float)))
+            return true;
+    return false;
+}
+
+/* The base's identity: CRC-32C of its densities as little-endian binary32, continued over each
+ * painted channel (its id as uint32, then its values); a channel holding only the default counts
+ * as absent, so an unpainted model's CRC is its densities' alone (as in version 1). (Not a CRC
+ * over the file: a CRC over data followed by its own CRC is a constant, so over an .argil, whose
+ * sections each end in their CRC, it would not depend on the sections' contents at all.) */
+static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], size_t n)
+{
+    uint32_t crc = f32s_crc(0, density, n);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        if (!mat_painted(mat[ch], n, (grid_mat_t)ch))
+            continue;
+        uint8_t id[4];
+        io_put_u32le(id, (uint32_t)ch);
+        crc = crc32c(crc, id, 4);
+        crc = f32s_crc(crc, mat[ch], n);
     }
     return crc;
 }
 
 /* ---- the model as a journal holds it ---- */
 
-argil_err_t journal_model_doc(const journal_info_t *info, const float *density, argil_doc_t *doc)
+argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
+                              float *const mat[GRID_MAT_N], argil_doc_t *doc)
 {
     argil_doc_init(doc);
     argil_err_t e = grid_init(&doc->grid, info->dims, info->spacing_m, info->origin_m);
@@ -129,6 +158,14 @@ argil_err_t journal_model_doc(const journal_info_t *info, const float *density, 
         return e;
     const size_t n = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
     memcpy(doc->grid.density, density, n * sizeof(float));
+    for (int ch = 0; mat != NULL && ch < GRID_MAT_N; ch++) {
+        if (mat[ch] == NULL)
+            continue;
+        float *m = grid_mat_alloc(&doc->grid, (grid_mat_t)ch);
+        if (m == NULL)
+            return ARGIL_ERR_NOMEM;
+        memcpy(m, mat[ch], n * sizeof(float));
+    }
     memcpy(doc->grid.rest, density, n * sizeof(float));
     doc->grid.iso = info->iso;
     doc->grid.band_m = info->band_m;
@@ -151,17 +188,20 @@ static void writer_info(const journal_t *j, uint32_t edits, journal_info_t *info
     info->edits = edits;
 }
 
-argil_err_t journal_write_model(const journal_t *j, const float *density, uint32_t edits,
+argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
                                 const char *path, char *err, size_t err_len)
 {
-    if (density == NULL && j->shadow == NULL) {
-        io_err(err, err_len, "%s: the journal holds no model", path);
+    if ((g == NULL && j->shadow == NULL) ||
+        (g != NULL && (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] ||
+                       g->dims[2] != j->dims[2] || g->density == NULL))) {
+        io_err(err, err_len, "%s: the journal holds no model (or not this grid's)", path);
         return ARGIL_ERR_STATE;
     }
     journal_info_t info;
     writer_info(j, edits, &info);
     argil_doc_t doc;
-    argil_err_t e = journal_model_doc(&info, density ? density : j->shadow, &doc);
+    argil_err_t e = g != NULL ? journal_model_doc(&info, g->density, g->mat, &doc)
+                              : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", path);
         argil_doc_free(&doc);
@@ -224,7 +264,8 @@ static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t er
         goto out;
     }
     uint8_t h[JOURNAL_HEADER_BYTES];
-    encode_header(j, base, (uint64_t)st.st_size, density_crc(j->shadow, j->n), edits, h);
+    encode_header(j, base, (uint64_t)st.st_size, model_crc(j->shadow, j->mat_shadow, j->n), edits,
+                  h);
     fd = open(tmp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     e = ARGIL_ERR_IO;
     if (fd < 0) {
@@ -284,6 +325,18 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
         return ARGIL_ERR_NOMEM;
     }
     memcpy(j->shadow, g->density, j->n * sizeof(float));
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        if (g->mat[ch] == NULL)
+            continue;
+        j->mat_shadow[ch] = malloc(j->n * sizeof(float));
+        if (j->mat_shadow[ch] == NULL) {
+            io_err(err, err_len, "%s: out of memory for the journal", dir);
+            journal_close(j);
+            return ARGIL_ERR_NOMEM;
+        }
+        memcpy(j->mat_shadow[ch], g->mat[ch], j->n * sizeof(float));
+    }
+    j->mat_writes = g->mat_writes;
     if (journal_exists(dir)) {
         io_err(err, err_len, "%s holds an unfinished session's journal: run 'argil recover %s' "
                              "or start with --discard-journal", dir, dir);
@@ -330,6 +383,89 @@ static bool put_run(journal_t *j, const float *density, size_t start, size_t end
     memcpy(j->shadow + start, density + start, count * sizeof(float));
     j->buf_len += 8 + 4 * count;
     j->stats.samples += count;
+    return true;
+}
+
+/* Appends the run [start, end) of channel ch (gm: the grid's, NULL = the default everywhere) to
+ * the open record and to the channel's shadow. */
+static bool put_mat_run(journal_t *j, grid_mat_t ch, const float *gm, size_t start, size_t end)
+{
+    const size_t count = end - start;
+    if (!reserve(j, 8 + 4 * count))
+        return false;
+    uint8_t *p = j->buf + j->buf_len;
+    io_put_u32le(p, (uint32_t)start);
+    io_put_u32le(p + 4, (uint32_t)count);
+    const float def = grid_mat_default(ch);
+    float *sh = j->mat_shadow[ch];
+    for (size_t i = 0; i < count; i++) {
+        const float v = gm != NULL ? gm[start + i] : def;
+        io_put_f32le(p + 8 + 4 * i, v);
+        sh[start + i] = v;
+    }
+    j->buf_len += 8 + 4 * count;
+    j->stats.mat_samples += count;
+    return true;
+}
+
+/* Appends channel ch's changes since the last record as one material block (id, runs, runs),
+ * nothing when it did not change. false when out of memory. */
+static bool put_mat_block(journal_t *j, grid_mat_t ch, const float *gm, uint32_t *blocks)
+{
+    if (gm == NULL && j->mat_shadow[ch] == NULL)
+        return true;
+    const float def = grid_mat_default(ch);
+    if (j->mat_shadow[ch] == NULL) {
+        float *sh = malloc(j->n * sizeof(float));
+        if (sh == NULL)
+            return false;
+        for (size_t i = 0; i < j->n; i++)
+            sh[i] = def;
+        j->mat_shadow[ch] = sh;
+    }
+    const float *sh = j->mat_shadow[ch];
+    const size_t at = j->buf_len;
+    if (!reserve(j, 8))
+        return false;
+    j->buf_len += 8;
+    uint32_t runs = 0;
+    bool open_run = false;
+    size_t run_start = 0, run_end = 0;
+    const size_t chunk = 256;
+    for (size_t i0 = 0; i0 < j->n; i0 += chunk) {
+        const size_t i1 = j->n - i0 < chunk ? j->n : i0 + chunk;
+        if (gm != NULL && same_bits(gm + i0, sh + i0, (i1 - i0) * sizeof(float)))
+            continue;
+        for (size_t i = i0; i < i1; i++) {
+            const float v = gm != NULL ? gm[i] : def;
+            if (same_bits(&v, &sh[i], sizeof(float)))
+                continue;
+            if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
+                run_end = i + 1;
+                continue;
+            }
+            if (open_run) {
+                if (!put_mat_run(j, ch, gm, run_start, run_end))
+                    return false;
+                runs++;
+            }
+            open_run = true;
+            run_start = i;
+            run_end = i + 1;
+        }
+    }
+    if (open_run) {
+        if (!put_mat_run(j, ch, gm, run_start, run_end))
+            return false;
+        runs++;
+    }
+    if (runs == 0) {
+        j->buf_len = at;
+        return true;
+    }
+    io_put_u32le(j->buf + at, (uint32_t)ch);
+    io_put_u32le(j->buf + at + 4, runs);
+    (*blocks)++;
     return true;
 }
 
@@ -393,7 +529,23 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
             goto nomem;
         runs++;
     }
-    if (runs == 0 && !material_changed) {
+    /* Painted channels: whole, when they may have changed (record type 2). */
+    uint32_t blocks = 0;
+    if (box == NULL || g->mat_writes != j->mat_writes) {
+        const size_t blocks_at = j->buf_len;
+        if (!reserve(j, 4))
+            goto nomem;
+        j->buf_len += 4;
+        for (int ch = 0; ch < GRID_MAT_N; ch++)
+            if (!put_mat_block(j, (grid_mat_t)ch, g->mat[ch], &blocks))
+                goto nomem;
+        if (blocks == 0)
+            j->buf_len = blocks_at;
+        else
+            io_put_u32le(j->buf + blocks_at, blocks);
+        j->mat_writes = g->mat_writes;
+    }
+    if (runs == 0 && !material_changed && blocks == 0) {
         j->buf_len = rec_at;
         return ARGIL_OK;
     }
@@ -406,7 +558,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
     uint8_t *p = j->buf + rec_at;
     io_put_u32le(p, (uint32_t)payload);
     uint8_t *h = p + 4;
-    io_put_u32le(h, 1u); /* record type: edit step */
+    io_put_u32le(h, blocks > 0 ? 2u : 1u); /* record type: edit step (2: with painted material) */
     io_put_u32le(h + 4, j->seq);
     const double sim_us = sim_s > 0.0 ? sim_s * 1e6 + 0.5 : 0.0;
     put_u64(h + 8, (uint64_t)sim_us);
@@ -431,6 +583,7 @@ nomem:
      * The whole records before this one stay buffered and can still be synced. */
     j->buf_len = rec_at;
     io_err(err, err_len, "%s: out of memory for journal records", j->dir);
+    /* The material shadows may be part-written too. */
     free(j->shadow);
     j->shadow = NULL;
     return ARGIL_ERR_NOMEM;
@@ -504,6 +657,10 @@ void journal_close(journal_t *j)
     free(j->dir);
     free(j->shadow);
     free(j->buf);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        free(j->mat_shadow[ch]);
+        j->mat_shadow[ch] = NULL;
+    }
     j->dir = NULL;
     j->shadow = NULL;
     j->buf = NULL;
@@ -592,8 +749,9 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
     if (io_get_u32le(data + JOURNAL_HEADER_BYTES - 4) !=
         crc32c(0, data, JOURNAL_HEADER_BYTES - 4))
         return fail(err, err_len, name, JOURNAL_HEADER_BYTES - 4, "header checksum mismatch");
-    if (io_get_u32le(data + 8) != JOURNAL_VERSION)
-        return fail(err, err_len, name, 8, "journal version (this argil reads 1..1)");
+    info->version = io_get_u32le(data + 8);
+    if (info->version < 1 || info->version > JOURNAL_VERSION)
+        return fail(err, err_len, name, 8, "journal version (this argil reads 1..2)");
     if (io_get_u32le(data + 12) != JOURNAL_HEADER_BYTES)
         return fail(err, err_len, name, 12, "header size");
     int64_t n = 1;
@@ -641,10 +799,103 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
     return ARGIL_OK;
 }
 
-/* Checks one record's payload (CRC already good) and, with density, applies it. */
+/* Checks the painted-material blocks of a type-2 record (from payload offset *off) against n
+ * samples; advances *off past them and adds their values to *samples. */
+static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *off, size_t at,
+                                    const char *name, size_t n, uint32_t rec, uint64_t *samples,
+                                    char *err, size_t err_len)
+{
+    char why[200];
+    size_t o = *off;
+    if (payload - o < 4) {
+        snprintf(why, sizeof(why), "record %u: material block count runs past the record", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    const uint32_t blocks = io_get_u32le(p + o);
+    if (blocks < 1 || blocks > GRID_MAT_N) {
+        snprintf(why, sizeof(why), "record %u: material block count %u not in 1..4", rec, blocks);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    o += 4;
+    int64_t prev = -1;
+    for (uint32_t k = 0; k < blocks; k++) {
+        if (payload - o < 8) {
+            snprintf(why, sizeof(why), "record %u: material block %u head runs past the record",
+                     rec, k);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        if (ch >= GRID_MAT_N || (int64_t)ch <= prev || runs < 1) {
+            snprintf(why, sizeof(why), "record %u: material block %u: channel %u not 0..3 in "
+                     "increasing order, or no runs", rec, k, ch);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        prev = (int64_t)ch;
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++) {
+            if (payload - o < 8) {
+                snprintf(why, sizeof(why), "record %u: material run %u head runs past the record",
+                         rec, r);
+                return fail(err, err_len, name, at + 4 + o, why);
+            }
+            const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            if (count == 0 || start + count > (uint64_t)n || count > (payload - o - 8) / 4) {
+                snprintf(why, sizeof(why), "record %u: material run %u (%llu samples from %llu) "
+                         "empty, beyond the grid or past the record", rec, r,
+                         (unsigned long long)count, (unsigned long long)start);
+                return fail(err, err_len, name, at + 4 + o, why);
+            }
+            for (uint64_t i = 0; i < count; i++)
+                if (!grid_mat_valid((grid_mat_t)ch, io_get_f32le(p + o + 8 + 4 * i))) {
+                    snprintf(why, sizeof(why), "record %u: painted material value out of range "
+                             "(finite; mass scale > 0, stiffness and damping scales >= 0)", rec);
+                    return fail(err, err_len, name, at + 4 + o + 8 + 4 * (size_t)i, why);
+                }
+            o += 8 + 4 * (size_t)count;
+            *samples += count;
+        }
+    }
+    *off = o;
+    return ARGIL_OK;
+}
+
+/* Applies the checked material blocks at payload offset off to g's channels. */
+static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, const char *name,
+                                    char *err, size_t err_len)
+{
+    const uint32_t blocks = io_get_u32le(p + off);
+    size_t o = off + 4;
+    /* Every channel the record touches exists before anything is written. */
+    for (uint32_t k = 0; k < blocks; k++) {
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
+            io_err(err, err_len, "%s: out of memory for a painted material channel", name);
+            return ARGIL_ERR_NOMEM;
+        }
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++)
+            o += 8 + 4 * (size_t)io_get_u32le(p + o + 4);
+    }
+    o = off + 4;
+    for (uint32_t k = 0; k < blocks; k++) {
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        float *m = g->mat[ch];
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++) {
+            const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            for (size_t i = 0; i < count; i++)
+                m[start + i] = io_get_f32le(p + o + 8 + 4 * i);
+            o += 8 + 4 * count;
+        }
+    }
+    g->mat_writes++;
+    return ARGIL_OK;
+}
+
+/* Checks one record's payload (CRC already good) and, with density (and g), applies it. */
 static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, const char *name,
-                                float *density, size_t n, journal_info_t *info, char *err,
-                                size_t err_len)
+                                float *density, grid_t *g, size_t n, journal_info_t *info,
+                                char *err, size_t err_len)
 {
     char why[160];
     const uint32_t rec = info->records + 1u;
@@ -652,8 +903,9 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: shorter than a record head", rec);
         return fail(err, err_len, name, at, why);
     }
-    if (io_get_u32le(p) != 1u) {
-        snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, io_get_u32le(p));
+    const uint32_t type = io_get_u32le(p);
+    if (type != 1u && (type != 2u || info->version < 2u)) {
+        snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, type);
         return fail(err, err_len, name, at + 4, why);
     }
     const uint32_t seq = io_get_u32le(p + 4);
@@ -671,7 +923,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     const uint32_t runs = io_get_u32le(p + 48);
     /* Check every run before changing anything. */
     size_t off = JOURNAL_RECORD_HEAD_BYTES;
-    uint64_t samples = 0;
+    uint64_t samples = 0, mat_samples = 0;
     for (uint32_t r = 0; r < runs; r++) {
         if (payload - off < 8) {
             snprintf(why, sizeof(why), "record %u: run %u head runs past the record", rec, r);
@@ -696,9 +948,21 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         off += 8 + 4 * (size_t)count;
         samples += count;
     }
+    const size_t mat_off = off;
+    if (type == 2u) {
+        const argil_err_t e = check_mat_blocks(p, payload, &off, at, name, n, rec, &mat_samples,
+                                               err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
     if (off != payload) {
         snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
         return fail(err, err_len, name, at + 4 + off, why);
+    }
+    if (type == 2u && g != NULL) {
+        const argil_err_t e = apply_mat_blocks(p, mat_off, g, name, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
     }
     if (density != NULL) {
         off = JOURNAL_RECORD_HEAD_BYTES;
@@ -716,11 +980,13 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     info->edits = io_get_u32le(p + 24);
     info->material = m;
     info->samples += samples;
+    info->mat_samples += mat_samples;
     return ARGIL_OK;
 }
 
-argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
-                           size_t n, journal_info_t *info, char *err, size_t err_len)
+/* journal_replay with an optional grid for the painted channels (density = g's then). */
+static argil_err_t replay(const uint8_t *data, size_t len, const char *name, float *density,
+                          size_t n, grid_t *g, journal_info_t *info, char *err, size_t err_len)
 {
     argil_err_t e = journal_header_decode(data, len, name, info, err, err_len);
     if (e != ARGIL_OK)
@@ -754,7 +1020,7 @@ argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, fl
                      info->records + 1u);
             return fail(err, err_len, name, at, why);
         }
-        e = apply_record(data + at + 4, (size_t)payload, at, name, density, want, info, err,
+        e = apply_record(data + at + 4, (size_t)payload, at, name, density, g, want, info, err,
                          err_len);
         if (e != ARGIL_OK)
             return e;
@@ -762,6 +1028,19 @@ argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, fl
         info->good_bytes = at;
     }
     return ARGIL_OK;
+}
+
+argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
+                           size_t n, journal_info_t *info, char *err, size_t err_len)
+{
+    return replay(data, len, name, density, n, NULL, info, err, err_len);
+}
+
+argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
+                                journal_info_t *info, char *err, size_t err_len)
+{
+    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    return replay(data, len, name, g->density, n, g, info, err, err_len);
 }
 
 static argil_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
@@ -822,13 +1101,13 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     const size_t bn = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    const uint32_t crc = density_crc(g->density, bn);
+    const uint32_t crc = model_crc(g->density, g->mat, bn);
     if (blen != info->base_len || crc != info->base_crc ||
         !same_bits(&g->material, &info->material, sizeof(g->material)) ||
         b.state.edits != info->edits) {
         io_err(err, err_len,
                "%s: the base snapshot %s is not the one this journal continues (%llu bytes, "
-               "density CRC %08x; the journal expects %llu bytes, CRC %08x, and its material "
+               "model CRC %08x; the journal expects %llu bytes, CRC %08x, and its material "
                "and edit count): refusing to replay onto it",
                path, base_path, (unsigned long long)blen, crc, (unsigned long long)info->base_len,
                info->base_crc);
@@ -844,11 +1123,11 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
-    e = journal_replay(data, len, path, b.grid.density, bn, info, err, err_len);
+    e = journal_replay_grid(data, len, path, &b.grid, info, err, err_len);
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         goto out;
-    /* After a bad record (PARSE) the density holds the model as of the record before it. */
-    const argil_err_t me = journal_model_doc(info, b.grid.density, doc);
+    /* After a bad record (PARSE) the grid holds the model as of the record before it. */
+    const argil_err_t me = journal_model_doc(info, b.grid.density, b.grid.mat, doc);
     if (me != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the recovered model", path);
         e = me;

@@ -1,5 +1,6 @@
 /* The autosave journal of a sculpting session: every applied edit step is appended as the
- * density samples it changed (sparse runs of new values, CRC-32C per record) on top of a base
+ * density samples it changed (sparse runs of new values, CRC-32C per record), and the painted
+ * material samples it changed (grid_t.mat, record type 2), on top of a base
  * .argil snapshot; records are written and fdatasync'ed at a bounded interval, and the journal
  * is rotated onto a new snapshot at checkpoints. After a crash the model is rebuilt bit for bit
  * as of the last whole record. Layout byte by byte: docs/files.md. */
@@ -14,7 +15,8 @@
 #include "host/model/grid.h"
 #include "shared/argil_err.h"
 
-#define JOURNAL_VERSION 1u
+#define JOURNAL_VERSION 2u                 /* 2: record type 2 carries painted material; the
+                                            * base CRC covers the painted channels */
 #define JOURNAL_HEADER_BYTES 160u
 #define JOURNAL_RECORD_HEAD_BYTES 52u      /* payload bytes before the runs */
 #define JOURNAL_BASE_NAME_MAX 60u          /* bytes for the base file's name in the header */
@@ -34,6 +36,7 @@ typedef struct {
     uint32_t syncs;           /* write + fdatasync rounds */
     uint32_t checkpoints;     /* rotations onto a new base */
     uint64_t samples;         /* sample values journaled */
+    uint64_t mat_samples;     /* painted material values journaled */
 } journal_stats_t;
 
 /* The open journal of a running session (writer side). */
@@ -46,6 +49,9 @@ typedef struct {
     vec3_t origin_m;
     size_t n;                 /* samples */
     float *shadow;            /* density as of the last record */
+    float *mat_shadow[GRID_MAT_N]; /* painted channels as of the last record (NULL: never
+                               * painted, all grid_mat_default) */
+    uint32_t mat_writes;      /* the grid's mat_writes when its channels were last compared */
     spring_material_t material; /* as of the last record */
     uint8_t *buf;             /* records not yet written to the file */
     size_t buf_len, buf_cap;
@@ -60,6 +66,7 @@ typedef struct {
 
 /* What a journal holds, as far as its records are whole and valid. */
 typedef struct {
+    uint32_t version;         /* of the journal file */
     uint32_t checkpoint;
     uint32_t first_seq;       /* seq the first record must carry */
     uint32_t records;         /* good records */
@@ -69,6 +76,7 @@ typedef struct {
     uint32_t edits;           /* edit steps since the session began, as of the last record */
     spring_material_t material; /* as of the last record (the base's when there is none) */
     uint64_t samples;         /* sample values replayed */
+    uint64_t mat_samples;     /* painted material values replayed */
     size_t good_bytes;        /* header + good records */
     size_t torn_bytes;        /* an incomplete last record, ignored */
     char base_name[JOURNAL_BASE_NAME_MAX + 1];
@@ -92,10 +100,11 @@ typedef struct {
     int32_t lo[3], hi[3];
 } journal_box_t;
 
-/* Appends one record when the grid's densities or material differ from the last record
- * (buffered; *appended says whether one was made). Only samples inside box are compared when
- * box is not NULL: the caller promises nothing changed outside it. edits counts the session's
- * edit steps. */
+/* Appends one record when the grid's densities, material or painted channels differ from the
+ * last record (buffered; *appended says whether one was made). Only densities inside box are
+ * compared when box is not NULL: the caller promises nothing changed outside it; the painted
+ * channels are compared whole when box is NULL or the grid's mat_writes moved. edits counts the
+ * session's edit steps. */
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len);
@@ -114,10 +123,10 @@ argil_err_t journal_sync(journal_t *j, char *err, size_t err_len);
  * the old journal stays valid until the new one has replaced it by rename. */
 argil_err_t journal_checkpoint(journal_t *j, double sim_s, char *err, size_t err_len);
 
-/* Writes density (the journal's grid; NULL: the journal's copy as of the last record) with the
- * material of the last record and edits to path as .argil, in exactly the form argil recover
- * writes, so a model and its recovery compare byte for byte. */
-argil_err_t journal_write_model(const journal_t *j, const float *density, uint32_t edits,
+/* Writes g's densities and painted channels (g: the journal's grid; NULL: the journal's copy as
+ * of the last record) with the material of the last record and edits to path as .argil, in
+ * exactly the form argil recover writes, so a model and its recovery compare byte for byte. */
+argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
                                 const char *path, char *err, size_t err_len);
 
 /* Releases the journal and keeps its files (the session did not end cleanly). */
@@ -137,12 +146,18 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
                                   journal_info_t *info, char *err, size_t err_len);
 
 /* Walks the records after the header; with density (n samples, matching the header's dims)
- * applies each good record to it. An incomplete last record (a write cut short by a crash) is
- * ignored and counted in torn_bytes. A bad record before the end stops the walk: density holds
- * the model as of the record before it, info describes the good part, and the result is
- * ARGIL_ERR_PARSE with err naming the byte, the record and the rule. */
+ * applies each good record's densities to it (painted material is checked, not applied). An
+ * incomplete last record (a write cut short by a crash) is ignored and counted in torn_bytes. A
+ * bad record before the end stops the walk: density holds the model as of the record before it,
+ * info describes the good part, and the result is ARGIL_ERR_PARSE with err naming the byte, the
+ * record and the rule. */
 argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
                            size_t n, journal_info_t *info, char *err, size_t err_len);
+
+/* journal_replay onto a whole grid (dims matching the header's): densities and painted
+ * channels (allocated as records need them); ARGIL_ERR_NOMEM when a channel cannot be. */
+argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
+                                journal_info_t *info, char *err, size_t err_len);
 
 /* Reads dir's journal without its base: counts the good records (for the offer to recover). */
 argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len);
@@ -153,8 +168,10 @@ argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size
 argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
                             size_t err_len);
 
-/* Fills doc (initialised here, owning a copy of density) with the model as a journal holds it:
- * the grid geometry, material and edits from info. ARGIL_ERR_NOMEM / ARG. */
-argil_err_t journal_model_doc(const journal_info_t *info, const float *density, argil_doc_t *doc);
+/* Fills doc (initialised here, owning copies of density and of the painted channels in mat,
+ * which may be NULL or hold NULLs) with the model as a journal holds it: the grid geometry,
+ * material and edits from info. ARGIL_ERR_NOMEM / ARG. */
+argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
+                              float *const mat[GRID_MAT_N], argil_doc_t *doc);
 
 #endif

@@ -77,7 +77,69 @@ void grid_free(grid_t *g)
     free(g->velocity);
     free(g->force);
     g->density = g->rest = g->velocity = g->force = NULL;
+    for (int c = 0; c < GRID_MAT_N; c++) {
+        free(g->mat[c]);
+        g->mat[c] = NULL;
+    }
     g->dims[0] = g->dims[1] = g->dims[2] = 0;
+}
+
+static size_t grid_count(const grid_t *g)
+{
+    return (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+}
+
+float grid_mat_default(grid_mat_t ch)
+{
+    return ch == GRID_MAT_RESTLEN ? 0.0f : 1.0f;
+}
+
+bool grid_mat_valid(grid_mat_t ch, float v)
+{
+    if (!isfinite(v) || (unsigned)ch >= GRID_MAT_N)
+        return false;
+    if (ch == GRID_MAT_MASS)
+        return v > 0.0f;
+    return ch == GRID_MAT_RESTLEN || v >= 0.0f;
+}
+
+float grid_mat_value(const grid_t *g, grid_mat_t ch, size_t i)
+{
+    return g->mat[ch] != NULL ? g->mat[ch][i] : grid_mat_default(ch);
+}
+
+float *grid_mat_alloc(grid_t *g, grid_mat_t ch)
+{
+    if ((unsigned)ch >= GRID_MAT_N || g->density == NULL)
+        return NULL;
+    if (g->mat[ch] != NULL)
+        return g->mat[ch];
+    const size_t n = grid_count(g);
+    float *m = malloc(n * sizeof(float));
+    if (m == NULL)
+        return NULL;
+    const float def = grid_mat_default(ch);
+    for (size_t i = 0; i < n; i++)
+        m[i] = def;
+    g->mat[ch] = m;
+    return m;
+}
+
+bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)
+{
+    const size_t n = grid_count(a);
+    if (n != grid_count(b))
+        return false;
+    if (a->mat[ch] != NULL && b->mat[ch] != NULL)
+        return memcmp(a->mat[ch], b->mat[ch], n * sizeof(float)) == 0;
+    const float *m = a->mat[ch] != NULL ? a->mat[ch] : b->mat[ch];
+    if (m == NULL)
+        return true;
+    const float def = grid_mat_default(ch);
+    for (size_t i = 0; i < n; i++)
+        if (memcmp(&m[i], &def, sizeof(float)) != 0)
+            return false;
+    return true;
 }
 
 spring_field_t grid_springs(grid_t *g)

@@ -4,6 +4,7 @@
 #define ARGIL_GRID_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "shared/argil_err.h"
@@ -13,6 +14,18 @@
 /* Largest number of samples a grid may hold (indices stay within int32). */
 #define GRID_SAMPLES_MAX ((int64_t)1 << 30)
 
+/* Painted material channels (Hua & Qin §6.3), the sampled view of the B-spline model's
+ * FS_STIFF, FS_MASS, FS_DAMP and FS_RESTLEN: scales of the base material (1 = unpainted) and
+ * the rest-length offset (density units, 0 = none). The numbers are the file formats' channel
+ * ids (docs/files.md): never reorder them. */
+typedef enum {
+    GRID_MAT_STIFFNESS = 0,
+    GRID_MAT_MASS = 1,
+    GRID_MAT_DAMPING = 2,
+    GRID_MAT_RESTLEN = 3,
+    GRID_MAT_N = 4
+} grid_mat_t;
+
 typedef struct {
     int32_t dims[3];            /* samples per axis; index = x + dims0*(y + dims1*z) */
     float spacing_m;            /* distance between neighbouring samples */
@@ -21,6 +34,9 @@ typedef struct {
     float band_m;               /* half-width of the density ramp across the surface */
     spring_material_t material;
     float *density, *rest, *velocity, *force;
+    float *mat[GRID_MAT_N];     /* painted channels, one value per sample; NULL until first
+                                 * painted (every sample then holds grid_mat_default) */
+    uint32_t mat_writes;        /* +1 whenever a mat channel changes (the journal then looks) */
 } grid_t;
 
 /* Allocates a grid with all densities 0, iso 0.5, band 4 spacings, the default material.
@@ -30,6 +46,24 @@ argil_err_t grid_init(grid_t *g, const int32_t dims[3], float spacing_m, vec3_t 
 
 /* Releases the arrays; g may then be initialised again. */
 void grid_free(grid_t *g);
+
+/* The value an unpainted sample holds in channel ch: 1 (scales) or 0 (rest-length offset). */
+float grid_mat_default(grid_mat_t ch);
+
+/* True when v may be stored in channel ch: finite; mass scale > 0, stiffness and damping
+ * scales >= 0 (what host/model/material.c keeps them to). */
+bool grid_mat_valid(grid_mat_t ch, float v);
+
+/* Channel ch of sample i (the default when ch is not painted). */
+float grid_mat_value(const grid_t *g, grid_mat_t ch, size_t i);
+
+/* Makes channel ch present (every sample the default when newly allocated) and returns it;
+ * NULL when out of memory or ch is out of range. */
+float *grid_mat_alloc(grid_t *g, grid_mat_t ch);
+
+/* True when the two grids' samples hold the same bits in channel ch (an absent channel reads
+ * as the default everywhere); false when their sample counts differ. */
+bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch);
 
 /* A spring_field_t view onto the grid's own arrays (no copy). */
 spring_field_t grid_springs(grid_t *g);

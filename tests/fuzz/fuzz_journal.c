@@ -1,6 +1,8 @@
 /* libFuzzer target for the autosave-journal reader: any bytes either replay or stop with one line
  * naming the journal and the byte; scanning and replaying agree; replay never writes outside the
- * grid nor leaves a density outside [0, 1]. Every record carries a CRC-32C, so the input is read
+ * grid nor leaves a density outside [0, 1] or a painted material value grid_mat_valid refuses
+ * (replayed onto a whole grid too, so type-2 records reach the channels). Every record carries a
+ * CRC-32C, so the input is read
  * as it is, then once more with the header and record checksums recomputed, which lets mutated
  * records reach the decoder. */
 #include <math.h>
@@ -51,6 +53,24 @@ static void check_one(const uint8_t *data, size_t size)
         if (!isfinite(density[i]) || density[i] < 0.0f || density[i] > 1.0f)
             abort();
     free(density);
+    /* Onto a whole grid: the same verdict, densities and channels stay valid. */
+    grid_t g;
+    if (grid_init(&g, scan.dims, 0.001f, vec3(0, 0, 0)) != ARGIL_OK)
+        return;
+    for (size_t i = 0; i < n; i++)
+        g.density[i] = 0.5f;
+    journal_info_t grid_play;
+    char err3[512] = "";
+    const argil_err_t e3 = journal_replay_grid(data, size, name, &g, &grid_play, err3,
+                                               sizeof(err3));
+    if (e3 != e || grid_play.records != scan.records || grid_play.mat_samples != scan.mat_samples ||
+        strcmp(err, err3) != 0)
+        abort();
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        for (size_t i = 0; g.mat[ch] != NULL && i < n; i++)
+            if (!grid_mat_valid((grid_mat_t)ch, g.mat[ch][i]))
+                abort();
+    grid_free(&g);
 }
 
 /* Recomputes the header CRC and every whole record's CRC; true when anything changed. */

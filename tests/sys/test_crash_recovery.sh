@@ -2,7 +2,9 @@
 # Crash safety: a scripted session killed with SIGKILL in the middle, then `argil recover`. The
 # recovered model must be byte for byte the model at the last journal record (a deterministic
 # rerun of the same script dumps the model at that record), the work lost must be within the
-# autosave interval, and the next start must offer the recovery instead of overwriting it.
+# autosave interval, and the next start must offer the recovery instead of overwriting it. The
+# script paints the clay (stiffness 4x, mass 0.5x) before the kill: the painted material is part
+# of the model, so it is recovered as of the last record too.
 set -eu
 bin="$REL/argil"
 tmp=$(mktemp -d)
@@ -30,6 +32,12 @@ expect 2 "--autosave-s needs seconds" sculpt --autosave-s 0
 expect 2 "--checkpoint-s needs seconds" sculpt --checkpoint-s x
 "$bin" --help | grep -q "recover" || fail "argil --help does not list 'recover'"
 
+# The default session with two paints where the stylus first touches the clay (~1 s in).
+script="$tmp/paint.scn"
+sed 's/^move 0 0 32 0.4$/&\npaint stiffness 4 radius 10\npaint mass 0.5 radius 8/' \
+    scripts/default.scn >"$script"
+[ "$(grep -c '^paint ' "$script")" = 2 ] || fail "could not add the paints to the script"
+
 # 1. Sculpt with a checkpoint every 1.5 simulated seconds, and kill -9 once the journal has been
 #    rotated twice and holds records after that. A kill that lands right after a rotation leaves
 #    a journal with no records (recovery gives the base); that case is tried again, up to 3 times.
@@ -37,7 +45,7 @@ attempt=0
 while :; do
     attempt=$((attempt + 1))
     rm -rf "$tmp/s" "$tmp/s2"
-    "$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/s" --quiet \
+    "$bin" sculpt --device sim --script "$script" --out "$tmp/s" --quiet \
         --autosave-s "$autosave_s" --checkpoint-s 1.5 &
     pid=$!
     polls=0
@@ -72,7 +80,7 @@ cp -r "$tmp/s" "$tmp/s2"
 # 2. The next start in that directory offers recovery (stdin is not a tty: no prompt) and leaves
 #    the journal alone.
 status=0
-"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/s" --quiet \
+"$bin" sculpt --device sim --script "$script" --out "$tmp/s" --quiet \
     </dev/null 2>"$tmp/offer" || status=$?
 cat "$tmp/offer"
 [ "$status" = 1 ] || fail "a start over an unfinished session exited $status, not 1"
@@ -97,15 +105,30 @@ grep -Eq "base snapshot .*journal-base-([2-9]|[1-9][0-9]+)\.argil \(checkpoint" 
 [ "$count" -ge 5 ] || fail "only $count records after the last checkpoint"
 [ -s "$tmp/rec.argil" ] && [ -s "$tmp/rec.ply" ] || fail "recover wrote no model or no mesh"
 [ -e "$tmp/s/journal.log" ] && fail "recover kept the journal"
-"$bin" info "$tmp/rec.argil" >/dev/null || fail "the recovered model does not read back"
+"$bin" info "$tmp/rec.argil" >"$tmp/rec.info" || fail "the recovered model does not read back"
+cat "$tmp/rec.info"
+# The paint came before the rotations: it is in the base, and the recovered model holds it.
+grep -q "format version 2" "$tmp/rec.info" || fail "the recovered model holds no painted material"
+stiff=$(sed -n 's/.*painted   stiffness scale [0-9.]* \.\. \([0-9.]*\) on \([0-9]*\) samples.*/\1 \2/p' "$tmp/rec.info")
+mass=$(sed -n 's/.*painted   mass scale \([0-9.]*\) \.\. [0-9.]* on \([0-9]*\) samples.*/\1 \2/p' "$tmp/rec.info")
+[ -n "$stiff" ] && [ -n "$mass" ] || fail "argil info shows no painted stiffness and mass"
+echo "recovered paint: stiffness max and samples: $stiff; mass min and samples: $mass"
+# 4x near the tip (>= 3.6 with the tip up to 1.08 mm from a sample), over a 10 mm ball (~2145
+# samples); 0.5x likewise (<= 0.57), over an 8 mm ball (~1098 samples).
+echo "$stiff $mass" | awk '{ exit !($1 >= 3.6 && $1 <= 4 && $2 > 1800 && $2 < 2500 &&
+                                    $3 >= 0.5 && $3 <= 0.57 && $4 > 900 && $4 < 1300) }' ||
+    fail "the recovered paint is not the painted 4x stiffness and 0.5x mass"
 
 # 4. The reference: the same script, replayed deterministically, dumps the model at record $last.
-"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/ref" --quiet \
+"$bin" sculpt --device sim --script "$script" --out "$tmp/ref" --quiet \
     --debug-journal-dump "$last" "$tmp/ref.argil"
 cmp "$tmp/ref.argil" "$tmp/rec.argil" || fail "the recovered model differs from the model at record $last"
+"$bin" info "$tmp/ref.argil" | grep "painted" >"$tmp/ref.paint"
+grep "painted" "$tmp/rec.info" | cmp -s - "$tmp/ref.paint" ||
+    fail "the recovered paint differs from the paint at record $last"
 echo "recovered model = model at journal record $last, byte for byte ($(stat -c %s "$tmp/rec.argil") bytes)"
 # ... and the comparison can tell records apart: the model one record earlier differs.
-"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/ref2" --quiet \
+"$bin" sculpt --device sim --script "$script" --out "$tmp/ref2" --quiet \
     --debug-journal-dump "$((last - 1))" "$tmp/ref_prev.argil"
 cmp -s "$tmp/ref_prev.argil" "$tmp/rec.argil" && fail "records $((last - 1)) and $last give the same model"
 
@@ -117,8 +140,40 @@ echo "work at risk: ${at_risk_ms} ms (autosave interval ${autosave_s} s)"
 limit_ms=$(awk -v a="$autosave_s" 'BEGIN { print int(a * 1000 + 100) }')
 [ "$at_risk_ms" -le "$limit_ms" ] || fail "${at_risk_ms} ms of work lost, more than ${limit_ms} ms"
 
-# 6. --discard-journal starts over, and a clean end leaves no journal behind.
-"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/s2" --quiet \
+# 6. Paint journaled, not only in a base: no rotation (--checkpoint-s 3600), killed once the
+#    journal holds 2 MB (the paints, ~1.6 s into the session, are in its records by 1.4 MB):
+#    recovery replays them (record type 2) and equals the model at the last record, paint and all.
+rm -rf "$tmp/p"
+"$bin" sculpt --device sim --script "$script" --out "$tmp/p" --quiet --autosave-s "$autosave_s" \
+    --checkpoint-s 3600 &
+pid=$!
+polls=0
+while [ "$(stat -c %s "$tmp/p/journal.log" 2>/dev/null || echo 0)" -lt 2000000 ]; do
+    kill -0 "$pid" 2>/dev/null || fail "the session ended before its journal held 2 MB"
+    polls=$((polls + 1))
+    [ "$polls" -lt 6000 ] || fail "the journal did not reach 2 MB in 60 s"
+    sleep 0.01
+done
+kill -9 "$pid"
+wait "$pid" || true
+pid=
+[ -e "$tmp/p/journal-base-1.argil" ] && fail "the journal was rotated despite --checkpoint-s 3600"
+"$bin" recover "$tmp/p" -o "$tmp/prec.argil" >"$tmp/prec.txt" || { cat "$tmp/prec.txt"; fail "recover (paint) failed"; }
+cat "$tmp/prec.txt"
+painted=$(sed -n 's/.*painted material *\([0-9]*\) values replayed.*/\1/p' "$tmp/prec.txt")
+plast=$(sed -n 's/.*journal records *[0-9]* (numbers [0-9]*\.\.\([0-9]*\)).*/\1/p' "$tmp/prec.txt")
+[ -n "$painted" ] && [ -n "$plast" ] || fail "cannot read the paint recovery summary"
+# 2154 stiffness + 1088 mass samples painted (10 mm and 8 mm balls at 1.25 mm spacing).
+[ "$painted" -gt 3000 ] && [ "$painted" -lt 4000 ] ||
+    fail "$painted painted values replayed, expected the ~3240 the two paints set"
+"$bin" sculpt --device sim --script "$script" --out "$tmp/pref" --quiet \
+    --debug-journal-dump "$plast" "$tmp/pref.argil"
+cmp "$tmp/pref.argil" "$tmp/prec.argil" ||
+    fail "the recovered painted model differs from the model at record $plast"
+echo "painted model recovered from the journal's records = model at record $plast ($painted painted values)"
+
+# 7. --discard-journal starts over, and a clean end leaves no journal behind.
+"$bin" sculpt --device sim --script "$script" --out "$tmp/s2" --quiet \
     --discard-journal </dev/null 2>"$tmp/discard" || { cat "$tmp/discard"; fail "--discard-journal"; }
 grep -q "discarded" "$tmp/discard" || fail "no word about the discarded journal"
 [ -s "$tmp/s2/final.ply" ] || fail "the new session wrote no final.ply"

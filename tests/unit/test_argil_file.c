@@ -256,8 +256,8 @@ static void test_each_rule(void **state)
     f.b[20] = 1;
     test_spit(p, f.b, f.len + 4);
     expect_rule(p, "byte 28", "header checksum mismatch");
-    b_end(&f, p, 2);
-    expect_rule(p, "byte 8", "format version 2; this argil reads 1..1");
+    b_end(&f, p, 3);
+    expect_rule(p, "byte 8", "format version 3; this argil reads 1..2");
     f.n_sec = 0;
     b_end(&f, p, 1);
     expect_rule(p, "byte 12", "section count not in 1..64");
@@ -488,6 +488,242 @@ static void test_octb(void **state)
     expect_rule(p, "byte 1016", "OCTB section repeated");
 }
 
+
+/* Paints channels of d's 6x5x4 grid: stiffness 4x and mass 0.5x on a few samples with a gap
+ * (bridged into one run) and a far one (a second run), a subnormal, a rest-length -0 (a value
+ * whose bits differ from the default 0, so it must be stored). */
+static void paint_doc(argil_doc_t *d)
+{
+    float *k = grid_mat_alloc(&d->grid, GRID_MAT_STIFFNESS);
+    float *m = grid_mat_alloc(&d->grid, GRID_MAT_MASS);
+    float *r = grid_mat_alloc(&d->grid, GRID_MAT_RESTLEN);
+    assert_non_null(k);
+    assert_non_null(m);
+    assert_non_null(r);
+    k[10] = 4.0f;
+    k[11] = 2.5f;
+    k[13] = 1.0000001f; /* gap of 1 at 12: bridged */
+    k[119] = 4.0f;      /* far: a second run */
+    m[0] = 0.5f;
+    m[1] = 1e-40f;      /* subnormal, still > 0 */
+    r[50] = -0.0f;
+    assert_non_null(grid_mat_alloc(&d->grid, GRID_MAT_DAMPING)); /* present, all default */
+}
+
+/* Painted channels come back bit for bit; the file is version 2 and grows only by the painted
+ * runs; an unpainted model stays a version-1 file of the old size. */
+static void test_painted_round_trip(void **state)
+{
+    (void)state;
+    char p[128], q[128], err[256];
+    snprintf(p, sizeof(p), "%s/plain.argil", g_test_dir);
+    snprintf(q, sizeof(q), "%s/painted.argil", g_test_dir);
+    argil_doc_t d, r;
+    make_doc(&d, false);
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    paint_doc(&d);
+    assert_int_equal(argil_file_write(q, &d, err, sizeof(err)), ARGIL_OK);
+    size_t lp, lq;
+    uint8_t *bp = test_slurp(p, &lp), *bq = test_slurp(q, &lq);
+    assert_int_equal(io_get_u32le(bp + 8), 1);
+    assert_int_equal(io_get_u32le(bq + 8), 2);
+    /* MTLS = 16 overhead + 4 count + stiffness (8 + 2 runs: 8+4*4, 8+4) + mass (8 + 8+2*4) +
+     * rest length (8 + 8+4); damping holds no painted value and is left out. */
+    assert_int_equal(lq - lp, 16 + 4 + (8 + 24 + 12) + (8 + 16) + (8 + 12));
+    free(bp);
+    free(bq);
+    assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(r.file_version, 2);
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        assert_true(grid_mat_equal(&r.grid, &d.grid, (grid_mat_t)ch));
+    assert_non_null(r.grid.mat[GRID_MAT_STIFFNESS]);
+    assert_null(r.grid.mat[GRID_MAT_DAMPING]);
+    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][10], 4.0f, 0);
+    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][12], 1.0f, 0); /* bridged, unpainted */
+    assert_float_equal(r.grid.mat[GRID_MAT_MASS][0], 0.5f, 0);
+    assert_true(signbit(r.grid.mat[GRID_MAT_RESTLEN][50]));
+    assert_memory_equal(r.grid.density, d.grid.density, 120 * sizeof(float));
+    argil_doc_free(&r);
+    /* A changed painted value is not the same model. */
+    d.grid.mat[GRID_MAT_MASS][0] = 0.25f;
+    assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_OK);
+    assert_false(grid_mat_equal(&r.grid, &d.grid, GRID_MAT_MASS));
+    argil_doc_free(&r);
+    /* Out-of-range paint is refused at write time, naming the channel and sample. */
+    d.grid.mat[GRID_MAT_MASS][3] = 0.0f;
+    assert_int_equal(argil_file_write(q, &d, err, sizeof(err)), ARGIL_ERR_NONFINITE);
+    assert_non_null(strstr(err, "channel 1 holds 0 at sample 3"));
+    d.grid.mat[GRID_MAT_MASS][3] = 1.0f;
+    /* Every cut of a painted file is a clear refusal. */
+    bq = test_slurp(q, &lq);
+    for (size_t cut = 0; cut < lq; cut += 7) {
+        test_spit(p, bq, cut);
+        assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
+        assert_non_null(strstr(err, p));
+        assert_null(r.grid.density);
+    }
+    free(bq);
+    argil_doc_free(&d);
+}
+
+/* A file the version-1 writer made (before painted material existed) still loads, and an
+ * unpainted model is still written as exactly those bytes. */
+static const uint8_t V1_FILE[] = {
+  0x41, 0x52, 0x47, 0x49, 0x4c, 0x0d, 0x0a, 0x1a, 0x01, 0x00, 0x00, 0x00,
+  0x04, 0x00, 0x00, 0x00, 0xd8, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x00, 0x00, 0xad, 0xd1, 0xea, 0xb9, 0x47, 0x52, 0x49, 0x44,
+  0x3c, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x03, 0x00, 0x00, 0x00,
+  0x02, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x6f, 0x12, 0x83, 0x3a,
+  0x6f, 0x12, 0x83, 0xba, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x00, 0x3f, 0x6f, 0x12, 0x83, 0x3b, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x00, 0x3e, 0x00, 0x00, 0x80, 0x3e, 0x00, 0x00, 0xc0, 0x3e,
+  0x00, 0x00, 0x00, 0x3f, 0x00, 0x00, 0x20, 0x3f, 0x3b, 0xcf, 0x70, 0xdb,
+  0x4d, 0x41, 0x54, 0x4c, 0x14, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x80, 0x3f, 0x00, 0x00, 0xe0, 0x40, 0x00, 0x00, 0x80, 0x40,
+  0x00, 0x00, 0x20, 0x42, 0x00, 0x00, 0xa0, 0x41, 0xd5, 0xe7, 0xed, 0xb5,
+  0x54, 0x4f, 0x4f, 0x4c, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x00, 0x00, 0x0a, 0xd7, 0xa3, 0x3b, 0x00, 0x00, 0x00, 0x3f,
+  0xc8, 0x50, 0x28, 0x00, 0x26, 0xf2, 0x88, 0xa2, 0x53, 0x54, 0x41, 0x54,
+  0x14, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+  0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3f,
+  0x05, 0x00, 0x00, 0x00, 0x1a, 0x8f, 0xcd, 0x69, 0x07, 0x92, 0x98, 0x2f
+};
+
+static void test_old_version_loads(void **state)
+{
+    (void)state;
+    char p[128], q[128], err[256];
+    snprintf(p, sizeof(p), "%s/v1.argil", g_test_dir);
+    snprintf(q, sizeof(q), "%s/v1-again.argil", g_test_dir);
+    test_spit(p, V1_FILE, sizeof(V1_FILE));
+    argil_doc_t r;
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(r.file_version, 1);
+    assert_int_equal(r.grid.dims[0], 3);
+    assert_int_equal(r.grid.dims[1], 2);
+    assert_float_equal(r.grid.density[5], 0.625f, 0);
+    assert_float_equal(r.grid.material.stiffness, 7.0f, 0);
+    assert_int_equal(r.state.edits, 5);
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        assert_null(r.grid.mat[ch]);
+    assert_int_equal(argil_file_write(q, &r, err, sizeof(err)), ARGIL_OK);
+    size_t len;
+    uint8_t *b = test_slurp(q, &len);
+    assert_int_equal(len, sizeof(V1_FILE));
+    assert_memory_equal(b, V1_FILE, len);
+    free(b);
+    argil_doc_free(&r);
+}
+
+/* One crafted MTLS section per rule (GRID of 1x1x2 samples). */
+static void mtls_case(const char *path, uint32_t version, const uint8_t *m, size_t ml, int copies)
+{
+    build_t f;
+    uint8_t g[512];
+    const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
+    b_begin(&f);
+    b_sec(&f, "GRID", g, gl);
+    for (int i = 0; i < copies; i++)
+        b_sec(&f, "MTLS", m, ml);
+    b_end(&f, path, version);
+}
+
+static size_t mtls_one(uint8_t *m, uint32_t k, uint32_t ch, uint32_t runs, uint32_t start,
+                       uint32_t count, float v)
+{
+    io_put_u32le(m, k);
+    io_put_u32le(m + 4, ch);
+    io_put_u32le(m + 8, runs);
+    io_put_u32le(m + 12, start);
+    io_put_u32le(m + 16, count);
+    io_put_f32le(m + 20, v);
+    return 24;
+}
+
+static void test_mtls_rules(void **state)
+{
+    (void)state;
+    char p[128], err[256];
+    snprintf(p, sizeof(p), "%s/m.argil", g_test_dir);
+    uint8_t m[64];
+    size_t ml = mtls_one(m, 1, GRID_MAT_STIFFNESS, 1, 1, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    argil_doc_t r;
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK); /* builder is right */
+    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][0], 1.0f, 0);
+    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][1], 4.0f, 0);
+    argil_doc_free(&r);
+    /* Damping (2) then rest length (3): two channels, increasing ids. */
+    uint8_t two[64];
+    io_put_u32le(two, 2);
+    mtls_one(two, 2, GRID_MAT_DAMPING, 1, 0, 1, 0.0f); /* overwrites the count: fix below */
+    io_put_u32le(two, 2);
+    memcpy(two + 24, two + 4, 20);
+    io_put_u32le(two + 24, GRID_MAT_RESTLEN);
+    io_put_f32le(two + 40, -0.25f);
+    mtls_case(p, 2, two, 44, 1);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_float_equal(r.grid.mat[GRID_MAT_DAMPING][0], 0.0f, 0);
+    assert_float_equal(r.grid.mat[GRID_MAT_RESTLEN][0], -0.25f, 0);
+    argil_doc_free(&r);
+    io_put_u32le(two + 24, GRID_MAT_DAMPING);
+    mtls_case(p, 2, two, 44, 1);
+    expect_rule(p, "byte 128", "MTLS channel id not 0..3");
+
+    mtls_case(p, 1, m, ml, 1);
+    expect_rule(p, "byte 92", "MTLS section (painted material) in a version-1 file");
+    mtls_case(p, 2, m, ml, 2);
+    expect_rule(p, "byte 132", "second MTLS section");
+    mtls_case(p, 2, m, 2, 1);
+    expect_rule(p, "byte 104", "shorter than its 4-byte channel count");
+    mtls_case(p, 2, m, 4, 1);
+    expect_rule(p, "byte 108", "MTLS channel head runs past the section");
+    ml = mtls_one(m, 0, 0, 1, 1, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 104", "MTLS channel count not in 1..4");
+    ml = mtls_one(m, 5, 0, 1, 1, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 104", "MTLS channel count not in 1..4");
+    ml = mtls_one(m, 1, 4, 1, 1, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 108", "MTLS channel id not 0..3");
+    ml = mtls_one(m, 1, 0, 0, 1, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 112", "MTLS channel with no runs");
+    ml = mtls_one(m, 1, 0, 1, 1, 0, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 116", "MTLS run empty, overlapping or out of order");
+    ml = mtls_one(m, 1, 0, 1, 2, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 116", "beyond the grid's samples");
+    ml = mtls_one(m, 1, 0, 1, 0, 2, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 116", "MTLS run values run past the section");
+    ml = mtls_one(m, 1, 0, 2, 0, 1, 4.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 128", "MTLS run head runs past the section");
+    /* Two runs, the second starting inside the first. */
+    ml = mtls_one(m, 1, 0, 2, 0, 2, 4.0f);
+    io_put_f32le(m + 24, 3.0f);
+    io_put_u32le(m + 28, 1);
+    io_put_u32le(m + 32, 1);
+    io_put_f32le(m + 36, 2.0f);
+    mtls_case(p, 2, m, 40, 1);
+    expect_rule(p, "byte 132", "overlapping or out of order");
+    ml = mtls_one(m, 1, GRID_MAT_MASS, 1, 0, 1, 0.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 124", "MTLS value out of range");
+    ml = mtls_one(m, 1, GRID_MAT_STIFFNESS, 1, 0, 1, -1.0f);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 124", "MTLS value out of range");
+    ml = mtls_one(m, 1, GRID_MAT_RESTLEN, 1, 0, 1, NAN);
+    mtls_case(p, 2, m, ml, 1);
+    expect_rule(p, "byte 124", "MTLS value out of range");
+    ml = mtls_one(m, 1, 0, 1, 0, 1, 4.0f);
+    mtls_case(p, 2, m, ml + 3, 1);
+    expect_rule(p, "byte 128", "bytes after the last MTLS channel");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -496,6 +732,9 @@ int main(void)
         cmocka_unit_test(test_any_corruption_refused),
         cmocka_unit_test(test_each_rule),
         cmocka_unit_test(test_octb),
+        cmocka_unit_test(test_painted_round_trip),
+        cmocka_unit_test(test_old_version_loads),
+        cmocka_unit_test(test_mtls_rules),
     };
     return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }

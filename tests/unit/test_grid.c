@@ -285,6 +285,46 @@ static void test_springs_push_lowers_density(void **state)
     drop_grid(g);
 }
 
+
+/* Painted channels: absent until allocated, defaults 1 / 0, the value rules, freed with the grid,
+ * and equality bit for bit (an absent channel equals one holding only defaults, not one with -0). */
+static void test_painted_channels(void **state)
+{
+    (void)state;
+    grid_t a, b;
+    const int32_t dims[3] = {3, 2, 2};
+    assert_int_equal(grid_init(&a, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
+    assert_int_equal(grid_init(&b, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        assert_null(a.mat[ch]);
+    assert_float_equal(grid_mat_value(&a, GRID_MAT_STIFFNESS, 5), 1.0f, 0);
+    assert_float_equal(grid_mat_value(&a, GRID_MAT_RESTLEN, 5), 0.0f, 0);
+    assert_true(grid_mat_valid(GRID_MAT_MASS, 1e-6f));
+    assert_false(grid_mat_valid(GRID_MAT_MASS, 0.0f));
+    assert_true(grid_mat_valid(GRID_MAT_STIFFNESS, 0.0f));
+    assert_false(grid_mat_valid(GRID_MAT_DAMPING, -0.5f));
+    assert_true(grid_mat_valid(GRID_MAT_RESTLEN, -0.5f));
+    assert_false(grid_mat_valid(GRID_MAT_STIFFNESS, INFINITY));
+    assert_false(grid_mat_valid(GRID_MAT_N, 1.0f));
+    float *m = grid_mat_alloc(&a, GRID_MAT_MASS);
+    assert_non_null(m);
+    assert_ptr_equal(grid_mat_alloc(&a, GRID_MAT_MASS), m); /* allocated once */
+    assert_null(grid_mat_alloc(&a, GRID_MAT_N));
+    for (int i = 0; i < 12; i++)
+        assert_float_equal(m[i], 1.0f, 0);
+    assert_true(grid_mat_equal(&a, &b, GRID_MAT_MASS)); /* all default = absent */
+    m[7] = 0.5f;
+    assert_false(grid_mat_equal(&a, &b, GRID_MAT_MASS));
+    assert_false(grid_mat_equal(&b, &a, GRID_MAT_MASS));
+    float *r = grid_mat_alloc(&b, GRID_MAT_RESTLEN);
+    r[0] = -0.0f; /* == 0, other bits */
+    assert_false(grid_mat_equal(&a, &b, GRID_MAT_RESTLEN));
+    grid_free(&a);
+    grid_free(&b);
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        assert_null(a.mat[ch]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -295,6 +335,7 @@ int main(void)
         cmocka_unit_test(test_window_corner_and_extract),
         cmocka_unit_test(test_add_force),
         cmocka_unit_test(test_springs_push_lowers_density),
+        cmocka_unit_test(test_painted_channels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -165,7 +165,7 @@ static void test_round_trip(void **state)
     char a[128], b[128];
     test_path(a, sizeof(a), "writer.argil");
     test_path(b, sizeof(b), "recovered.argil");
-    assert_int_equal(journal_write_model(&s->j, s->grid.density, 24, a, err, sizeof(err)),
+    assert_int_equal(journal_write_model(&s->j, &s->grid, 24, a, err, sizeof(err)),
                      ARGIL_OK);
     assert_int_equal(argil_file_write(b, &doc, err, sizeof(err)), ARGIL_OK);
     size_t la, lb;
@@ -295,7 +295,7 @@ static void test_wrong_base_refused(void **state)
     test_path(bp, sizeof(bp), "journal-base-0.argil");
     /* Another model under the base's name. */
     grid_fill_sphere(&s->grid, vec3(0, 0, 0), 0.004f);
-    assert_int_equal(journal_write_model(&s->j, s->grid.density, 0, bp, err, sizeof(err)),
+    assert_int_equal(journal_write_model(&s->j, &s->grid, 0, bp, err, sizeof(err)),
                      ARGIL_OK);
     argil_doc_t doc;
     journal_info_t info;
@@ -421,9 +421,9 @@ static void test_each_rule(void **state)
     expect_refusal(b, len, "header checksum mismatch");
 #define HDR_FIX() io_put_u32le(b + h - 4, crc32c(0, b, h - 4))
     FRESH();
-    io_put_u32le(b + 8, 2);
+    io_put_u32le(b + 8, 3);
     HDR_FIX();
-    expect_refusal(b, len, "journal version");
+    expect_refusal(b, len, "journal version (this argil reads 1..2)");
     FRESH();
     io_put_u32le(b + 12, 100);
     HDR_FIX();
@@ -462,6 +462,16 @@ static void test_each_rule(void **state)
     io_put_u32le(b + p, 7);
     fix_record_crc(b, len);
     expect_refusal(b, len, "unknown record type 7");
+    FRESH();
+    io_put_u32le(b + 8, 1); /* a version-1 journal has no painted-material records */
+    HDR_FIX();
+    io_put_u32le(b + p, 2);
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "unknown record type 2");
+    FRESH();
+    io_put_u32le(b + p, 2); /* type 2 without its material blocks */
+    fix_record_crc(b, len);
+    expect_refusal(b, len, "material block count runs past the record");
     FRESH();
     io_put_u32le(b + p + 4, 5);
     fix_record_crc(b, len);
@@ -556,6 +566,160 @@ static void test_box_hint(void **state)
     sess_free(s);
 }
 
+
+/* Paints (what gsolve_material_to_grid does): channel ch of samples [at, at + n) set to v. */
+static void paint(grid_t *g, grid_mat_t ch, size_t at, size_t n, float v)
+{
+    float *m = grid_mat_alloc(g, ch);
+    assert_non_null(m);
+    for (size_t i = 0; i < n; i++)
+        m[at + i] = v;
+    g->mat_writes++;
+}
+
+static void record(sess_t *s, const journal_box_t *box, double sim_s, bool want)
+{
+    bool appended = false;
+    char err[512] = "";
+    assert_int_equal(journal_record(&s->j, &s->grid, box, s->records + 1u, sim_s, sim_s, 0,
+                                    &appended, err, sizeof(err)),
+                     ARGIL_OK);
+    assert_int_equal(appended, want);
+    s->records += appended;
+    assert_int_equal(journal_tick(&s->j, sim_s, sim_s, err, sizeof(err)), ARGIL_OK);
+}
+
+static void assert_mat(const grid_t *got, const grid_t *want)
+{
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        if (!grid_mat_equal(got, want, (grid_mat_t)ch))
+            fail_msg("painted channel %d differs", ch);
+}
+
+/* Painted material is journaled (record type 2) and recovered bit for bit: through a box that
+ * does not hold it (mat_writes tells the journal to look), across a rotation onto a painted
+ * base, and with a torn last record ignored. */
+static void test_painted_material(void **state)
+{
+    (void)state;
+    journal_cfg_t c;
+    journal_cfg_default(&c);
+    c.checkpoint_s = 1.0f;
+    sess_t *s = sess_new(&c);
+    const journal_box_t corner = {{0, 0, 0}, {8, 1, 1}}; /* densities compared: 8 samples */
+    char err[512] = "";
+    paint(&s->grid, GRID_MAT_STIFFNESS, 100, 40, 4.0f);
+    paint(&s->grid, GRID_MAT_MASS, 130, 20, 0.5f);
+    record(s, &corner, 0.1, true);
+    assert_int_equal(s->j.stats.mat_samples, 60);
+    /* Unchanged paint, another mat_writes: nothing to record. */
+    s->grid.mat_writes++;
+    record(s, &corner, 0.2, false);
+    /* A change that skips mat_writes waits for the whole-grid comparison. */
+    s->grid.mat[GRID_MAT_STIFFNESS][5] = 2.0f;
+    record(s, &corner, 0.3, false);
+    record(s, NULL, 0.4, true);
+    assert_int_equal(s->j.stats.mat_samples, 61);
+    /* Rotation at 1 s: the new base holds the paint. */
+    record(s, NULL, 1.1, false);
+    assert_int_equal(s->j.stats.checkpoints, 1);
+    paint(&s->grid, GRID_MAT_STIFFNESS, 100, 10, 3.0f);
+    paint(&s->grid, GRID_MAT_RESTLEN, 0, 1, -0.0f);
+    s->grid.density[7] = 0.75f;
+    record(s, &corner, 1.2, true);
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+
+    argil_doc_t doc;
+    journal_info_t info;
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.checkpoint, 1);
+    assert_int_equal(info.records, 1);
+    assert_int_equal(info.mat_samples, 11);
+    assert_density(doc.grid.density, s->grid.density);
+    assert_mat(&doc.grid, &s->grid);
+    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][105], 3.0f, 0);
+    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][139], 4.0f, 0);
+    assert_float_equal(doc.grid.mat[GRID_MAT_MASS][149], 0.5f, 0);
+    assert_true(signbit(doc.grid.mat[GRID_MAT_RESTLEN][0]));
+    /* The writer's model and the recovered one are the same bytes, painted (version 2). */
+    char a[128], b[128];
+    test_path(a, sizeof(a), "writer.argil");
+    test_path(b, sizeof(b), "recovered.argil");
+    assert_int_equal(journal_write_model(&s->j, &s->grid, s->records, a, err, sizeof(err)),
+                     ARGIL_OK);
+    doc.state.edits = s->records;
+    assert_int_equal(argil_file_write(b, &doc, err, sizeof(err)), ARGIL_OK);
+    size_t la, lb;
+    uint8_t *ba = test_slurp(a, &la), *bb = test_slurp(b, &lb);
+    assert_int_equal(la, lb);
+    assert_memory_equal(ba, bb, la);
+    assert_int_equal(io_get_u32le(ba + 8), 2);
+    free(ba);
+    free(bb);
+    argil_doc_free(&doc);
+
+    /* The last record torn: the paint as of the base (stiffness 4 at sample 105). */
+    char jp[128];
+    test_path(jp, sizeof(jp), JOURNAL_FILE);
+    size_t len;
+    uint8_t *full = test_slurp(jp, &len);
+    test_spit(jp, full, len - 5);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 0);
+    assert_true(info.torn_bytes > 0);
+    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][105], 4.0f, 0);
+    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][5], 2.0f, 0);
+    assert_null(doc.grid.mat[GRID_MAT_RESTLEN]);
+    argil_doc_free(&doc);
+    test_spit(jp, full, len);
+
+    /* A base whose paint differs from the journal's is refused (the CRC covers the paint). */
+    char bp[128];
+    test_path(bp, sizeof(bp), "journal-base-1.argil");
+    argil_doc_t base;
+    assert_int_equal(argil_file_read(bp, &base, err, sizeof(err)), ARGIL_OK);
+    base.grid.mat[GRID_MAT_MASS][130] = 0.25f;
+    assert_int_equal(argil_file_write(bp, &base, err, sizeof(err)), ARGIL_OK);
+    argil_doc_free(&base);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_non_null(strstr(err, "is not the one this journal continues"));
+    assert_null(doc.grid.density);
+
+    /* Record rules for the material blocks (the last record's, its CRC fixed). */
+    size_t r = JOURNAL_HEADER_BYTES;
+    const size_t payload = io_get_u32le(full + r);
+    const size_t blocks = r + 4 + JOURNAL_RECORD_HEAD_BYTES + 8 + 4; /* one density run of 1 */
+    assert_int_equal(io_get_u32le(full + r + 4), 2);                 /* type 2 */
+    assert_int_equal(io_get_u32le(full + blocks), 2);                /* stiffness, rest length */
+    journal_info_t ji;
+    static float density[N_SAMPLES];
+#define MAT_CASE(off, val, rule)                                                            \
+    do {                                                                                    \
+        uint8_t *m = malloc(len);                                                           \
+        assert_non_null(m);                                                                 \
+        memcpy(m, full, len);                                                               \
+        io_put_u32le(m + (off), (val));                                                     \
+        io_put_u32le(m + r + 4 + payload, crc32c(0, m + r, 4 + payload));                  \
+        const argil_err_t e = journal_replay(m, len, "j.log", density, N_SAMPLES, &ji, err, \
+                                             sizeof(err));                                  \
+        if (e != ARGIL_ERR_PARSE || strstr(err, rule) == NULL)                              \
+            fail_msg("wanted '%s', got %d '%s'", rule, e, err);                             \
+        free(m);                                                                            \
+    } while (0)
+    MAT_CASE(blocks, 0, "material block count 0 not in 1..4");
+    MAT_CASE(blocks, 5, "material block count 5 not in 1..4");
+    MAT_CASE(blocks + 4, 9, "channel 9 not 0..3");
+    MAT_CASE(blocks + 8, 0, "channel 0 not 0..3 in increasing order, or no runs");
+    MAT_CASE(blocks + 12, N_SAMPLES, "material run 0");
+    MAT_CASE(blocks + 16, 0, "empty, beyond the grid or past the record");
+    MAT_CASE(blocks + 20, 0xff800000u, "painted material value out of range");
+    MAT_CASE(blocks, 3, "material block 2 head runs past the record");
+    MAT_CASE(blocks, 1, "bytes after the last run");
+#undef MAT_CASE
+    free(full);
+    sess_free(s);
+}
+
 static void test_discard_and_bad_config(void **state)
 {
     (void)state;
@@ -604,6 +768,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_autosave_interval, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_painted_material, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, test_dir_teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
