@@ -91,20 +91,25 @@ echo "== board tick by tick (tests/bench/bench_ticks.c: the default session, boa
 # so no tick pays for the dynamic linker. Wall time: the same program natively, 3 runs.
 bt="$tmp/bench_ticks"
 cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_ticks.c "$rel/libargil.a" -lm -Wl,-z,now -o "$bt"
-for edge in 16 32; do
+# The third row: the same session with the B-spline solve and the clay's stiffness painted 4x
+# round the pushed pole, so the board's windows carry per-node stiffness (two channels).
+for row in 16 32 "16 --paint-stiffness 4"; do
+    edge=${row%% *}
+    paint=""
+    [ "$row" = "$edge" ] || paint=${row#* }
     : >"$tmp/bt.med"; : >"$tmp/bt.p99"; : >"$tmp/bt.worst"
     for i in 1 2 3; do
-        "$bt" --window "$edge" >"$tmp/bt.out"
+        "$bt" --window "$edge" $paint >"$tmp/bt.out"
         sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\1/p' "$tmp/bt.out" >>"$tmp/bt.med"
         sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\2/p' "$tmp/bt.out" >>"$tmp/bt.p99"
         sed -n 's/^wall per tick: median \([0-9.]*\) us, p99 \([0-9.]*\) us, worst \([0-9.]*\) us$/\3/p' "$tmp/bt.out" >>"$tmp/bt.worst"
     done
-    printf '  %s\n' "$(head -n 1 "$tmp/bt.out")"
+    grep -v '^wall per tick' "$tmp/bt.out" | sed 's/^/  /'
     printf '    wall-clock per tick (median of 3 runs): median %s us, p99 %s us, worst %s us\n' \
         "$(median <"$tmp/bt.med")" "$(median <"$tmp/bt.p99")" "$(median <"$tmp/bt.worst")"
     if command -v valgrind >/dev/null 2>&1 && [ -f /usr/include/valgrind/callgrind.h ]; then
         valgrind --tool=callgrind --collect-atstart=no --combine-dumps=yes --dump-line=no \
-            --callgrind-out-file="$tmp/ticks.cg" "$bt" --window "$edge" >"$tmp/bt.cg.out" 2>/dev/null
+            --callgrind-out-file="$tmp/ticks.cg" "$bt" --window "$edge" $paint >"$tmp/bt.cg.out" 2>/dev/null
         ticks=$(sed -n 's/^window [0-9]*^3: \([0-9]*\) ticks.*/\1/p' "$tmp/bt.cg.out")
         # one "totals:" per part; the last part is the dump at exit (nothing collected)
         sed -n 's/^totals: \([0-9]*\)$/\1/p' "$tmp/ticks.cg" | head -n "$ticks" >"$tmp/ticks.ir"
@@ -157,13 +162,16 @@ fi
 # The default session in the window under Xvfb, paced to real time, three runs: frame time of the
 # window (22k triangles, 1024 x 768; 4x MSAA once the clay is still) and, on the wall clock, the
 # time from the board's impulse reaching the host to the return of the swap of the first frame
-# showing the solve step that took it in, with the median of each stage on the way.
+# showing the solve step that took it in, with the median of each stage on the way, and what the
+# frames were drawn for (a new mesh, another snapshot, input or the HUD alone). The load average
+# comes first: llvmpipe shares the machine's cores with everything else running.
 if command -v xvfb-run >/dev/null 2>&1; then
     for run in 1 2 3; do
+        echo "  run $run, load average $(cut -d ' ' -f 1-3 /proc/loadavg)"
         xvfb-run -a -s "-screen 0 1280x1024x24" "$bin" sculpt --script "$script" \
             --out "$tmp/live$run" --linger 0 >"$tmp/live.txt" 2>&1 ||
             echo "  live session failed: $(tail -n 1 "$tmp/live.txt")"
-        grep -A1 "live window" "$tmp/live.txt" || true
+        grep -A2 "live window" "$tmp/live.txt" || true
     done
     echo "  (goal: a stroke's change on screen within 2 frames at 60 Hz = 33 ms)"
 else

@@ -22,6 +22,8 @@
     X(glfwSwapBuffers)                                                                           \
     X(glfwSwapInterval)                                                                          \
     X(glfwPollEvents)                                                                            \
+    X(glfwWaitEventsTimeout)                                                                     \
+    X(glfwPostEmptyEvent)                                                                        \
     X(glfwWindowShouldClose)                                                                     \
     X(glfwGetFramebufferSize)                                                                    \
     X(glfwGetCursorPos)                                                                          \
@@ -142,6 +144,21 @@ void glfw_window_poll(glfw_window_t *w, glfw_input_t *in)
     in->right_down = f->glfwGetMouseButton(w->window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     in->shift = f->glfwGetKey(w->window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
                 f->glfwGetKey(w->window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+}
+
+void glfw_window_wait(glfw_window_t *w, double timeout_s)
+{
+    const glfw_fns_t *f = w->fns;
+    if (timeout_s > 0.0)
+        f->glfwWaitEventsTimeout(timeout_s);
+    else
+        f->glfwPollEvents();
+}
+
+void glfw_window_wake(glfw_window_t *w)
+{
+    const glfw_fns_t *f = w->fns;
+    f->glfwPostEmptyEvent();
 }
 
 bool glfw_window_take_key(glfw_window_t *w, int *key)

@@ -37,6 +37,14 @@ argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visib
 /* Processes pending events and returns the mouse and keyboard state. */
 void glfw_window_poll(glfw_window_t *w, glfw_input_t *in);
 
+/* Processes pending events; when there are none, sleeps until one arrives, glfw_window_wake is
+ * called or timeout_s passes (timeout_s <= 0: does not sleep). Main thread only. */
+void glfw_window_wait(glfw_window_t *w, double timeout_s);
+
+/* Makes a glfw_window_wait in progress (or the next one) return at once. Safe from any thread
+ * while the window is open. */
+void glfw_window_wake(glfw_window_t *w);
+
 /* Takes the oldest key pressed since the last poll (a GLFW_KEY_* code); false when none. */
 bool glfw_window_take_key(glfw_window_t *w, int *key);
 

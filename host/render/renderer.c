@@ -10,68 +10,72 @@ enum { ATTR_POS = 0, ATTR_NORMAL = 1, ATTR_RGB = 2 };
 enum { SPHERE_SLICES = 32, SPHERE_STACKS = 16 };
 enum { LINE_VERTS_MAX = 24 + 10 };  /* 12 box edges + the force line and its 4-stroke head */
 
+/* The base colour is linearised per vertex: for the clay's one colour and the tool's tint that is
+ * the same as per pixel, and a colour-mapped mesh blends its colours in linear light. */
 static const char *SURF_VS =
     "#version 330 core\n"
     "layout(location = 0) in vec3 a_pos;\n"
     "layout(location = 1) in vec3 a_normal;\n"
     "layout(location = 2) in vec3 a_rgb;\n"
     "uniform mat4 u_model, u_view, u_proj;\n"
-    "out vec3 v_pos, v_normal, v_rgb;\n"
+    "uniform vec4 u_tint;\n"
+    "uniform float u_tint_mix;\n"
+    "out vec3 v_pos, v_normal, v_base;\n"
     "void main() {\n"
     "    mat4 mv = u_view * u_model;\n"
     "    vec4 p = mv * vec4(a_pos, 1.0);\n"
     "    v_pos = p.xyz;\n"
     "    v_normal = mat3(mv) * a_normal;\n"
-    "    v_rgb = a_rgb;\n"
+    "    v_base = pow(mix(a_rgb, u_tint.rgb, u_tint_mix), vec3(2.2));\n"
     "    gl_Position = u_proj * p;\n"
     "}\n";
 
-/* Lights and the environment are in view space: the studio turns with the camera. */
-static const char *SURF_FS =
-    "#version 330 core\n"
-    "in vec3 v_pos, v_normal, v_rgb;\n"
-    "uniform int u_mode;\n"
-    "uniform vec3 u_key_dir, u_key_rgb, u_fill_dir, u_fill_rgb, u_ambient;\n"
-    "uniform vec4 u_tint;\n"
-    "uniform float u_tint_mix;\n"
-    "out vec4 o_color;\n"
-    "\n"
-    "vec3 studio(vec3 r, vec3 kd, vec3 fd) {\n"
-    "    vec3 zenith = vec3(0.80, 0.86, 0.95), horizon = vec3(0.34, 0.36, 0.40);\n"
-    "    vec3 ground = vec3(0.12, 0.10, 0.09);\n"
-    "    vec3 sky = mix(horizon, zenith, smoothstep(0.0, 0.8, r.y));\n"
-    "    vec3 c = mix(ground, sky, smoothstep(-0.12, 0.04, r.y));\n"
-    "    c += 3.0 * u_key_rgb * smoothstep(0.93, 0.99, dot(r, kd));\n"
-    "    c += 1.5 * u_fill_rgb * smoothstep(0.88, 0.97, dot(r, fd));\n"
-    "    return c;\n"
+/* Lights and the environment are in view space: the studio turns with the camera. One program
+ * per shading mode (CLEARCOAT 0 or 1): llvmpipe would shade both sides of a branch on a
+ * uniform, about a sixth more work per pixel of clay. */
+#define SURF_FS_BODY                                                                             \
+    "in vec3 v_pos, v_normal, v_base;\n"                                                         \
+    "uniform vec3 u_key_dir, u_key_rgb, u_fill_dir, u_fill_rgb, u_ambient;\n"                    \
+    "uniform vec4 u_tint;\n"                                                                     \
+    "out vec4 o_color;\n"                                                                        \
+    "\n"                                                                                         \
+    "vec3 studio(vec3 r, vec3 kd, vec3 fd) {\n"                                                  \
+    "    vec3 zenith = vec3(0.80, 0.86, 0.95), horizon = vec3(0.34, 0.36, 0.40);\n"              \
+    "    vec3 ground = vec3(0.12, 0.10, 0.09);\n"                                                \
+    "    vec3 sky = mix(horizon, zenith, smoothstep(0.0, 0.8, r.y));\n"                          \
+    "    vec3 c = mix(ground, sky, smoothstep(-0.12, 0.04, r.y));\n"                             \
+    "    c += 3.0 * u_key_rgb * smoothstep(0.93, 0.99, dot(r, kd));\n"                           \
+    "    c += 1.5 * u_fill_rgb * smoothstep(0.88, 0.97, dot(r, fd));\n"                          \
+    "    return c;\n"                                                                            \
+    "}\n"                                                                                        \
+    "\n"                                                                                         \
+    "vec3 blinn(vec3 n, vec3 v, vec3 l, vec3 light, vec3 base, float shininess, float ks) {\n"   \
+    "    float ndl = max(dot(n, l), 0.0);\n"                                                     \
+    "    float nh = max(dot(n, normalize(l + v)), 0.0);\n"                                       \
+    "    float spec = ndl > 0.0 ? ks * (shininess + 8.0) / 25.13 * pow(nh, shininess) : 0.0;\n"  \
+    "    return light * (base * ndl + vec3(spec));\n"                                            \
+    "}\n"                                                                                        \
+    "\n"                                                                                         \
+    "void main() {\n"                                                                            \
+    "    vec3 n = normalize(v_normal);\n"                                                        \
+    "    if (!gl_FrontFacing) n = -n;\n"                                                         \
+    "    vec3 v = normalize(-v_pos);\n"                                                          \
+    "    vec3 kd = normalize(u_key_dir), fd = normalize(u_fill_dir);\n"                          \
+    "    vec3 base = v_base;\n"                                                                  \
+    "#if CLEARCOAT\n"                                                                            \
+    "    vec3 under = u_ambient * base + blinn(n, v, kd, u_key_rgb, base, 6.0, 0.02)\n"          \
+    "               + blinn(n, v, fd, u_fill_rgb, base, 6.0, 0.02);\n"                           \
+    "    float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(n, v), 0.0), 5.0);\n"                   \
+    "    float coat = 0.06 + 0.7 * fresnel;\n"                                                   \
+    "    vec3 c = under * (1.0 - coat) + coat * studio(reflect(-v, n), kd, fd);\n"               \
+    "#else\n"                                                                                    \
+    "    vec3 c = u_ambient * base + blinn(n, v, kd, u_key_rgb, base, 40.0, 0.12)\n"             \
+    "           + blinn(n, v, fd, u_fill_rgb, base, 40.0, 0.12);\n"                              \
+    "#endif\n"                                                                                   \
+    "    o_color = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), u_tint.a);\n"                  \
     "}\n"
-    "\n"
-    "vec3 blinn(vec3 n, vec3 v, vec3 l, vec3 light, vec3 base, float shininess, float ks) {\n"
-    "    float ndl = max(dot(n, l), 0.0);\n"
-    "    float nh = max(dot(n, normalize(l + v)), 0.0);\n"
-    "    float spec = ndl > 0.0 ? ks * (shininess + 8.0) / 25.13 * pow(nh, shininess) : 0.0;\n"
-    "    return light * (base * ndl + vec3(spec));\n"
-    "}\n"
-    "\n"
-    "void main() {\n"
-    "    vec3 n = normalize(v_normal);\n"
-    "    if (!gl_FrontFacing) n = -n;\n"
-    "    vec3 v = normalize(-v_pos);\n"
-    "    vec3 kd = normalize(u_key_dir), fd = normalize(u_fill_dir);\n"
-    "    vec3 base = pow(mix(v_rgb, u_tint.rgb, u_tint_mix), vec3(2.2));\n"
-    "    vec3 c;\n"
-    "    if (u_mode == 0) {\n"
-    "        c = u_ambient * base + blinn(n, v, kd, u_key_rgb, base, 40.0, 0.12)\n"
-    "          + blinn(n, v, fd, u_fill_rgb, base, 40.0, 0.12);\n"
-    "    } else {\n"
-    "        vec3 under = u_ambient * base + blinn(n, v, kd, u_key_rgb, base, 6.0, 0.02)\n"
-    "                   + blinn(n, v, fd, u_fill_rgb, base, 6.0, 0.02);\n"
-    "        float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(n, v), 0.0), 5.0);\n"
-    "        float coat = 0.06 + 0.7 * fresnel;\n"
-    "        c = under * (1.0 - coat) + coat * studio(reflect(-v, n), kd, fd);\n"
-    "    }\n"
-    "    o_color = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), u_tint.a);\n"
-    "}\n";
+static const char *SURF_FS_PLAIN = "#version 330 core\n#define CLEARCOAT 0\n" SURF_FS_BODY;
+static const char *SURF_FS_COAT = "#version 330 core\n#define CLEARCOAT 1\n" SURF_FS_BODY;
 
 static const char *LINE_VS = "#version 330 core\n"
                              "layout(location = 0) in vec3 a_pos;\n"
@@ -214,9 +218,14 @@ argil_err_t renderer_init(renderer_t *r, const gl_api_t *gl, char *err, size_t e
 {
     memset(r, 0, sizeof(*r));
     r->gl = gl;
-    r->prog_surf = link_program(gl, SURF_VS, SURF_FS, err, err_len);
+    r->prog_surf = link_program(gl, SURF_VS, SURF_FS_PLAIN, err, err_len);
     if (r->prog_surf == 0)
         return ARGIL_ERR_STATE;
+    r->prog_coat = link_program(gl, SURF_VS, SURF_FS_COAT, err, err_len);
+    if (r->prog_coat == 0) {
+        renderer_free(r);
+        return ARGIL_ERR_STATE;
+    }
     r->prog_line = link_program(gl, LINE_VS, LINE_FS, err, err_len);
     if (r->prog_line == 0) {
         renderer_free(r);
@@ -363,6 +372,20 @@ static void draw_wire(const renderer_t *r, const render_scene_t *s)
     gl->Enable(GL_DEPTH_TEST);
 }
 
+/* Binds a surface program with the scene's camera and lights. */
+static void use_surface(const renderer_t *r, unsigned prog, const render_scene_t *s)
+{
+    const gl_api_t *gl = r->gl;
+    gl->UseProgram(prog);
+    set_mat4(gl, prog, "u_view", s->view);
+    set_mat4(gl, prog, "u_proj", s->proj);
+    set_vec3(gl, prog, "u_key_dir", s->key.dir);
+    set_vec3(gl, prog, "u_key_rgb", s->key.rgb);
+    set_vec3(gl, prog, "u_fill_dir", s->fill.dir);
+    set_vec3(gl, prog, "u_fill_rgb", s->fill.rgb);
+    set_vec3(gl, prog, "u_ambient", s->ambient);
+}
+
 void renderer_draw(const renderer_t *r, const render_scene_t *s, int width, int height)
 {
     const gl_api_t *gl = r->gl;
@@ -377,18 +400,11 @@ void renderer_draw(const renderer_t *r, const render_scene_t *s, int width, int 
     gl->Disable(GL_CULL_FACE);
 
     /* The clay: opaque, both sides lit (an open or clipped mesh shows its inside). */
-    gl->UseProgram(r->prog_surf);
-    set_mat4(gl, r->prog_surf, "u_view", s->view);
-    set_mat4(gl, r->prog_surf, "u_proj", s->proj);
-    set_mat4(gl, r->prog_surf, "u_model", identity);
-    gl->Uniform1i(gl->GetUniformLocation(r->prog_surf, "u_mode"), (int)s->mode);
-    set_vec3(gl, r->prog_surf, "u_key_dir", s->key.dir);
-    set_vec3(gl, r->prog_surf, "u_key_rgb", s->key.rgb);
-    set_vec3(gl, r->prog_surf, "u_fill_dir", s->fill.dir);
-    set_vec3(gl, r->prog_surf, "u_fill_rgb", s->fill.rgb);
-    set_vec3(gl, r->prog_surf, "u_ambient", s->ambient);
-    set_color(gl, r->prog_surf, "u_tint", s->clay_rgb, 1.0f);
-    gl->Uniform1f(gl->GetUniformLocation(r->prog_surf, "u_tint_mix"), 0.0f);
+    const unsigned clay_prog = s->mode == RENDER_MODE_PLAIN ? r->prog_surf : r->prog_coat;
+    use_surface(r, clay_prog, s);
+    set_mat4(gl, clay_prog, "u_model", identity);
+    set_color(gl, clay_prog, "u_tint", s->clay_rgb, 1.0f);
+    gl->Uniform1f(gl->GetUniformLocation(clay_prog, "u_tint_mix"), 0.0f);
     if (r->mesh_index_count > 0) {
         gl->BindVertexArray(r->vao_mesh);
         if (!r->mesh_has_rgb)
@@ -435,12 +451,11 @@ void renderer_draw(const renderer_t *r, const render_scene_t *s, int width, int 
 
     /* The tool: a translucent sphere over everything drawn so far. */
     if (s->show_tool && s->tool_radius_m > 0.0f) {
-        gl->UseProgram(r->prog_surf);
+        use_surface(r, r->prog_surf, s);
         const float rad = s->tool_radius_m;
         const float model[16] = {rad, 0, 0, 0, 0, rad, 0, 0, 0, 0, rad, 0,
                                  s->tool_pos_m.x, s->tool_pos_m.y, s->tool_pos_m.z, 1};
         set_mat4(gl, r->prog_surf, "u_model", model);
-        gl->Uniform1i(gl->GetUniformLocation(r->prog_surf, "u_mode"), 0);
         set_color(gl, r->prog_surf, "u_tint", s->tool_rgb, s->tool_alpha);
         gl->Uniform1f(gl->GetUniformLocation(r->prog_surf, "u_tint_mix"), 1.0f);
         gl->Enable(GL_BLEND);
@@ -495,6 +510,8 @@ void renderer_free(renderer_t *r)
     gl->DeleteVertexArrays(4, vaos);
     if (r->prog_surf)
         gl->DeleteProgram(r->prog_surf);
+    if (r->prog_coat)
+        gl->DeleteProgram(r->prog_coat);
     if (r->prog_line)
         gl->DeleteProgram(r->prog_line);
     memset(r, 0, sizeof(*r));

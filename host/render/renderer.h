@@ -52,6 +52,7 @@ void render_scene_default(render_scene_t *s);
 typedef struct {
     const gl_api_t *gl;
     unsigned prog_surf, prog_line;
+    unsigned prog_coat;            /* prog_surf's clear-coat twin (RENDER_MODE_CLEARCOAT) */
     unsigned vao_mesh, vbo_pos, vbo_nrm, vbo_rgb, ibo_mesh;
     size_t mesh_index_count;
     bool mesh_has_rgb;

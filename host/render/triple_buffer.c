@@ -19,11 +19,18 @@ uint32_t triple_buffer_back(const triple_buffer_t *t)
 
 uint32_t triple_buffer_publish(triple_buffer_t *t)
 {
+    /* Sequentially consistent, so a reader that announced it is going to sleep and then found
+     * nothing fresh is seen by the writer's next look at that announcement (sculpt_window.c). */
     const uint32_t old = atomic_exchange_explicit(&t->middle, t->back | TRIPLE_BUFFER_FRESH,
-                                                  memory_order_acq_rel);
+                                                  memory_order_seq_cst);
     t->back = old & 3u;
     t->published++;
     return t->back;
+}
+
+bool triple_buffer_has_fresh(const triple_buffer_t *t)
+{
+    return (atomic_load_explicit(&t->middle, memory_order_seq_cst) & TRIPLE_BUFFER_FRESH) != 0u;
 }
 
 bool triple_buffer_take(triple_buffer_t *t, uint32_t *slot)

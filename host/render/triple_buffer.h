@@ -29,6 +29,9 @@ uint32_t triple_buffer_back(const triple_buffer_t *t);
  * fill. One atomic exchange. */
 uint32_t triple_buffer_publish(triple_buffer_t *t);
 
+/* Reader: true when a published slot waits to be taken (one sequentially consistent load). */
+bool triple_buffer_has_fresh(const triple_buffer_t *t);
+
 /* Reader: takes the newest published slot if there is one the reader has not seen (true), and
  * returns its slot in *slot either way. One atomic load, plus one exchange when fresh. */
 bool triple_buffer_take(triple_buffer_t *t, uint32_t *slot);

@@ -20,14 +20,18 @@ static void test_single_thread_rotation(void **state)
     triple_buffer_t t;
     triple_buffer_init(&t);
     uint32_t slot = 99;
+    assert_false(triple_buffer_has_fresh(&t));
     assert_false(triple_buffer_take(&t, &slot)); /* nothing published yet */
     assert_int_equal(slot, 2);
     const uint32_t b0 = triple_buffer_back(&t);
     const uint32_t b1 = triple_buffer_publish(&t);
     assert_int_not_equal(b0, b1);
     assert_int_not_equal(b1, 2); /* never the reader's slot */
+    assert_true(triple_buffer_has_fresh(&t)); /* a peek does not take it */
+    assert_true(triple_buffer_has_fresh(&t));
     assert_true(triple_buffer_take(&t, &slot));
     assert_int_equal(slot, b0);
+    assert_false(triple_buffer_has_fresh(&t));
     assert_false(triple_buffer_take(&t, &slot)); /* taken once only */
     assert_int_equal(slot, b0);
     /* Three publishes without a take: the reader gets the newest, the writer never the
