@@ -15,6 +15,7 @@ void window_init(window_t *w)
     w->active = 0;
     w->pending = false;
     w->chunks_refused = 0;
+    w->asm_max_stiffness = 0.0f;
     for (int k = 0; k < 2; k++) {
         w->buf[k].valid = false;
         w->buf[k].density = w->buf[k].field;
@@ -72,6 +73,14 @@ static proto_err_t feed(window_t *w, const msg_window_t *chunk, bool decoded)
         b->velocity[i] = 0.0f;
         b->force[i] = 0.0f;
     }
+    /* Likewise the largest node stiffness (channel 2: array index ≥ nodes); the first distinct
+     * chunk of an assembly starts it again. */
+    if (w->assembler.received == 1u)
+        w->asm_max_stiffness = 0.0f;
+    for (uint32_t k = chunk->first_sample < n_nodes ? n_nodes - chunk->first_sample : 0u;
+         k < chunk->sample_count; k++)
+        if (chunk->samples[k] > w->asm_max_stiffness)
+            w->asm_max_stiffness = chunk->samples[k];
     if (!window_asm_complete(&w->assembler))
         return PROTO_OK;
 
@@ -93,9 +102,8 @@ static proto_err_t feed(window_t *w, const msg_window_t *chunk, bool decoded)
     b->density = b->field;
     b->node_stiffness = h->channels > 1 ? b->field + n : 0;
     b->max_stiffness = h->stiffness;
-    for (int32_t i = 0; b->node_stiffness && i < n; i++)
-        if (b->node_stiffness[i] > b->max_stiffness)
-            b->max_stiffness = b->node_stiffness[i];
+    if (b->node_stiffness && w->asm_max_stiffness > b->max_stiffness)
+        b->max_stiffness = w->asm_max_stiffness;
     if (!spring_material_valid(&b->material)) {
         w->chunks_refused++;
         asm_target_back(w);

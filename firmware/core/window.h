@@ -36,6 +36,8 @@ typedef struct {
     uint8_t active;                /* index of the buffer in use */
     bool pending;                  /* the back buffer holds a complete, checked window */
     window_asm_t assembler;        /* writes into buf[!active].field */
+    float asm_max_stiffness;       /* largest node stiffness among the chunks assembled so far
+                                    * (kept chunk by chunk: no tick scans a whole window) */
     uint32_t chunks_refused;
 } window_t;
 

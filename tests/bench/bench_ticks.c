@@ -4,7 +4,10 @@
  * `valgrind --tool=callgrind --collect-atstart=no --combine-dumps=yes`: collection is switched
  * on only inside board_run_tick and the counters are dumped after every tick, so each dump part
  * of the output file holds exactly one tick's instructions (tests/bench.sh reads them).
- * Usage: bench_ticks [--window 16|32] [--script FILE] [--max-ticks N] */
+ * --paint-stiffness SCALE: the B-spline global solve, with the clay's stiffness painted SCALE×
+ * (40 mm round the +z pole, where the default script pushes) before the session, so the board
+ * gets two-channel windows (per-node stiffness).
+ * Usage: bench_ticks [--window 16|32] [--script FILE] [--max-ticks N] [--paint-stiffness SCALE] */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
@@ -102,6 +105,7 @@ int main(int argc, char **argv)
     int edge = 16;
     const char *script_path = "scripts/default.scn";
     long max_ticks_arg = 0;
+    float paint_scale = 0.0f;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--window") == 0 && i + 1 < argc)
             edge = atoi(argv[++i]);
@@ -109,8 +113,11 @@ int main(int argc, char **argv)
             script_path = argv[++i];
         else if (strcmp(argv[i], "--max-ticks") == 0 && i + 1 < argc)
             max_ticks_arg = atol(argv[++i]);
+        else if (strcmp(argv[i], "--paint-stiffness") == 0 && i + 1 < argc)
+            paint_scale = (float)atof(argv[++i]);
         else {
-            fprintf(stderr, "usage: bench_ticks [--window 16|32] [--script FILE] [--max-ticks N]\n");
+            fprintf(stderr, "usage: bench_ticks [--window 16|32] [--script FILE] [--max-ticks N] "
+                            "[--paint-stiffness SCALE]\n");
             return 2;
         }
     }
@@ -149,8 +156,16 @@ int main(int argc, char **argv)
     peer_cfg_t pc;
     peer_cfg_default(&pc);
     pc.window_edge = edge;
+    if (paint_scale > 0.0f)
+        pc.global_solve = PEER_SOLVE_BSPLINE;
     if (peer_init(&b->peer, &pc, &b->grid, bench_send, NULL, b) != ARGIL_OK) {
         fprintf(stderr, "bench_ticks: window edge %d refused\n", edge);
+        return 2;
+    }
+    if (paint_scale > 0.0f &&
+        peer_paint_material(&b->peer, PEER_MAT_STIFFNESS, vec3(0, 0, CLAY_RADIUS_M), 0.040f,
+                            paint_scale) != ARGIL_OK) {
+        fprintf(stderr, "bench_ticks: paint scale %g refused\n", (double)paint_scale);
         return 2;
     }
     b->offset_m = vec3_sub(vec3(0, 0, START_Z_M), sim_device_tip_m(&b->dev));
@@ -224,6 +239,9 @@ int main(int argc, char **argv)
     printf("window %d^3: %llu ticks (%.2f s simulated, %llu ACTIVE), final state %s\n", edge,
            (unsigned long long)ticks, (double)ticks * dt_s, (unsigned long long)active_ticks,
            safety_state_name(b->board.safety.state));
+    if (paint_scale > 0.0f)
+        printf("painted %gx: %u windows, %u chunks sent\n", (double)paint_scale,
+               b->peer.stats.windows_sent, b->peer.stats.chunks_sent);
     if (ticks > 0)
         printf("wall per tick: median %.1f us, p99 %.1f us, worst %.1f us\n",
                (double)wall[(ticks - 1) / 2] * 1e-3, (double)wall[(ticks * 99 - 1) / 100] * 1e-3,
