@@ -102,9 +102,15 @@ void gsolve_set_material(gsolve_t *gs, const spring_material_t *m)
 
 argil_err_t gsolve_init(gsolve_t *gs, grid_t *g)
 {
+    return gsolve_init_ratio(gs, g, GSOLVE_RATIO_DEFAULT);
+}
+
+argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
+{
     memset(gs, 0, sizeof(*gs));
-    argil_err_t e = field_init(&gs->field, g->spacing_m * (float)GSOLVE_RATIO, GSOLVE_RATIO,
-                               g->origin_m);
+    if (ratio != 1 && ratio != 2 && ratio != GSOLVE_RATIO_MAX)
+        return ARGIL_ERR_ARG;
+    argil_err_t e = field_init(&gs->field, g->spacing_m * (float)ratio, ratio, g->origin_m);
     if (e != ARGIL_OK)
         return e;
     gs->field.iso = g->iso;
@@ -212,6 +218,133 @@ void gsolve_close_window(gsolve_t *gs)
     close_window(gs);
 }
 
+int32_t gsolve_ratio(const gsolve_t *gs)
+{
+    return gs->field.ratio;
+}
+
+argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3], int32_t hi[3])
+{
+    for (int a = 0; a < 3; a++)
+        lo[a] = hi[a] = 0;
+    if (max_dd)
+        *max_dd = 0.0f;
+    field_t *f = &gs->field;
+    if (f->ratio < 2)
+        return ARGIL_ERR_STATE;
+    /* The field is current after every step (p, velocity, d, rest): only the window goes. */
+    close_window(gs);
+    const int32_t zero[3] = {0, 0, 0};
+    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    float *before = malloc(2 * n * sizeof(float));
+    if (!before)
+        return ARGIL_ERR_NOMEM;
+    float *after = before + n;
+    sparse_read_box(&f->samp, FS_D, zero, g->dims, before);
+    const uint32_t gen = f->lattice_gen;
+    argil_err_t e = field_refine(f);
+    if (e != ARGIL_OK && f->lattice_gen != gen) {
+        /* Out of memory after the finer coefficients replaced the coarse ones: some d may still
+         * hold the old values (field.h); recompute the grid's part once more. */
+        const argil_err_t e2 = field_refresh(f, zero, g->dims);
+        if (e2 == ARGIL_OK)
+            e = ARGIL_OK;
+    }
+    if (e != ARGIL_OK) {
+        free(before);
+        return e;
+    }
+    sparse_read_box(&f->samp, FS_D, zero, g->dims, after);
+    /* The grid follows only a density the refinement itself moved by > GSOLVE_VIEW_EPS (none
+     * measured: ~5e-7): a sample the view left within GSOLVE_VIEW_EPS of the field stays as it
+     * is, so the grid, the mesh and the board's window do not change at all. */
+    float dd = 0.0f;
+    bool changed = false;
+    for (size_t i = 0; i < n; i++) {
+        const float c = fabsf(after[i] - before[i]);
+        if (c > dd)
+            dd = c;
+        if (c > GSOLVE_VIEW_EPS) {
+            g->density[i] = clamp01(after[i]);
+            changed = true;
+        }
+    }
+    free(before);
+    gs->stats.refines++;
+    if (max_dd)
+        *max_dd = dd;
+    if (changed)
+        for (int a = 0; a < 3; a++)
+            hi[a] = g->dims[a];
+    return ARGIL_OK;
+}
+
+static double dot(const float *a, const float *b, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++)
+        s += (double)a[i] * b[i];
+    return s;
+}
+
+/* Least squares for R > 1: GSOLVE_SEED_FIT_ITERS of CGLS on A p = d over the grid's samples in
+ * [lo, hi), from the quasi-interpolant already in the field (the coefficients those samples
+ * depend on are free). */
+static argil_err_t seed_fit(field_t *f, const grid_t *g, const int32_t lo[3], const int32_t hi[3])
+{
+    int32_t a0[3], a1[3], clo[3], chi[3], nc[3], ns[3];
+    if (!clip_to_grid(g, lo, hi, a0, a1))
+        return ARGIL_OK;
+    field_coefs_of_samples(f, a0, a1, clo, chi);
+    size_t ncoef = 1, nsamp = 1;
+    for (int a = 0; a < 3; a++) {
+        nc[a] = chi[a] - clo[a];
+        ns[a] = a1[a] - a0[a];
+        ncoef *= (size_t)nc[a];
+        nsamp *= (size_t)ns[a];
+    }
+    /* What field_samples_from and field_coefs_from need as scratch (field.h). */
+    const size_t tmp_a = (size_t)ns[0] * nc[1] * nc[2] + (size_t)ns[0] * ns[1] * nc[2];
+    const size_t tmp_at = (size_t)nc[0] * ns[1] * ns[2] + (size_t)nc[0] * nc[1] * ns[2];
+    float *buf = malloc((3 * ncoef + 2 * nsamp + (tmp_a > tmp_at ? tmp_a : tmp_at)) *
+                        sizeof(float));
+    if (!buf)
+        return ARGIL_ERR_NOMEM;
+    float *P = buf, *S = P + ncoef, *Q = S + ncoef, *Rs = Q + ncoef, *T = Rs + nsamp,
+          *tmp = T + nsamp;
+    sparse_read_box(&f->coef, FC_P, clo, nc, P);
+    field_samples_from(f, P, clo, nc, a0, a1, Rs, tmp);
+    for (int32_t z = 0, k = 0; z < ns[2]; z++)
+        for (int32_t y = 0; y < ns[1]; y++)
+            for (int32_t x = 0; x < ns[0]; x++, k++)
+                Rs[k] = g->density[(size_t)(a0[0] + x) + (size_t)g->dims[0] *
+                                   ((size_t)(a0[1] + y) + (size_t)g->dims[1] *
+                                    (size_t)(a0[2] + z))] - Rs[k];
+    field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
+    memcpy(Q, S, ncoef * sizeof(float));
+    double gamma = dot(S, S, ncoef);
+    for (int it = 0; it < GSOLVE_SEED_FIT_ITERS && gamma > 0.0; it++) {
+        field_samples_from(f, Q, clo, nc, a0, a1, T, tmp);
+        const double tt = dot(T, T, nsamp);
+        if (!(tt > 0.0))
+            break;
+        const float alpha = (float)(gamma / tt);
+        for (size_t i = 0; i < ncoef; i++)
+            P[i] += alpha * Q[i];
+        for (size_t i = 0; i < nsamp; i++)
+            Rs[i] -= alpha * T[i];
+        field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
+        const double gamma1 = dot(S, S, ncoef);
+        const float beta = (float)(gamma1 / gamma);
+        gamma = gamma1;
+        for (size_t i = 0; i < ncoef; i++)
+            Q[i] = S[i] + beta * Q[i];
+    }
+    const argil_err_t e = sparse_write_box(&f->coef, FC_P, clo, nc, P);
+    free(buf);
+    return e;
+}
+
 argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     field_t *f = &gs->field;
@@ -251,6 +384,8 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         memset(p, 0, ncoef * sizeof(float));
         e = sparse_write_box(&f->coef, FC_V, clo, nc, p);
     }
+    if (e == ARGIL_OK && f->ratio > 1)
+        e = seed_fit(f, g, lo, hi);
     if (e == ARGIL_OK)
         e = field_refresh(f, slo, shi);
     if (e != ARGIL_OK)
@@ -286,26 +421,32 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
     if (!(dt_s > 0.0f) || !isfinite(dt_s))
         return ARGIL_ERR_ARG;
     field_t *f = &gs->field;
-    if (gs->win_open && (memcmp(lo, gs->box_lo, sizeof(gs->box_lo)) != 0 ||
-                         memcmp(hi, gs->box_hi, sizeof(gs->box_hi)) != 0)) {
-        /* Same size, shifted by whole knot spans: move the open window instead of reopening. */
+    /* The coefficients whose samples cover the box (at least 4 per axis). */
+    int32_t clo[3], chi[3];
+    for (int a = 0; a < 3; a++) {
+        clo[a] = floordiv(lo[a], f->ratio);
+        chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
+        if (chi[a] - clo[a] < 4)
+            chi[a] = clo[a] + 4;
+    }
+    if (gs->win_open && (memcmp(clo, gs->win.clo, sizeof(clo)) != 0 ||
+                         memcmp(chi, gs->win.chi, sizeof(chi)) != 0)) {
+        /* Same size, shifted by whole knot spans (R samples each; a box that moved less stays
+         * on the same coefficients): move the open window instead of reopening. */
         bool same = true;
         int32_t shift[3];
         for (int a = 0; a < 3; a++) {
-            shift[a] = lo[a] - gs->box_lo[a];
-            same = same && hi[a] - lo[a] == gs->box_hi[a] - gs->box_lo[a] &&
-                   shift[a] % f->ratio == 0;
+            shift[a] = clo[a] - gs->win.clo[a];
+            same = same && chi[a] - clo[a] == gs->win.chi[a] - gs->win.clo[a];
         }
         if (same) {
             physwin_t *w = &gs->win;
             for (int a = 0; a < 3; a++) {
-                w->clo[a] += shift[a] / f->ratio;
-                w->chi[a] += shift[a] / f->ratio;
-                w->slo[a] += shift[a];
-                w->shi[a] += shift[a];
+                w->clo[a] += shift[a];
+                w->chi[a] += shift[a];
+                w->slo[a] += shift[a] * f->ratio;
+                w->shi[a] += shift[a] * f->ratio;
             }
-            memcpy(gs->box_lo, lo, sizeof(gs->box_lo));
-            memcpy(gs->box_hi, hi, sizeof(gs->box_hi));
             const argil_err_t e = reload_window(gs, dt_s, true);
             if (e != ARGIL_OK) {
                 close_window(gs);
@@ -316,19 +457,16 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
             close_window(gs);
         }
     }
+    if (gs->win_open) {
+        memcpy(gs->box_lo, lo, sizeof(gs->box_lo));
+        memcpy(gs->box_hi, hi, sizeof(gs->box_hi));
+    }
     if (gs->win_open && gs->stale) {
         const argil_err_t e = reload_window(gs, dt_s, false);
         if (e != ARGIL_OK)
             return e;
     }
     if (!gs->win_open) {
-        int32_t clo[3], chi[3];
-        for (int a = 0; a < 3; a++) {
-            clo[a] = floordiv(lo[a], f->ratio);
-            chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
-            if (chi[a] - clo[a] < 4)
-                chi[a] = clo[a] + 4;
-        }
         gs->cfg.dt_s = dt_s;
         const argil_err_t e = physwin_open(&gs->win, f, clo, chi, &gs->cfg);
         if (e != ARGIL_OK)
@@ -437,46 +575,10 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
 argil_err_t gsolve_carve_sphere(gsolve_t *gs, grid_t *g, vec3_t centre_m, float radius_m,
                                 int32_t lo[3], int32_t hi[3])
 {
-    for (int a = 0; a < 3; a++)
-        lo[a] = hi[a] = 0;
-    if (!vec3_isfinite(centre_m) || !isfinite(radius_m) || !(radius_m >= 0.0f))
-        return ARGIL_ERR_ARG;
-    field_t *f = &gs->field;
-    /* The tool changes coefficients the open window holds: reload it on the next step. */
-    gs->stale = gs->win_open;
-    gs->resting = false;
-    tool_shape_t t;
-    memset(&t, 0, sizeof(t));
-    t.kind = TOOL_SPHERE;
-    t.radius_m = radius_m;
-    tool_pose_t pose;
-    tool_pose_at(&pose, centre_m);
-    tool_params_t prm;
-    tool_params_default(&prm, TOOL_CARVE);
-    tool_stats_t st;
-    memset(&st, 0, sizeof(st));
-    const argil_err_t e = tool_apply(f, &t, &pose, &prm, NULL, &st);
-    if (e != ARGIL_OK)
-        return e;
-    gs->stats.carves++;
-    if (st.coefs_changed == 0)
-        return ARGIL_OK;
-    /* Samples a changed coefficient can reach: the sphere, the ramp and two knot spans. */
-    const float reach_m = radius_m + f->band_m + 3.0f * f->coef_spacing_m;
-    const float c[3] = {centre_m.x - f->origin_m.x, centre_m.y - f->origin_m.y,
-                        centre_m.z - f->origin_m.z};
-    int32_t slo[3], shi[3];
-    for (int a = 0; a < 3; a++) {
-        slo[a] = (int32_t)floorf((c[a] - reach_m) / f->sample_spacing_m);
-        shi[a] = (int32_t)ceilf((c[a] + reach_m) / f->sample_spacing_m) + 1;
-    }
-    const float change = view_to_grid(gs, g, slo, shi);
-    if (change < 0.0f)
-        return ARGIL_ERR_NOMEM;
-    if (change > 0.0f && !clip_to_grid(g, slo, shi, lo, hi))
-        for (int a = 0; a < 3; a++)
-            lo[a] = hi[a] = 0;
-    return ARGIL_OK;
+    /* The host tool's default (carve, sphere, no mirror) at one point: the same tool_apply. */
+    host_tool_t ht;
+    host_tool_default(&ht);
+    return gsolve_apply_tool(gs, g, &ht, radius_m, vec3(0, 0, 1), &centre_m, 1, 1.0f, lo, hi);
 }
 
 argil_err_t gsolve_paint(gsolve_t *gs, gsolve_material_t ch, vec3_t centre_m, float radius_m,
@@ -504,4 +606,210 @@ float gsolve_material_at(const gsolve_t *gs, gsolve_material_t ch, vec3_t x_m)
         s[a] = (int32_t)lrintf(u);
     }
     return sparse_get(&f->samp, ch == GSOLVE_MAT_MASS ? FS_MASS : FS_STIFF, s[0], s[1], s[2]);
+}
+
+bool gsolve_material_box(const gsolve_t *gs, gsolve_material_t ch, const int32_t lo[3],
+                         const int32_t dims[3], float *out)
+{
+    const int32_t n = dims[0] * dims[1] * dims[2];
+    for (int32_t i = 0; i < n; i++)
+        out[i] = 1.0f; /* what a refused box reads */
+    sparse_read_box(&gs->field.samp, ch == GSOLVE_MAT_MASS ? FS_MASS : FS_STIFF, lo, dims, out);
+    bool painted = false;
+    for (int32_t i = 0; i < n; i++)
+        painted |= out[i] != 1.0f;
+    return painted;
+}
+
+/* ---- painted material and the grid's channels (helper "persist": .argil MTLS, journal) ---- */
+
+static const int GSOLVE_GRID_MAT_FS[GRID_MAT_N] = {FS_STIFF, FS_MASS, FS_DAMP, FS_RESTLEN};
+
+argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3],
+                                    const int32_t hi[3])
+{
+    int32_t a0[3], a1[3], n[3];
+    if (!clip_to_grid(g, lo, hi, a0, a1))
+        return ARGIL_OK;
+    for (int a = 0; a < 3; a++)
+        n[a] = a1[a] - a0[a];
+    const size_t vol = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    float *v = malloc(vol * sizeof(float));
+    if (v == NULL)
+        return ARGIL_ERR_NOMEM;
+    bool changed = false;
+    argil_err_t e = ARGIL_OK;
+    for (int ch = 0; ch < GRID_MAT_N && e == ARGIL_OK; ch++) {
+        sparse_read_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], a0, n, v);
+        size_t k = 0;
+        for (int32_t z = a0[2]; z < a1[2] && e == ARGIL_OK; z++)
+            for (int32_t y = a0[1]; y < a1[1] && e == ARGIL_OK; y++)
+                for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
+                    const size_t i = (size_t)x + (size_t)g->dims[0] *
+                                     ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+                    const float old = grid_mat_value(g, (grid_mat_t)ch, i);
+                    if (memcmp(&old, &v[k], sizeof(float)) == 0)
+                        continue;
+                    if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
+                        e = ARGIL_ERR_NOMEM;
+                        break;
+                    }
+                    g->mat[ch][i] = v[k];
+                    changed = true;
+                }
+    }
+    free(v);
+    if (changed)
+        g->mat_writes++;
+    return e;
+}
+
+argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
+{
+    const int32_t lo[3] = {0, 0, 0};
+    bool any = false;
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        if (g->mat[ch] == NULL)
+            continue;
+        const argil_err_t e = sparse_write_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], lo,
+                                               g->dims, g->mat[ch]);
+        if (e != ARGIL_OK)
+            return e;
+        any = true;
+    }
+    if (any && gs->win_open)
+        physwin_sync_inputs(&gs->win, &gs->field);
+    gs->resting = false;
+    return ARGIL_OK;
+}
+
+/* ---- the session's host tool (helper "hosttools"; host/app/host_tool.h) ---- */
+
+static const tool_action_t HOST_TO_TOOL_ACTION[HOST_ACT_COUNT] = {
+    [HOST_ACT_CARVE] = TOOL_CARVE,       [HOST_ACT_ADD] = TOOL_ADD,
+    [HOST_ACT_TOOTHPASTE] = TOOL_TOOTHPASTE, [HOST_ACT_SOFT_ERASE] = TOOL_SOFT_ERASE,
+    [HOST_ACT_SMOOTH] = TOOL_SMOOTH,     [HOST_ACT_STAMP] = TOOL_STAMP,
+    [HOST_ACT_CHISEL] = TOOL_CHISEL,     [HOST_ACT_SQUIRT] = TOOL_SQUIRT,
+    [HOST_ACT_INTERIOR_CARVE] = TOOL_INTERIOR_CARVE};
+
+/* The tool's frame with local z along axis (unit): x and y complete a right-handed frame. */
+static void pose_along(tool_pose_t *pose, vec3_t pos_m, vec3_t w)
+{
+    tool_pose_at(pose, pos_m);
+    const vec3_t ref = fabsf(w.x) > 0.9f ? vec3(0, 1, 0) : vec3(1, 0, 0);
+    const vec3_t uc = vec3_cross(ref, w);
+    const vec3_t u = vec3_scale(uc, 1.0f / vec3_norm(uc));
+    const vec3_t v = vec3_cross(w, u);
+    const float col[3][3] = {{u.x, u.y, u.z}, {v.x, v.y, v.z}, {w.x, w.y, w.z}};
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            pose->rot[r][c] = col[c][r];
+}
+
+argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, float radius_m,
+                              vec3_t axis, const vec3_t *pts_m, size_t n_pts, float dt_s,
+                              int32_t lo[3], int32_t hi[3])
+{
+    for (int a = 0; a < 3; a++)
+        lo[a] = hi[a] = 0;
+    const float axis_len = vec3_norm(axis);
+    if (ht == NULL || !host_tool_valid(ht) || !isfinite(radius_m) || !(radius_m > 0.0f) ||
+        radius_m > 1.0f || !(axis_len > 1e-6f) || !isfinite(axis_len) || pts_m == NULL ||
+        n_pts == 0 || !isfinite(dt_s) || !(dt_s > 0.0f))
+        return ARGIL_ERR_ARG;
+    for (size_t i = 0; i < n_pts; i++)
+        if (!vec3_isfinite(pts_m[i]))
+            return ARGIL_ERR_NONFINITE;
+    field_t *f = &gs->field;
+    /* The tool changes coefficients the open window holds: reload it on the next step. */
+    gs->stale = gs->win_open;
+    gs->resting = false;
+    tool_shape_t t;
+    memset(&t, 0, sizeof(t));
+    switch (ht->shape) {
+    case HOST_SHAPE_BOX:
+        t.kind = TOOL_BOX;
+        t.half_m = vec3(radius_m, radius_m, radius_m);
+        break;
+    case HOST_SHAPE_CYLINDER:
+        t.kind = TOOL_CYLINDER;
+        t.radius_m = radius_m;
+        t.half_len_m = radius_m;
+        break;
+    case HOST_SHAPE_TORUS:
+        t.kind = TOOL_TORUS;
+        t.radius_m = radius_m;
+        t.radius2_m = radius_m * HOST_TORUS_TUBE_FRACTION;
+        break;
+    default:
+        t.kind = TOOL_SPHERE;
+        t.radius_m = radius_m;
+        break;
+    }
+    tool_pose_t pose;
+    if (t.kind == TOOL_SPHERE)
+        tool_pose_at(&pose, pts_m[0]); /* no rotation: the eraser the session always applied */
+    else
+        pose_along(&pose, pts_m[0], vec3_scale(axis, 1.0f / axis_len));
+    tool_params_t prm;
+    tool_params_default(&prm, HOST_TO_TOOL_ACTION[ht->action]);
+    const float per_step = ht->strength * dt_s;
+    if (ht->action == HOST_ACT_CHISEL || ht->action == HOST_ACT_SQUIRT)
+        prm.depth_m = per_step * 1e-3f; /* strength: mm per second */
+    else if (host_action_has_strength(ht->action))
+        prm.strength = per_step < 1.0f ? per_step : 1.0f;
+    prm.mirror = ht->mirror;
+    prm.mirror_origin_m = vec3(0, 0, 0); /* the model's origin planes */
+    argil_err_t e;
+    bool changed = true;
+    if (n_pts == 1) {
+        tool_stats_t st;
+        memset(&st, 0, sizeof(st));
+        e = tool_apply(f, &t, &pose, &prm, NULL, &st);
+        changed = st.coefs_changed > 0;
+    } else {
+        e = tool_stroke(f, &t, &pose, pts_m, n_pts, &prm, NULL);
+    }
+    if (e != ARGIL_OK)
+        return e;
+    gs->stats.carves++;
+    if (!changed)
+        return ARGIL_OK;
+    /* Samples a changed coefficient can reach: the tool (a stamp's rim reaches (s + m + r) / s
+     * of it), the ramp and two knot spans; one box per mirror image of the stroke. */
+    float bound_m = tool_bound_m(&t);
+    if (ht->action == HOST_ACT_STAMP)
+        bound_m *= (prm.stamp.s + prm.stamp.m + prm.stamp.r) / prm.stamp.s;
+    const float reach_m = bound_m + f->band_m + 3.0f * f->coef_spacing_m;
+    const float org[3] = {f->origin_m.x, f->origin_m.y, f->origin_m.z};
+    bool any = false;
+    for (uint32_t m = 0; m < 8; m++) {
+        if ((m & ~ht->mirror) != 0)
+            continue;
+        float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < n_pts; i++) {
+            const float p[3] = {pts_m[i].x, pts_m[i].y, pts_m[i].z};
+            for (int a = 0; a < 3; a++) {
+                const float c = ((m >> a) & 1u) ? -p[a] : p[a];
+                bmin[a] = c < bmin[a] ? c : bmin[a];
+                bmax[a] = c > bmax[a] ? c : bmax[a];
+            }
+        }
+        int32_t slo[3], shi[3], clo[3], chi[3];
+        for (int a = 0; a < 3; a++) {
+            slo[a] = (int32_t)floorf((bmin[a] - org[a] - reach_m) / f->sample_spacing_m);
+            shi[a] = (int32_t)ceilf((bmax[a] - org[a] + reach_m) / f->sample_spacing_m) + 1;
+        }
+        const float change = view_to_grid(gs, g, slo, shi);
+        if (change < 0.0f)
+            return ARGIL_ERR_NOMEM;
+        if (change > 0.0f && clip_to_grid(g, slo, shi, clo, chi)) {
+            for (int a = 0; a < 3; a++) {
+                lo[a] = any && lo[a] < clo[a] ? lo[a] : clo[a];
+                hi[a] = any && hi[a] > chi[a] ? hi[a] : chi[a];
+            }
+            any = true;
+        }
+    }
+    return ARGIL_OK;
 }

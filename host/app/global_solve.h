@@ -10,6 +10,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "host/app/host_tool.h"
 #include "host/model/field.h"
 #include "host/model/grid.h"
 #include "host/model/physwin.h"
@@ -17,10 +18,16 @@
 #include "shared/density_springs.h"
 #include "shared/vec3.h"
 
-/* Samples per coefficient spacing: 1 puts a coefficient on every grid sample, so the free
- * interior of the window moves exactly as the grid's springs would (d'' = M^-1 f), only with
- * the implicit step. */
-#define GSOLVE_RATIO 1
+/* Samples per coefficient spacing R (the session's --knot-ratio; gsolve_init_ratio). 1 puts a
+ * coefficient on every grid sample, so the free interior of the window moves exactly as the
+ * grid's springs would (d'' = M^-1 f), only with the implicit step; 2 or 4 put one every 2 or 4
+ * samples (fewer coefficients, smoother clay; the window's sample box grows with R, so R = 4 is
+ * not cheaper than 2: docs/model.md), and each gsolve_refine halves R. */
+#define GSOLVE_RATIO_DEFAULT 1
+#define GSOLVE_RATIO_MAX 4
+/* At R > 1 the seed's quasi-interpolant is improved by this many CGLS iterations of the least
+ * squares fit to the grid's samples (at R = 1, A is square and the seed stays as it was). */
+#define GSOLVE_SEED_FIT_ITERS 8
 /* CG's relative stopping residual: 0, every step runs all SOLVER_CG_ITERS_MAX iterations. The
  * right side b of eq. 12 holds 4 M~ p (the whole clay's density), so any tolerance relative to
  * |b| lets a slow motion pass as converged with 0 iterations: the warm start 2 p_i - p_i-1 then
@@ -41,6 +48,7 @@ typedef struct {
     uint32_t windows_moved;           /* shifted with the board's window (not reopened) */
     uint32_t carves;
     uint32_t rest_skips;              /* solve periods the resting window was not stepped */
+    uint32_t refines;                 /* knot insertions (gsolve_refine) */
     int32_t last_cg_iters;
     float last_residual;
     float max_residual;
@@ -66,11 +74,15 @@ typedef struct {
  * grid's densities (gsolve_seed_from_grid) and the grid's material. The grid is then rewritten
  * as the field's view (densities d = A p, clamped to [0, 1]). ARGIL_ERR_NOMEM, ARGIL_ERR_ARG. */
 argil_err_t gsolve_init(gsolve_t *gs, grid_t *g);
+/* The same with R samples per knot span (1, 2 or GSOLVE_RATIO_MAX = 4; else ARGIL_ERR_ARG): coefficient c sits on
+ * grid sample R c, h_c = R x the grid spacing. */
+argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio);
 void gsolve_free(gsolve_t *gs);
 
 /* Fits the field to the grid's densities in sample box [lo, hi) (quasi-interpolation: each
- * coefficient takes the density at its own sample, which a B-spline reproduces exactly on the
- * linear density ramp), makes that the rest shape, and writes the field's view back into the
+ * coefficient takes the density at its own sample R c, which a B-spline reproduces exactly on
+ * the linear density ramp; at R > 1 then GSOLVE_SEED_FIT_ITERS of least squares), makes that
+ * the rest shape, and writes the field's view back into the
  * grid. For a model loaded into the grid (.argil, journal recovery). */
 argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3]);
 
@@ -89,6 +101,21 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
  * new one. */
 void gsolve_close_window(gsolve_t *gs);
 
+/* Samples per knot span now (R): the session's start value, halved by every gsolve_refine. */
+int32_t gsolve_ratio(const gsolve_t *gs);
+
+/* Knot insertion during the session (field_refine): a knot in the middle of every span of the
+ * whole field, so h_c and R halve and the shape does not change: every sample's density is
+ * recomputed from the finer coefficients (equal to float rounding) and the grid is rewritten
+ * only where the refinement moved a density by > GSOLVE_VIEW_EPS (none measured: so neither the
+ * view, the mesh, the journal nor the board's window changes). The open physical window is closed (its coefficient indices name other
+ * places now); the next gsolve_step opens one on the new lattice and the motion goes on (the
+ * coefficient velocities refine like p). max_dd (may be NULL) gets the largest |change| of a
+ * field density over the grid's samples; lo/hi the grid box rewritten (lo = hi: none).
+ * ARGIL_ERR_STATE at R = 1 (already one coefficient per sample: nothing changes);
+ * ARGIL_ERR_ARG / ARGIL_ERR_NOMEM from field_refine. */
+argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3], int32_t hi[3]);
+
 /* Carves a sphere out of the model (host/model/tools.c, TOOL_CARVE) and copies the result into
  * the grid; changed samples box in lo/hi (lo = hi = 0 when nothing changed). */
 argil_err_t gsolve_carve_sphere(gsolve_t *gs, grid_t *g, vec3_t centre_m, float radius_m,
@@ -102,5 +129,38 @@ argil_err_t gsolve_paint(gsolve_t *gs, gsolve_material_t ch, vec3_t centre_m, fl
 
 /* The painted scale at x (nearest sample; 1 = the base material). */
 float gsolve_material_at(const gsolve_t *gs, gsolve_material_t ch, vec3_t x_m);
+
+/* Copies the painted scale of ch over the sample box [lo, lo + dims) into out (x fastest; 1 =
+ * the base material, also for a box the store refuses) and returns true when any of them is not
+ * 1: what the board's window needs to carry a per-node stiffness (host/app/peer.c). */
+bool gsolve_material_box(const gsolve_t *gs, gsolve_material_t ch, const int32_t lo[3],
+                         const int32_t dims[3], float *out);
+
+/* Mirrors the model's painted channels (FS_STIFF, FS_MASS, FS_DAMP, FS_RESTLEN) in sample box
+ * [lo, hi) (clipped to the grid) into the grid's mat channels, bit for bit, allocating a channel
+ * only once it holds a painted value; bumps g->mat_writes when anything changed (the journal
+ * then records it). After every paint; ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3],
+                                    const int32_t hi[3]);
+
+/* The other way, for a model loaded into the grid (.argil, journal recovery): the grid's
+ * painted channels become the model's FS_STIFF, FS_MASS, FS_DAMP, FS_RESTLEN (absent channels
+ * leave the model's as they are). ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g);
+
+/* ---- the session's host tool (helper "hosttools"; host/app/host_tool.h) ---- */
+
+/* Applies the host tool once (host/model/tools.c, no undo step): its action and shape at the
+ * stroke points pts_m[0..n_pts) (n_pts >= 1; between consecutive points the poses are spaced
+ * <= band / 2, as tool_stroke does) and at their mirror images across the model's origin
+ * planes, as one union. radius_m is the board tool's radius; axis (need not be unit, not zero)
+ * orients box, cylinder and torus (a sphere ignores it); the per-second strength acts for dt_s.
+ * The result is copied into the grid; the changed sample box goes to lo/hi (lo = hi = 0: none).
+ * The default setting at one point is exactly gsolve_carve_sphere. ARGIL_ERR_ARG for a setting
+ * out of range, a radius not in (0, 1] m, a zero or non-finite axis, n_pts 0 or dt_s not > 0;
+ * ARGIL_ERR_NONFINITE for a point; ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, float radius_m,
+                              vec3_t axis, const vec3_t *pts_m, size_t n_pts, float dt_s,
+                              int32_t lo[3], int32_t hi[3]);
 
 #endif

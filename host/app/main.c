@@ -62,14 +62,19 @@ static void usage_sculpt(FILE *f)
             "                  board over USB or UDP: 'argil connect --device usb|udp:H:P')\n"
             "  --script FILE   the session script (default scripts/default.scn; format in\n"
             "                  docs/script.md)\n"
-            "  --out DIR       where to write final.ply, telemetry.csv and session.scn\n"
-            "                  (default out; created if missing)\n"
+            "  --out DIR       where to write final.ply, model.argil (with any painted\n"
+            "                  material), telemetry.csv and session.scn (default out;\n"
+            "                  created if missing)\n"
             "  --window N      edge of the board's local density window in samples, 4..32\n"
             "                  (default 16)\n"
             "  --global-solve bspline|springs\n"
             "                  the host's global solve: the implicit B-spline model or the\n"
             "                  explicit density springs on the grid (default bspline;\n"
             "                  docs/model.md)\n"
+            "  --knot-ratio 1|2|4\n"
+            "                  B-spline: grid samples per knot span at the start (default 1,\n"
+            "                  one coefficient per sample); 2 or 4 solve fewer coefficients and\n"
+            "                  a script's 'refine' (or the K key) inserts knots: R halves\n"
             "  --quiet         no progress line and no summary\n"
             "  --screenshot FILE.png\n"
             "                  afterwards, render the final clay with the tool where it ended\n"
@@ -179,6 +184,14 @@ int cmd_sculpt(int argc, char **argv)
             }
             i++;
             o.global_solve = v[0] == 'b' ? PEER_SOLVE_BSPLINE : PEER_SOLVE_SPRINGS;
+        } else if (strcmp(a, "--knot-ratio") == 0) {
+            if (!v || (strcmp(v, "1") != 0 && strcmp(v, "2") != 0 && strcmp(v, "4") != 0)) {
+                fprintf(stderr, "argil sculpt: --knot-ratio needs 1, 2 or 4 (grid samples per "
+                                "knot span)\n");
+                return 2;
+            }
+            i++;
+            o.knot_ratio = v[0] - '0';
         } else if (strcmp(a, "--iso2") == 0) {
             char *end = NULL;
             const double x = v ? strtod(v, &end) : 0.0;
@@ -311,6 +324,11 @@ int cmd_sculpt(int argc, char **argv)
                o.global_solve == PEER_SOLVE_BSPLINE ? "B-spline model (implicit)"
                                                     : "density springs (explicit)",
                s.solves, s.solve_median_ms, s.solve_p99_ms, s.solve_max_ms, s.real_seconds);
+        if (o.global_solve == PEER_SOLVE_BSPLINE)
+            printf("  knots               %d sample%s per knot span at the start, %d at the end; "
+                   "%u refinement%s (largest density change %.2g)\n",
+                   o.knot_ratio, o.knot_ratio == 1 ? "" : "s", s.knot_ratio_end, s.refines,
+                   s.refines == 1 ? "" : "s", (double)s.refine_max_dd);
         printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
                (double)s.force_limit_n);
         printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,

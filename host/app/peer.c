@@ -13,6 +13,7 @@ void peer_cfg_default(peer_cfg_t *cfg)
 {
     cfg->window_edge = 16;
     cfg->global_solve = PEER_SOLVE_SPRINGS;
+    cfg->knot_ratio = GSOLVE_RATIO_DEFAULT;
     cfg->heartbeat_period_us = 5000u;
     cfg->solve_period_us = 10000u;
     cfg->window_min_period_us = 20000u;
@@ -23,9 +24,11 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
                       peer_telemetry_fn on_telemetry, void *ctx)
 {
     if (cfg->window_edge < 4 || cfg->window_edge > ARGIL_WINDOW_MAX ||
-        (cfg->global_solve != PEER_SOLVE_SPRINGS && cfg->global_solve != PEER_SOLVE_BSPLINE))
+        (cfg->global_solve != PEER_SOLVE_SPRINGS && cfg->global_solve != PEER_SOLVE_BSPLINE) ||
+        (cfg->knot_ratio != 1 && cfg->knot_ratio != 2 && cfg->knot_ratio != 4))
         return ARGIL_ERR_ARG;
     memset(p, 0, sizeof(*p));
+    host_tool_default(&p->host_tool);
     p->cfg = *cfg;
     p->grid = grid;
     p->send = send;
@@ -34,8 +37,9 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
     p->next_version = 1;
     p->margin = PEER_MARGIN_MAX;
     p->stats.margin_min = PEER_MARGIN_MAX;
-    p->win_samples = malloc((size_t)cfg->window_edge * cfg->window_edge * cfg->window_edge *
-                            sizeof(float));
+    /* Densities, then room for the per-node stiffness of a painted window (channels 2). */
+    p->win_samples = malloc((size_t)PROTO_WINDOW_CHANNELS_MAX * (size_t)cfg->window_edge *
+                            (size_t)cfg->window_edge * (size_t)cfg->window_edge * sizeof(float));
     if (!p->win_samples)
         return ARGIL_ERR_NOMEM;
     for (int a = 0; a < 3; a++) {
@@ -50,7 +54,10 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
             peer_free(p);
             return ARGIL_ERR_NOMEM;
         }
-        const argil_err_t e = gsolve_init(p->gs, grid);
+        argil_err_t e = gsolve_init_ratio(p->gs, grid, cfg->knot_ratio);
+        /* A loaded model's painted material (.argil MTLS, journal recovery). */
+        if (e == ARGIL_OK && (e = gsolve_material_from_grid(p->gs, grid)) != ARGIL_OK)
+            gsolve_free(p->gs);
         if (e != ARGIL_OK) {
             free(p->gs);
             p->gs = NULL;
@@ -243,7 +250,17 @@ static void start_window(peer_t *p)
     p->head.damping = g->material.damping;
     p->head.plastic_rate_hz = g->material.plastic_rate_hz;
     p->head.impulse_seq = p->impulse_seq_applied;
-    p->head.channels = 1;
+    /* Painted stiffness is felt: when any node of the window has a painted scale, the window
+     * carries each node's spring stiffness (base × scale) as a second channel; an unpainted
+     * window stays one channel, as cheap as before. Painted mass acts in the global solve only
+     * (the wire has one node_mass per window: docs/model.md "In the session"). */
+    float *node_k = p->win_samples + (size_t)e * (size_t)e * (size_t)e;
+    const bool painted =
+        p->gs && gsolve_material_box(p->gs, GSOLVE_MAT_STIFFNESS, r.corner, dims, node_k);
+    if (painted)
+        for (int32_t i = 0; i < e * e * e; i++)
+            node_k[i] *= g->material.stiffness;
+    p->head.channels = painted ? 2 : 1;
     p->head.chunk_count = window_chunk_count(p->head.dims, p->head.channels);
     p->sending = r;
     p->sending_active = true;
@@ -359,6 +376,44 @@ static void solve_error(peer_t *p, argil_err_t e)
     p->stats.last_solve_error = e;
 }
 
+/* The host tool at the stylus (peer_set_host_tool), once this solve period. A stylus that
+ * moved more than band / 2 (2.5 mm) since the last application (faster than 0.25 m/s at
+ * 10 ms) gets the poses in between too, so a fast stroke leaves no gaps; a slower one is one
+ * pose, exactly the eraser the session always applied. */
+static argil_err_t apply_host_tool(peer_t *p, int32_t lo[3], int32_t hi[3])
+{
+    const vec3_t at = tool_pos(p);
+    vec3_t pts[2] = {at, at};
+    size_t n = 1;
+    const float step_m = 0.5f * p->grid->band_m;
+    if (p->host_prev_valid) {
+        const vec3_t d = vec3_sub(at, p->host_prev_m);
+        const float len = vec3_norm(d);
+        /* Longer than 10 cm in one period is a jump (a new window, a glitch), not a stroke. */
+        if (len > step_m && len < 0.1f) {
+            pts[0] = vec3_add(p->host_prev_m, vec3_scale(d, step_m / len));
+            pts[1] = at;
+            n = 2;
+        }
+    }
+    p->host_prev_m = at;
+    p->host_prev_valid = true;
+    const vec3_t axis = vec3(p->tool.axis[0], p->tool.axis[1], p->tool.axis[2]);
+    return gsolve_apply_tool(p->gs, p->grid, &p->host_tool, p->tool.radius_m,
+                             vec3_norm(axis) > 1e-6f ? axis : vec3(0, 0, 1), pts, n,
+                             (float)p->cfg.solve_period_us * 1e-6f, lo, hi);
+}
+
+argil_err_t peer_set_host_tool(peer_t *p, const host_tool_t *t)
+{
+    if (!host_tool_valid(t))
+        return ARGIL_ERR_ARG;
+    if (!p->gs && !host_tool_is_default(t))
+        return ARGIL_ERR_STATE;
+    p->host_tool = *t;
+    return ARGIL_OK;
+}
+
 /* The global solve on the B-spline model: carving through host/model/tools.c, then one
  * implicit step in the physical window (the board's window and a margin). */
 static void solve_bspline(peer_t *p)
@@ -371,13 +426,15 @@ static void solve_bspline(peer_t *p)
     const bool active = p->have_tm && p->last_tm.state == SAFETY_ACTIVE;
     if (active && p->last_tm.tool_kind == TOOL_CARVE && (p->last_tm.buttons & 1u)) {
         int32_t lo[3], hi[3];
-        const argil_err_t e = gsolve_carve_sphere(p->gs, g, tool_pos(p), p->tool.radius_m, lo, hi);
+        const argil_err_t e = apply_host_tool(p, lo, hi);
         if (e != ARGIL_OK) {
             solve_error(p, e);
         } else if (hi[0] > lo[0]) {
             mark_dirty(p, lo, hi);
             p->field_dirty = true;
         }
+    } else {
+        p->host_prev_valid = false;
     }
     if (p->have_current) {
         peer_box_t box;
@@ -537,10 +594,52 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
             lo[a] = l < 0.0f ? 0 : l > (float)g->dims[a] ? g->dims[a] : (int32_t)l;
             hi[a] = h < 0.0f ? 0 : h > (float)g->dims[a] ? g->dims[a] : (int32_t)h;
         }
-        if (lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2])
+        if (lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2]) {
+            /* The grid's painted channels follow (what .argil files and the journal keep). */
+            const argil_err_t me = gsolve_material_to_grid(p->gs, p->grid, lo, hi);
+            if (me != ARGIL_OK)
+                return me;
             mark_dirty(p, lo, hi);
+            /* A paint that reaches the board's window changes what the hand feels there: the
+             * window is sent again (with its per-node stiffness) like an edited one. */
+            const peer_window_ref_t *w = p->sending_active ? &p->sending : &p->current;
+            bool overlaps = p->sending_active || p->have_current;
+            for (int a = 0; a < 3; a++)
+                overlaps = overlaps && lo[a] < w->corner[a] + w->dims[a] && hi[a] > w->corner[a];
+            if (overlaps)
+                p->field_dirty = true;
+        }
     }
     return e;
+}
+
+argil_err_t peer_refine(peer_t *p, float *max_dd)
+{
+    if (max_dd)
+        *max_dd = 0.0f;
+    if (!p->gs)
+        return ARGIL_ERR_STATE;
+    int32_t lo[3], hi[3];
+    float dd = 0.0f;
+    const argil_err_t e = gsolve_refine(p->gs, p->grid, &dd, lo, hi);
+    if (max_dd)
+        *max_dd = dd;
+    if (e == ARGIL_OK) {
+        p->stats.refines++;
+        if (dd > p->stats.refine_max_dd)
+            p->stats.refine_max_dd = dd;
+    }
+    if (e == ARGIL_OK && hi[0] > lo[0]) {
+        /* Only where rounding moved a density past the view's threshold (none measured). */
+        mark_dirty(p, lo, hi);
+        p->field_dirty = true;
+    }
+    return e;
+}
+
+int32_t peer_knot_ratio(const peer_t *p)
+{
+    return p->gs ? gsolve_ratio(p->gs) : 0;
 }
 
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max)

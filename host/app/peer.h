@@ -48,6 +48,8 @@ typedef struct {
     peer_global_solve_t global_solve; /* PEER_SOLVE_SPRINGS by default here (argil connect,
                                        * hil-host, the SIL rig); argil sculpt's session chooses
                                        * PEER_SOLVE_BSPLINE (session_opts_default) */
+    int32_t knot_ratio;               /* B-spline: grid samples per knot span at the start, 1, 2
+                                       * or 4 (1 by default; peer_refine halves it) */
     uint32_t heartbeat_period_us;     /* 5 ms */
     uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
     uint32_t window_min_period_us;    /* refresh an edited window at most this often */
@@ -79,6 +81,8 @@ typedef struct {
     double solve_max_ms;
     uint32_t region_shrinks;          /* adaptive_region: times the margin was lowered */
     int32_t margin_min;               /* the smallest margin used (samples) */
+    uint32_t refines;                 /* knot insertions (peer_refine) */
+    float refine_max_dd;              /* the largest |density change| one of them made */
 } peer_stats_t;
 
 typedef struct {
@@ -125,6 +129,9 @@ typedef struct {
     int32_t margin;                   /* samples of the solve's margin (PEER_MARGIN_MAX unless
                                        * adaptive_region lowered it) */
     uint32_t fast_steps;              /* solve steps in a row under 40 % of the period */
+    host_tool_t host_tool;            /* what the board's carve does on the host (B-spline) */
+    vec3_t host_prev_m;               /* stylus at the last host tool application */
+    bool host_prev_valid;             /* button 1 held since then */
 } peer_t;
 
 void peer_cfg_default(peer_cfg_t *cfg);
@@ -163,6 +170,23 @@ void peer_set_solve_period_us(peer_t *p, uint32_t us);
  * ARGIL_ERR_STATE with the springs solve (uniform material), ARGIL_ERR_ARG for bad values. */
 argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, float radius_m,
                                 float scale);
+
+/* Knot insertion in the B-spline model during the session (gsolve_refine): a knot in every
+ * span, R halves, the shape stays (the grid, the mesh and the board's window do not change);
+ * the physical window reopens on the finer lattice at the next solve. max_dd (may be NULL): the
+ * largest |density change| over the grid. ARGIL_ERR_STATE with the springs solve or at R = 1
+ * (already one coefficient per sample), nothing changed; ARGIL_ERR_NOMEM. */
+argil_err_t peer_refine(peer_t *p, float *max_dd);
+
+/* What the board's carve tool does on the host while button 1 is held (host/app/host_tool.h;
+ * carve with a sphere, no mirror by default): one application per solve period at the stylus,
+ * with the tool's radius and axis (gsolve_apply_tool). ARGIL_ERR_ARG for a setting out of
+ * range; ARGIL_ERR_STATE for anything but the default with the springs solve (it carves the
+ * grid directly); nothing changes on error. */
+argil_err_t peer_set_host_tool(peer_t *p, const host_tool_t *t);
+
+/* Grid samples per knot span of the B-spline model now (0 with the springs solve). */
+int32_t peer_knot_ratio(const peer_t *p);
 
 /* Median, 99th percentile (10 µs resolution) and max of the solve steps' thread CPU times, ms. */
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max);

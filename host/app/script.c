@@ -119,6 +119,67 @@ static argil_err_t push_cmd(script_t *s, const script_cmd_t *c)
         return ARGIL_ERR_PARSE;                                                                \
     } while (0)
 
+/* The host tool's verbs (host/app/host_tool.h): action NAME [strength S], action_shape NAME,
+ * mirror none|x|y|z|xy|... */
+static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c, char *err,
+                                   size_t err_len)
+{
+    const char *op = w[0];
+    char list[160] = "";
+    const bool act = strcmp(op, "action") == 0;
+    if (strcmp(op, "mirror") == 0) {
+        const int bits = n == 2 ? host_mirror_from_name(w[1]) : -1;
+        if (n != 2)
+            FAIL("line %d: 'mirror' takes one word: none, or the axes x, y, z (e.g. xz)", lineno);
+        if (bits < 0)
+            FAIL("line %d: unknown mirror '%s' (none, x, y, z, or axes together such as xz)",
+                 lineno, w[1]);
+        c->op = SCRIPT_MIRROR;
+        c->arg_int = bits;
+        return ARGIL_OK;
+    }
+    const int count = act ? HOST_ACT_COUNT : HOST_SHAPE_COUNT;
+    for (int k = 0; k < count; k++) {
+        strncat(list, act ? host_action_name((host_action_t)k) : host_shape_name((host_shape_t)k),
+                sizeof(list) - strlen(list) - 1);
+        if (k + 1 < count)
+            strncat(list, ", ", sizeof(list) - strlen(list) - 1);
+    }
+    if (!act) {
+        if (n != 2)
+            FAIL("line %d: 'action_shape' takes one name (%s)", lineno, list);
+        const int k = host_shape_from_name(w[1]);
+        if (k < 0)
+            FAIL("line %d: unknown action_shape '%s' (%s)", lineno, w[1], list);
+        c->op = SCRIPT_ACTION_SHAPE;
+        c->arg_int = k;
+        return ARGIL_OK;
+    }
+    if (n != 2 && n != 4)
+        FAIL("line %d: 'action' takes a name (%s) and optionally strength S", lineno, list);
+    if (strcmp(w[1], "paint") == 0)
+        FAIL("line %d: 'action paint': painted colour would not show (the session's grid, mesh "
+             "and files carry no colour; docs/model.md)", lineno);
+    const int k = host_action_from_name(w[1]);
+    if (k < 0)
+        FAIL("line %d: unknown action '%s' (%s)", lineno, w[1], list);
+    c->op = SCRIPT_ACTION;
+    c->arg_int = k;
+    c->value = host_action_default_strength((host_action_t)k);
+    if (n == 4) {
+        if (strcmp(w[2], "strength") != 0)
+            FAIL("line %d: 'action' takes NAME [strength S], not '%s'", lineno, w[2]);
+        if (!host_action_has_strength((host_action_t)k))
+            FAIL("line %d: 'action %s' takes no strength (it acts in full at once)", lineno, w[1]);
+        if (!parse_float(w[3], &c->value))
+            FAIL("line %d: '%s' is not a number", lineno, w[3]);
+        if (!(c->value >= 0.0f && c->value <= HOST_STRENGTH_MAX))
+            FAIL("line %d: strength must be within 0 … %g, got %s", lineno,
+                 (double)HOST_STRENGTH_MAX, w[3]);
+    }
+    return ARGIL_OK;
+}
+
 /* Parses one line's words into a command; returns 0 for a blank line, 1 for a command. */
 static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char *err,
                               size_t err_len)
@@ -227,8 +288,16 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
         c->radius_m = radius_mm * 1e-3f;
         return ARGIL_OK;
     }
+    if (strcmp(op, "refine") == 0) {
+        if (n != 1)
+            FAIL("line %d: 'refine' takes no arguments", lineno);
+        c->op = SCRIPT_REFINE;
+        return ARGIL_OK;
+    }
+    if (strcmp(op, "action") == 0 || strcmp(op, "action_shape") == 0 || strcmp(op, "mirror") == 0)
+        return parse_host_tool(w, n, lineno, c, err, err_len);
     FAIL("line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
-         "wait, paint)",
+         "wait, paint, refine, action, action_shape, mirror)",
          lineno, op);
 }
 
@@ -328,6 +397,24 @@ int script_first_paint_line(const script_t *s)
     return 0;
 }
 
+int script_first_host_tool_line(const script_t *s)
+{
+    for (size_t i = 0; i < s->count; i++)
+        if (s->cmds[i].op == SCRIPT_ACTION || s->cmds[i].op == SCRIPT_ACTION_SHAPE ||
+            s->cmds[i].op == SCRIPT_MIRROR)
+            return s->cmds[i].line;
+    return 0;
+}
+
+int script_refine_line(const script_t *s, int nth)
+{
+    int k = 0;
+    for (size_t i = 0; i < s->count; i++)
+        if (s->cmds[i].op == SCRIPT_REFINE && ++k == nth)
+            return s->cmds[i].line;
+    return 0;
+}
+
 void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
 {
     memset(p, 0, sizeof(*p));
@@ -341,6 +428,7 @@ void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
     p->axis = vec3(0, 0, 1);
     for (int k = 0; k < PARAM_COUNT; k++)
         p->params[k] = PARAMS[k].def;
+    host_tool_default(&p->host_tool);
     p->params_changed = 1;
 }
 
@@ -350,6 +438,7 @@ int script_player_step(script_player_t *p, float dt_s)
      * the next step when this one already handed over SCRIPT_PAINTS_PENDING_MAX. The paints of
      * the previous step were the caller's to apply before this call. */
     p->paints_pending = 0;
+    p->refines_pending = 0;
     while (!p->active && p->next < p->script->count) {
         if (p->script->cmds[p->next].op == SCRIPT_PAINT &&
             p->paints_pending >= (int)SCRIPT_PAINTS_PENDING_MAX)
@@ -364,6 +453,22 @@ int script_player_step(script_player_t *p, float dt_s)
             pt->pos_m = p->pos_m;
             break;
         }
+        case SCRIPT_REFINE:
+            p->refines_pending++;
+            break;
+        case SCRIPT_ACTION:
+            p->host_tool.action = (host_action_t)c->arg_int;
+            p->host_tool.strength = c->value;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_ACTION_SHAPE:
+            p->host_tool.shape = (host_shape_t)c->arg_int;
+            p->params_changed = 1;
+            break;
+        case SCRIPT_MIRROR:
+            p->host_tool.mirror = (uint32_t)c->arg_int;
+            p->params_changed = 1;
+            break;
         case SCRIPT_TOOL:
             p->tool = c->arg_int;
             p->params_changed = 1;

@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/app/host_tool.h"
 #include "shared/argil_err.h"
 #include "shared/vec3.h"
 
@@ -18,7 +19,11 @@ typedef enum {
     SCRIPT_PRESS,     /* press 1|2 */
     SCRIPT_RELEASE,   /* release 1|2 */
     SCRIPT_WAIT,      /* wait SECONDS */
-    SCRIPT_PAINT      /* paint stiffness|mass SCALE radius MM: at the hand (B-spline solve) */
+    SCRIPT_PAINT,     /* paint stiffness|mass SCALE radius MM: at the hand (B-spline solve) */
+    SCRIPT_REFINE,    /* refine: a knot in every span of the B-spline model (R halves) */
+    SCRIPT_ACTION,    /* action NAME [strength S]: what carve does on the host (host_tool.h) */
+    SCRIPT_ACTION_SHAPE, /* action_shape sphere|box|cylinder|torus */
+    SCRIPT_MIRROR     /* mirror none|x|y|z|xy|...: the host tool's mirror planes */
 } script_op_t;
 
 typedef enum { SCRIPT_PAINT_STIFFNESS = 0, SCRIPT_PAINT_MASS } script_paint_ch_t;
@@ -107,10 +112,18 @@ typedef struct {
     int params_changed;       /* set when tool or a param changed since the last call */
     script_paint_t paints[SCRIPT_PAINTS_PENDING_MAX]; /* reached by the last step: the */
     int paints_pending;       /* caller applies them before the next step (which drops them) */
+    int refines_pending;      /* refine commands reached by the last step (the same rule) */
+    host_tool_t host_tool;    /* action, action_shape, mirror (sets params_changed) */
 } script_player_t;
 
 /* The first paint command's line, or 0 when the script has none. */
 int script_first_paint_line(const script_t *s);
+
+/* The first action, action_shape or mirror command's line, or 0 when the script has none. */
+int script_first_host_tool_line(const script_t *s);
+
+/* The line of the nth (1-based) refine command, or 0 when the script has fewer. */
+int script_refine_line(const script_t *s, int nth);
 
 void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m);
 /* Advances by dt_s; returns 0 while running, 1 once every command has finished. */

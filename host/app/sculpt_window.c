@@ -22,6 +22,7 @@
 #include "host/render/backend_glfw.h"
 #include "host/render/camera.h"
 #include "host/render/colour_map.h"
+#include "host/render/frame_pacer.h"
 #include "host/render/hud.h"
 #include "host/render/png_write.h"
 #include "host/render/renderer.h"
@@ -32,7 +33,6 @@
 #define FRAME_PERIOD_S (1.0 / 60.0)   /* simulated time between snapshots */
 #define EARLY_PUBLISH_S 0.008        /* least simulated time between snapshots of other changes */
 #define SOLVED_PUBLISH_S 0.002       /* ... and after a solve step took in an impulse */
-#define DISPLAY_PERIOD_NS 16666667u   /* the window draws at most this often */
 #define STATS_WINDOW_S 1.0            /* loop rate and worst tick over this much time */
 #define LATENCY_SAMPLES 4096u
 #define INTERACTIVE_NS 300000000u     /* frames skip multisampling this long after a change */
@@ -53,12 +53,22 @@ enum {
 static const char *const STAGE_NAMES[STAGE_COUNT] = {"solve", "mesh", "hand-over",
                                                      "upload", "draw", "swap"};
 
+/* What the sleeping render thread wants to be woken for (live_t.render_waiting). */
+enum { WAIT_NONE = 0, WAIT_ANY, WAIT_NEWS };
+
 static const char *const TOOL_NAMES[TOOL_KIND_COUNT] = {"touch", "push", "pull",
                                                         "carve", "probe", "rope"};
 static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussian", "spherical",
                                                            "cylindrical", "conical"};
 
 #define PANEL_SOLVE_STEP (-1)         /* panel row that is no PARAM_*: the solve period */
+/* Rows for the host tool (what carve does on the host, host/app/host_tool.h): -/+ cycle the
+ * action, shape and mirror planes, scale the strength; the keys A, S, X, Y, Z reach them too. */
+#define PANEL_HOST_ACTION (-2)
+#define PANEL_HOST_SHAPE (-3)
+#define PANEL_HOST_MIRROR (-4)
+#define PANEL_HOST_STRENGTH (-5)
+#define HOST_MIRROR_TOGGLE_X 2.0f     /* UI_CMD_PARAM value on the mirror row: toggle x (+1 y, +2 z) */
 
 /* The panel's parameters: ranges as scripts accept them (host/app/script.c), a step factor,
  * and the first value above zero for those that may be 0. */
@@ -78,6 +88,10 @@ static const struct {
     /* The host's global solve step: a peer setting, not a script parameter. */
     {PANEL_SOLVE_STEP, "solve step ms", PEER_SOLVE_PERIOD_MIN_US * 1e-3f,
      PEER_SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, PEER_SOLVE_PERIOD_MIN_US * 1e-3f},
+    {PANEL_HOST_ACTION, "carve does", 0.0f, 0.0f, 1.0f, 0.0f},
+    {PANEL_HOST_SHAPE, "host shape", 0.0f, 0.0f, 1.0f, 0.0f},
+    {PANEL_HOST_MIRROR, "mirror", 0.0f, 0.0f, 1.0f, 0.0f},
+    {PANEL_HOST_STRENGTH, "host strength /s", 0.0f, HOST_STRENGTH_MAX, 1.25f, 0.1f},
 };
 #define PANEL_N ((int)(sizeof(PANEL) / sizeof(PANEL[0])))
 
@@ -114,6 +128,9 @@ typedef struct {
     uint64_t mesh2_serial;
     int colour;                   /* colour_map_t the mesh's vertex colours show */
     float colour_lo, colour_hi;   /* the ramp's range, relative to the default material */
+    int knot_ratio;               /* B-spline samples per knot span (0: springs solve) */
+    char knot_note[64];           /* what the last K (refine) did */
+    host_tool_t host_tool;        /* what carve does on the host */
 } live_frame_t;
 
 typedef struct {
@@ -123,17 +140,22 @@ typedef struct {
     _Atomic uint64_t shown_pub;   /* pub_seq of the newest snapshot a swapped frame showed */
     ui_queue_t q;
     atomic_int want_stop, session_done;
+    atomic_int render_waiting;    /* WAIT_*: the render thread sleeps until a publish wakes it */
+    atomic_int inflight;          /* an impulse is taken in but no snapshot shows it yet */
+    glfw_window_t *win;           /* woken by publish (glfw_window_wake is thread-safe) */
     /* Session thread only. */
     const sculpt_window_opts_t *wo;
     volatile sig_atomic_t *stop;
     mc_blocks_t mcb;
     bool mcb_ready, mcb_failed;
     uint64_t serial;
+    uint64_t news_serial, news_serial2; /* the serials the last snapshot published */
     mc_blocks_t mcb2;             /* the second iso-surface's mesher (only while shown) */
     bool mcb2_ready, iso2_on;
     float iso2_level;
     uint64_t serial2;
     int colour;                   /* colour_map_t */
+    char knot_note[64];           /* what the last UI_CMD_REFINE did */
     double next_frame_s, last_t_s, last_publish_s;
     uint64_t wall0_ns;
     bool wall0_set;
@@ -180,6 +202,33 @@ void sculpt_window_opts_default(sculpt_window_opts_t *o)
 
 /* ---- session thread ---- */
 
+/* A host tool row changed (PANEL_HOST_*): the player's setting, so the session hands it to the
+ * peer like a script's `action` (the springs solve keeps carve: the HUD says so). */
+static void host_panel(session_frame_t *f, int row, float value)
+{
+    script_player_t *pl = f->player;
+    host_tool_t t = pl->host_tool;
+    const int step = value > 0.0f ? 1 : -1;
+    if (row == PANEL_HOST_ACTION) {
+        t.action = (host_action_t)(((int)t.action + step + HOST_ACT_COUNT) % HOST_ACT_COUNT);
+        t.strength = host_action_default_strength(t.action);
+    } else if (row == PANEL_HOST_SHAPE) {
+        t.shape = (host_shape_t)(((int)t.shape + step + HOST_SHAPE_COUNT) % HOST_SHAPE_COUNT);
+    } else if (row == PANEL_HOST_MIRROR) {
+        const int bit = (int)lroundf(value - HOST_MIRROR_TOGGLE_X);
+        t.mirror = bit >= 0 && bit < 3 ? t.mirror ^ (1u << bit)
+                                       : (t.mirror + (uint32_t)(step + 8)) % 8u;
+    } else if (host_action_has_strength(t.action)) {
+        const float v = step > 0 ? (t.strength > 0.0f ? t.strength * 1.25f : 0.1f)
+                                 : (t.strength / 1.25f < 0.1f ? 0.0f : t.strength / 1.25f);
+        t.strength = v > HOST_STRENGTH_MAX ? HOST_STRENGTH_MAX : v;
+    }
+    if (f->peer->gs == NULL && !host_tool_is_default(&t))
+        return; /* springs: refused by peer_set_host_tool too */
+    pl->host_tool = t;
+    pl->params_changed = 1;
+}
+
 static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
 {
     script_player_t *pl = f->player;
@@ -198,7 +247,9 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
         }
         break;
     case UI_CMD_PARAM:
-        if (c->arg >= 0 && c->arg < PANEL_N) {
+        if (c->arg >= 0 && c->arg < PANEL_N && PANEL[c->arg].param <= PANEL_HOST_ACTION) {
+            host_panel(f, PANEL[c->arg].param, c->value);
+        } else if (c->arg >= 0 && c->arg < PANEL_N) {
             const int k = PANEL[c->arg].param;
             float v = k == PANEL_SOLVE_STEP ? (float)f->peer->cfg.solve_period_us * 1e-3f
                                             : pl->params[k];
@@ -261,6 +312,21 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
                 L->serial++; /* every slot's mesh is coloured again */
         }
         break;
+    case UI_CMD_REFINE: {
+        /* Knot insertion: the shape stays, so nothing is re-meshed; the HUD says what it did. */
+        const int r0 = (int)peer_knot_ratio(f->peer);
+        float dd = 0.0f;
+        const argil_err_t e = peer_refine(f->peer, &dd);
+        if (e == ARGIL_OK)
+            snprintf(L->knot_note, sizeof(L->knot_note), "refined %d -> %d, |dd| %.0e",
+                     r0, (int)peer_knot_ratio(f->peer), (double)dd);
+        else
+            snprintf(L->knot_note, sizeof(L->knot_note), "%s",
+                     r0 == 0                ? "no knots: springs solve"
+                     : e == ARGIL_ERR_STATE ? "already at one coefficient per sample"
+                                            : "refine failed: out of memory");
+        break;
+    }
     }
 }
 
@@ -350,6 +416,9 @@ static void publish(live_t *L, session_frame_t *f)
             fr->iso2_on = false;
     }
     const uint64_t meshed_ns = now_ns();
+    bool news = L->serial != L->news_serial || L->serial2 != L->news_serial2 || L->stopping;
+    L->news_serial = L->serial;
+    L->news_serial2 = L->serial2;
     fr->pub_seq = ++L->pub_seq;
     if (L->carry && atomic_load(&L->shown_pub) >= L->carry_pub)
         L->carry = false; /* a swapped frame has shown it */
@@ -365,6 +434,8 @@ static void publish(live_t *L, session_frame_t *f)
             L->carry_meshed_ns = meshed_ns;
         }
         L->pending_since_s = -1.0;
+        atomic_store(&L->inflight, 0);
+        news = true;
     }
     fr->has_change = L->carry;
     fr->change_pub = L->carry_pub;
@@ -395,9 +466,17 @@ static void publish(live_t *L, session_frame_t *f)
     fr->filter = f->player->filter;
     memcpy(fr->params, f->player->params, sizeof(fr->params));
     fr->solve_step_ms = (float)p->cfg.solve_period_us * 1e-3f;
+    fr->knot_ratio = (int)peer_knot_ratio(p);
+    memcpy(fr->knot_note, L->knot_note, sizeof(fr->knot_note));
+    fr->host_tool = f->player->host_tool;
     fr->inverted = L->inverted;
     fr->published_ns = now_ns();
     triple_buffer_publish(&L->tb);
+    /* Wake a sleeping render thread: for any snapshot, or only for one with a new mesh. */
+    const int waiting = atomic_load(&L->render_waiting);
+    if ((waiting == WAIT_ANY || (waiting == WAIT_NEWS && news)) &&
+        atomic_exchange(&L->render_waiting, WAIT_NONE) != WAIT_NONE)
+        glfw_window_wake(L->win);
 }
 
 static void on_tick(void *ctx, session_frame_t *f)
@@ -438,6 +517,7 @@ static void on_tick(void *ctx, session_frame_t *f)
     if (L->pending_since_s < 0.0 && p->impulse_seq_received != L->pending_seq) {
         L->pending_seq = p->impulse_seq_received;
         L->pending_since_s = f->t_s;
+        atomic_store(&L->inflight, 1);
         L->pending_arrival_ns = now_ns();
         L->pending_solved_ns = 0;
     }
@@ -538,6 +618,11 @@ typedef struct {
     double stage_ms[STAGE_COUNT][LATENCY_SAMPLES]; /* each measured change's path, per stage */
     double upload_ms[LATENCY_SAMPLES], draw_ms[LATENCY_SAMPLES], swap_ms[LATENCY_SAMPLES];
     size_t n_upload;              /* frames that uploaded something */
+    double cost_ms[LATENCY_SAMPLES]; /* per frame: start of the frame → swap returned */
+    size_t n_drawn_mesh, n_drawn_snapshot, n_drawn_other; /* frames: new mesh, other news, none */
+    uint64_t drawn_serial, drawn2_serial; /* the meshes the last frame drawn showed */
+    render_scene_t drawn;         /* the scene of the last frame drawn (drawn_any) */
+    bool drawn_any;
     double fps;
 } view_t;
 
@@ -549,6 +634,15 @@ static void ui_send(live_t *L, uint8_t kind, int32_t arg, float value)
     c.arg = arg;
     c.value = value;
     ui_queue_push(&L->q, &c);
+}
+
+/* The panel row of a PARAM_* or PANEL_* code. */
+static int panel_row(int param)
+{
+    for (int k = 0; k < PANEL_N; k++)
+        if (PANEL[k].param == param)
+            return k;
+    return 0;
 }
 
 static void on_key(live_t *L, view_t *v, int key)
@@ -584,6 +678,14 @@ static void on_key(live_t *L, view_t *v, int key)
     } else if (key == GLFW_KEY_M) {
         v->colour = (v->colour + 1) % COLOUR_MAP_COUNT;
         ui_send(L, UI_CMD_COLOUR, v->colour, 0.0f);
+    } else if (key == GLFW_KEY_A || key == GLFW_KEY_S) {
+        ui_send(L, UI_CMD_PARAM, panel_row(key == GLFW_KEY_A ? PANEL_HOST_ACTION : PANEL_HOST_SHAPE),
+                1.0f);
+    } else if (key == GLFW_KEY_X || key == GLFW_KEY_Y || key == GLFW_KEY_Z) {
+        ui_send(L, UI_CMD_PARAM, panel_row(PANEL_HOST_MIRROR),
+                HOST_MIRROR_TOGGLE_X + (float)(key - GLFW_KEY_X));
+    } else if (key == GLFW_KEY_K) {
+        ui_send(L, UI_CMD_REFINE, 0, 0.0f); /* knot insertion: R halves */
     } else if (key == GLFW_KEY_ESCAPE) {
         /* In order after the keys before it; straight to the flag if the queue is full. */
         ui_cmd_t c;
@@ -603,8 +705,29 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
     const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
     const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
     const int sel = v->panel_sel;
-    const float sel_v = PANEL[sel].param == PANEL_SOLVE_STEP ? fr->solve_step_ms
-                                                             : pr[PANEL[sel].param];
+    const host_tool_t *ht = &fr->host_tool;
+    char mirror[8], host[96], sel_v[48];
+    host_mirror_name(ht->mirror, mirror);
+    snprintf(host, sizeof(host), "%s %s  mirror %s", host_action_name(ht->action),
+             host_shape_name(ht->shape), mirror);
+    if (host_action_has_strength(ht->action))
+        snprintf(host + strlen(host), sizeof(host) - strlen(host), "  strength %.3g %s",
+                 (double)ht->strength,
+                 ht->action == HOST_ACT_CHISEL || ht->action == HOST_ACT_SQUIRT ? "mm/s" : "/s");
+    if (fr->knot_ratio == 0)
+        snprintf(host, sizeof(host), "carve (springs solve: no host actions)");
+    const int prm = PANEL[sel].param;
+    if (prm == PANEL_HOST_ACTION)
+        snprintf(sel_v, sizeof(sel_v), "%s", host_action_name(ht->action));
+    else if (prm == PANEL_HOST_SHAPE)
+        snprintf(sel_v, sizeof(sel_v), "%s", host_shape_name(ht->shape));
+    else if (prm == PANEL_HOST_MIRROR)
+        snprintf(sel_v, sizeof(sel_v), "%s", mirror);
+    else
+        snprintf(sel_v, sizeof(sel_v), "%.4g",
+                 prm == PANEL_HOST_STRENGTH ? (double)ht->strength
+                 : prm == PANEL_SOLVE_STEP  ? (double)fr->solve_step_ms
+                                            : (double)pr[prm]);
     char iso2[32] = "off", colour[96] = "none";
     if (fr->iso2_on)
         snprintf(iso2, sizeof(iso2), "%.2f (clay %.2f)", (double)fr->iso2_level, (double)fr->iso);
@@ -617,9 +740,10 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
              "view %.0f fps%s\n"
              "tool %s%s  beta %s  radius %.1f mm  stiffness %.2f N/mm  clay k %.3g  damping %.3g"
              "  plastic %.3g Hz  alpha %.3g  solve step %.1f ms\n"
-             "iso2 %s  colour %s\n"
-             "> %s = %.4g   [1-6 tool  B beta  TAB/UP/DOWN pick  -/+ change  SHIFT add<>remove"
-             "  C shading  I iso2  [ ] level  M colour  ESC quit]",
+             "iso2 %s  colour %s  knots R %d%s%s  carve does %s\n"
+             "> %s = %s   [1-6 tool  B beta  TAB/UP/DOWN pick  -/+ change  SHIFT add<>remove"
+             "  C shading  I iso2  [ ] level  M colour  K refine  A action  S shape  X Y Z mirror"
+             "  ESC quit]",
              fr->have_tm ? safety_state_name((safety_state_t)fr->tm.state) : "NO BOARD",
              (double)fr->loop_hz, fr->worst_tick_ns / 1000.0, (double)fr->link_latency_ms,
              sqrt((double)fx * fx + (double)fy * fy + (double)fz * fz), fr->t_s, v->fps,
@@ -627,7 +751,31 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
              FILTER_NAMES[b], (double)pr[PARAM_RADIUS_MM], (double)pr[PARAM_STIFFNESS_N_PER_MM],
              (double)pr[PARAM_CLAY_STIFFNESS], (double)pr[PARAM_CLAY_DAMPING],
              (double)pr[PARAM_PLASTIC_RATE_HZ], (double)pr[PARAM_ALPHA],
-             (double)fr->solve_step_ms, iso2, colour, PANEL[sel].label, (double)sel_v);
+             (double)fr->solve_step_ms, iso2, colour, fr->knot_ratio,
+             fr->knot_note[0] ? ": " : "", fr->knot_note, host, PANEL[sel].label, sel_v);
+}
+
+/* True when fr, with the meshes the last frame showed, would draw that frame again but for the
+ * HUD's figures: the tool within 0.05 mm (under a pixel at the default view), the force within
+ * 0.005 N (0.05 mm of its arrow), the same window box and second iso-surface. */
+static bool same_picture(const view_t *v, const live_frame_t *fr)
+{
+    const render_scene_t *d = &v->drawn;
+    if (!v->drawn_any || d->show_tool != fr->have_tm || d->show_box != fr->have_box ||
+        d->show_wire != (fr->iso2_on && fr->mesh2_serial != 0))
+        return false;
+    if (fr->have_tm) {
+        const vec3_t p = vec3(fr->tm.pos_m[0], fr->tm.pos_m[1], fr->tm.pos_m[2]);
+        const vec3_t f = vec3(fr->tm.force_n[0], fr->tm.force_n[1], fr->tm.force_n[2]);
+        const float r = fr->tool_radius_m > 0.0f ? fr->tool_radius_m : 0.004f;
+        if (vec3_norm(vec3_sub(p, d->tool_pos_m)) > 5e-5f || r != d->tool_radius_m ||
+            vec3_norm(vec3_sub(f, d->force_n)) > 0.005f)
+            return false;
+    }
+    if (fr->have_box && (vec3_norm(vec3_sub(fr->box_lo_m, d->box_lo_m)) > 0.0f ||
+                         vec3_norm(vec3_sub(fr->box_hi_m, d->box_hi_m)) > 0.0f))
+        return false;
+    return !d->show_wire || d->wire_on_top == (fr->iso2_level > fr->iso);
 }
 
 static void scene_from_frame(view_t *v, const live_frame_t *fr)
@@ -726,11 +874,13 @@ static double median(double *x, size_t n)
     return x[n / 2];
 }
 
-/* Applies the scripted input events due by simulated time t_s. */
-static void play_script(live_t *L, view_t *v, double t_s)
+/* Applies the scripted input events due by simulated time t_s; true when there were any. */
+static bool play_script(live_t *L, view_t *v, double t_s)
 {
+    bool any = false;
     while (v->next_ev < v->script.count && v->script.ev[v->next_ev].at_s <= t_s) {
         const ui_event_t *e = &v->script.ev[v->next_ev++];
+        any = true;
         switch (e->kind) {
         case UI_EV_KEY: on_key(L, v, e->code); break;
         case UI_EV_SHIFT: v->shift = e->down; break;
@@ -743,48 +893,81 @@ static void play_script(live_t *L, view_t *v, double t_s)
         case UI_EV_WHEEL: camera_zoom(&v->cam, e->x); break;
         }
     }
+    return any;
 }
 
+/* Sleeps until a publish of the kind asked for (WAIT_ANY, WAIT_NEWS), an input event or
+ * timeout_ns, whichever comes first; returns at once when a snapshot is already waiting. */
+static void wait_for_news(live_t *L, view_t *v, int kind, uint64_t timeout_ns)
+{
+    atomic_store(&L->render_waiting, kind);
+    /* After the announcement: a publish from now on sees it (both sequentially consistent). */
+    if (!triple_buffer_has_fresh(&L->tb))
+        glfw_window_wait(&v->win, (double)timeout_ns * 1e-9);
+    atomic_store(&L->render_waiting, WAIT_NONE);
+}
+
+/* The window's main loop. Frames start when frame_pacer says so: at once for a snapshot with a
+ * new mesh (or a change not shown yet) and for input that changes the view, other snapshots at
+ * most 60 a second and held back a little while an impulse is on its way to a mesh, and 4 a
+ * second with nothing new. In between the thread sleeps until a publish or an input event wakes
+ * it, leaving the cores to the session thread. */
 static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
 {
     const sculpt_window_opts_t *wo = L->wo;
     double next_shot_s = wo->screenshot_every_s > 0.0 ? 0.0 : INFINITY;
-    uint64_t last_frame_ns = now_ns(), done_at_ns = 0;
-    int status = 0;
-    bool have_frame = false;
+    uint64_t last_swap_ns = 0, done_at_ns = 0, taken_ns = 0;
+    frame_pacer_cfg_t pc;
+    frame_pacer_cfg_default(&pc);
+    frame_pacer_t pacer;
+    frame_pacer_init(&pacer);
+    int status = 0, drawn_w = 0, drawn_h = 0;
+    bool have_frame = false, undrawn = false;
     const live_frame_t *fr = &L->slot[L->tb.front];
     for (;;) {
+        const bool done = atomic_load(&L->session_done) != 0;
         glfw_input_t in;
         glfw_window_poll(&v->win, &in);
         if (glfw_window_should_close(&v->win))
             atomic_store(&L->want_stop, 1);
+        bool input = false;
         int key;
-        while (glfw_window_take_key(&v->win, &key))
+        while (glfw_window_take_key(&v->win, &key)) {
             on_key(L, v, key);
+            input = true;
+        }
         uint32_t slot;
         const bool fresh = triple_buffer_take(&L->tb, &slot);
-        const uint64_t taken_ns = now_ns();
         fr = &L->slot[slot];
-        if (fresh)
+        if (fresh) {
+            taken_ns = now_ns();
             have_frame = true;
+            undrawn = true;
+        }
+        if (done && done_at_ns == 0)
+            done_at_ns = now_ns(); /* the snapshot just taken is the session's last */
         if (v->script.count > 0) {
-            play_script(L, v, fr->t_s);
+            input |= play_script(L, v, fr->t_s);
         } else {
             v->cx = in.cursor_x;
             v->cy = in.cursor_y;
             v->left = in.left_down;
             v->right = in.right_down;
             v->shift = in.shift;
-            camera_zoom(&v->cam, glfw_window_take_scroll(&v->win));
+            const double scroll = glfw_window_take_scroll(&v->win);
+            camera_zoom(&v->cam, scroll);
+            input |= scroll != 0.0;
         }
         int w = 0, h = 0;
         glfw_window_size(&v->win, &w, &h);
-        if (v->right && v->prev_right && w > 0 && h > 0)
+        const bool moved = v->cx != v->prev_cx || v->cy != v->prev_cy;
+        if (v->right && v->prev_right && moved && w > 0 && h > 0) {
             camera_arcball(&v->cam, v->prev_cx, v->prev_cy, v->cx, v->cy, w, h);
+            input = true;
+        }
         if (v->shift != v->prev_shift)
             ui_send(L, UI_CMD_INVERT, v->shift ? 1 : 0, 0);
-        if (wo->mouse && w > 0 && h > 0 &&
-            (v->left || v->prev_left || v->cx != v->prev_cx || v->cy != v->prev_cy || fresh)) {
+        if (wo->mouse && w > 0 && h > 0 && (v->left || v->prev_left || moved || fresh)) {
             vec3_t o, d;
             camera_ray(&v->cam, v->cx, v->cy, w, h, &o, &d);
             ui_cmd_t c;
@@ -801,79 +984,120 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
         v->prev_shift = v->shift;
         v->prev_left = v->left;
 
-        bool uploaded = false;
-        if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial) {
-            if (renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
+        if (w > 0 && h > 0 && have_frame && fr->t_s + 1e-9 >= next_shot_s && wo->frames_dir) {
+            char path[4096];
+            snprintf(path, sizeof(path), "%s/frame_%06ld.png", wo->frames_dir,
+                     lround(fr->t_s * 1000.0));
+            scene_from_frame(v, fr);
+            if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial &&
+                renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
                 v->uploaded_serial = fr->mesh_serial;
-            uploaded = true;
-        }
-        if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial) {
-            if (renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
+            if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial &&
+                renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
                 v->uploaded2_serial = fr->mesh2_serial;
+            if (!write_shot(L, v, fr, path, w, h, err, err_len)) {
+                status = 1;
+                atomic_store(&L->want_stop, 1);
+            }
+            while (next_shot_s <= fr->t_s + 1e-9)
+                next_shot_s += wo->screenshot_every_s;
         }
-        const uint64_t uploaded_ns = now_ns();
-        if (uploaded)
-            v->last_upload_ns = uploaded_ns;
-        scene_from_frame(v, fr);
-        if (w > 0 && h > 0) {
-            if (have_frame && fr->t_s + 1e-9 >= next_shot_s && wo->frames_dir) {
-                char path[4096];
-                snprintf(path, sizeof(path), "%s/frame_%06ld.png", wo->frames_dir,
-                         lround(fr->t_s * 1000.0));
-                if (!write_shot(L, v, fr, path, w, h, err, err_len)) {
-                    status = 1;
-                    atomic_store(&L->want_stop, 1);
+
+        /* Draw now, or sleep until the next reason to. */
+        const bool new_mesh =
+            (fr->mesh_serial != 0 && fr->mesh_serial != v->drawn_serial) ||
+            (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->drawn2_serial);
+        const bool unshown = fr->has_change && fr->change_pub > v->counted_pub;
+        const bool urgent = undrawn && (new_mesh || unshown);
+        /* A snapshot that changes only the HUD's figures waits for the HUD's next refresh. */
+        const bool visible = urgent || (undrawn && !same_picture(v, fr));
+        uint64_t now = now_ns(), draw_at = now;
+        const frame_pacer_in_t pin = {visible, urgent, input || w != drawn_w || h != drawn_h,
+                                      !done && atomic_load(&L->inflight) != 0};
+        const bool draw = frame_pacer_due(&pacer, &pc, &pin, now, &draw_at) || (done && undrawn);
+        if (draw) {
+            const uint64_t start_ns = now;
+            bool uploaded = false;
+            if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial) {
+                if (renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
+                    v->uploaded_serial = fr->mesh_serial;
+                uploaded = true;
+            }
+            if (fr->mesh_serial != v->drawn_serial) {
+                uploaded = true;
+                v->drawn_serial = fr->mesh_serial;
+            }
+            if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial) {
+                if (renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
+                    v->uploaded2_serial = fr->mesh2_serial;
+            }
+            v->drawn2_serial = fr->mesh2_serial;
+            const uint64_t uploaded_ns = now_ns();
+            if (uploaded)
+                v->last_upload_ns = uploaded_ns;
+            scene_from_frame(v, fr);
+            if (w > 0 && h > 0)
+                draw_frame(L, v, fr, w, h, uploaded_ns);
+            v->drawn = v->scene;
+            v->drawn_any = true;
+            drawn_w = w;
+            drawn_h = h;
+            const uint64_t drawn_ns = now_ns();
+            glfw_window_swap(&v->win);
+            const uint64_t swapped_ns = now_ns();
+            if (v->n_upload < LATENCY_SAMPLES && uploaded) {
+                v->upload_ms[v->n_upload] = (double)(uploaded_ns - start_ns) * 1e-6;
+                v->draw_ms[v->n_upload] = (double)(drawn_ns - uploaded_ns) * 1e-6;
+                v->swap_ms[v->n_upload++] = (double)(swapped_ns - drawn_ns) * 1e-6;
+            }
+            if (urgent)
+                v->n_drawn_mesh++;
+            else if (visible)
+                v->n_drawn_snapshot++;
+            else
+                v->n_drawn_other++;
+            if (last_swap_ns != 0) {
+                const double dt_ms = (double)(swapped_ns - last_swap_ns) * 1e-6;
+                if (dt_ms > 0.0)
+                    v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms)
+                                          : 1000.0 / dt_ms;
+                if (v->n_frame < LATENCY_SAMPLES) {
+                    v->frame_ms[v->n_frame] = dt_ms;
+                    v->cost_ms[v->n_frame++] = (double)(swapped_ns - start_ns) * 1e-6;
                 }
-                while (next_shot_s <= fr->t_s + 1e-9)
-                    next_shot_s += wo->screenshot_every_s;
             }
-            draw_frame(L, v, fr, w, h, uploaded_ns);
-        }
-        const uint64_t drawn_ns = now_ns();
-        glfw_window_swap(&v->win);
-        const uint64_t swapped_ns = now_ns();
-        if (v->n_upload < LATENCY_SAMPLES && uploaded) {
-            v->upload_ms[v->n_upload] = (double)(uploaded_ns - taken_ns) * 1e-6;
-            v->draw_ms[v->n_upload] = (double)(drawn_ns - uploaded_ns) * 1e-6;
-            v->swap_ms[v->n_upload++] = (double)(swapped_ns - drawn_ns) * 1e-6;
-        }
-        /* At most 60 frames a second even where swaps do not wait for the display (Xvfb):
-         * the session thread keeps the CPU it needs. */
-        uint64_t now = now_ns();
-        if (now - last_frame_ns < DISPLAY_PERIOD_NS) {
-            const uint64_t rest = DISPLAY_PERIOD_NS - (now - last_frame_ns);
-            const struct timespec ts = {0, (long)rest};
-            nanosleep(&ts, NULL);
-            now = now_ns();
-        }
-        const double dt_ms = (double)(now - last_frame_ns) * 1e-6;
-        last_frame_ns = now;
-        if (dt_ms > 0.0)
-            v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms) : 1000.0 / dt_ms;
-        if (v->n_frame < LATENCY_SAMPLES)
-            v->frame_ms[v->n_frame++] = dt_ms;
-        if (fresh)
-            atomic_store(&L->shown_pub, fr->pub_seq);
-        if (fresh && fr->has_change && fr->change_pub > v->counted_pub &&
-            v->n_latency < LATENCY_SAMPLES) {
-            v->counted_pub = fr->change_pub;
-            /* Wall clock from the impulse's arrival at the host to the return of the first swap
-             * whose frame shows the solve step that integrated it. */
-            const uint64_t at[STAGE_COUNT + 1] = {fr->arrival_ns, fr->solved_ns, fr->meshed_ns,
-                                                  taken_ns, uploaded_ns, drawn_ns, swapped_ns};
-            for (int k = 0; k < STAGE_COUNT; k++)
-                v->stage_ms[k][v->n_latency] =
-                    at[k + 1] >= at[k] ? (double)(at[k + 1] - at[k]) * 1e-6 : 0.0;
-            v->latency_ms[v->n_latency++] = (double)(swapped_ns - fr->arrival_ns) * 1e-6;
-        }
-        if (atomic_load(&L->session_done)) {
-            if (done_at_ns == 0) {
-                done_at_ns = now;
-                continue; /* one more pass takes the last snapshot */
+            frame_pacer_drawn(&pacer, start_ns, swapped_ns);
+            last_swap_ns = swapped_ns;
+            if (undrawn)
+                atomic_store(&L->shown_pub, fr->pub_seq);
+            if (undrawn && unshown && v->n_latency < LATENCY_SAMPLES) {
+                /* Wall clock from the impulse's arrival at the host to the return of the first
+                 * swap whose frame shows the solve step that integrated it. */
+                const uint64_t at[STAGE_COUNT + 1] = {fr->arrival_ns, fr->solved_ns,
+                                                      fr->meshed_ns, taken_ns, uploaded_ns,
+                                                      drawn_ns, swapped_ns};
+                for (int k = 0; k < STAGE_COUNT; k++)
+                    v->stage_ms[k][v->n_latency] =
+                        at[k + 1] >= at[k] ? (double)(at[k + 1] - at[k]) * 1e-6 : 0.0;
+                v->latency_ms[v->n_latency++] = (double)(swapped_ns - fr->arrival_ns) * 1e-6;
             }
-            if (atomic_load(&L->want_stop) || v->quit ||
-                (double)(now - done_at_ns) * 1e-9 >= wo->linger_s)
-                break;
+            if (undrawn && unshown)
+                v->counted_pub = fr->change_pub;
+            undrawn = false;
+            now = swapped_ns;
+        }
+        if (done && !undrawn &&
+            (atomic_load(&L->want_stop) || v->quit ||
+             (double)(now - done_at_ns) * 1e-9 >= wo->linger_s))
+            break;
+        if (!draw) {
+            uint64_t until = draw_at;
+            if (done) {
+                const uint64_t end_ns = done_at_ns + (uint64_t)(wo->linger_s * 1e9);
+                until = end_ns < until ? end_ns : until;
+            }
+            /* Before draw_at only a new mesh is worth a frame: other publishes may sleep on. */
+            wait_for_news(L, v, visible ? WAIT_NEWS : WAIT_ANY, until > now ? until - now : 0);
         }
     }
     if (wo->screenshot_path) {
@@ -963,6 +1187,9 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     atomic_init(&L->want_stop, 0);
     atomic_init(&L->session_done, 0);
     atomic_init(&L->shown_pub, 0);
+    atomic_init(&L->render_waiting, WAIT_NONE);
+    atomic_init(&L->inflight, 0);
+    L->win = &v->win;
     L->wo = wo;
     L->so = *so;
     L->stop = so->stop;
@@ -1010,6 +1237,10 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
             printf("; frames with an upload: upload %.1f, draw %.1f, swap %.1f (%zu)\n",
                    median(v->upload_ms, v->n_upload), median(v->draw_ms, v->n_upload),
                    median(v->swap_ms, v->n_upload), v->n_upload);
+            printf("  frames drawn        %zu for a new mesh, %zu for the tool or view, %zu for "
+                   "input or the HUD alone; frame cost (start to swap) median %.1f ms\n",
+                   v->n_drawn_mesh, v->n_drawn_snapshot, v->n_drawn_other,
+                   median(v->cost_ms, nf));
             uint32_t slot;
             triple_buffer_take(&L->tb, &slot);
             const live_frame_t *fr = &L->slot[slot];

@@ -36,6 +36,7 @@ void session_opts_default(session_opts_t *o)
     o->out_dir = "out";
     o->window_edge = 16;
     o->global_solve = PEER_SOLVE_BSPLINE;
+    o->knot_ratio = 1;
     o->progress = false;
     o->settle_s = 2.0f;
     o->deadline_faults = true;
@@ -222,7 +223,7 @@ static argil_err_t journal_step(session_t *s, const session_opts_t *opts, double
     }
     if (e == ARGIL_OK && appended && opts->debug_dump_record == s->journal.seq &&
         opts->debug_dump_path) {
-        e = journal_write_model(&s->journal, s->grid.density, s->journal.seq,
+        e = journal_write_model(&s->journal, &s->grid, s->journal.seq,
                                 opts->debug_dump_path, err, err_len);
         *stop_now = true;
     }
@@ -262,6 +263,32 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             rc = ARGIL_ERR_ARG;
             goto done;
         }
+        const int host_line = script_first_host_tool_line(&s->script);
+        if (host_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
+            snprintf(err, err_len, "%s: line %d: host tool settings need the B-spline model "
+                     "(--global-solve bspline); the springs only carve",
+                     opts->script_path, host_line);
+            rc = ARGIL_ERR_ARG;
+            goto done;
+        }
+        /* Each refine halves R: R = 2 allows one, R = 4 two; with springs there are no knots. */
+        const int allowed = opts->global_solve != PEER_SOLVE_BSPLINE ? 0
+                            : opts->knot_ratio == 4                  ? 2
+                            : opts->knot_ratio == 2                  ? 1
+                                                                     : 0;
+        const int refine_line = script_refine_line(&s->script, allowed + 1);
+        if (refine_line > 0) {
+            if (opts->global_solve != PEER_SOLVE_BSPLINE)
+                snprintf(err, err_len, "%s: line %d: 'refine' needs the B-spline model "
+                         "(--global-solve bspline); the springs have no knots",
+                         opts->script_path, refine_line);
+            else
+                snprintf(err, err_len, "%s: line %d: 'refine': already at one coefficient per "
+                         "sample (--knot-ratio %d allows %d refine%s)", opts->script_path,
+                         refine_line, opts->knot_ratio, allowed, allowed == 1 ? "" : "s");
+            rc = ARGIL_ERR_ARG;
+            goto done;
+        }
     }
 
     /* The device and the board. */
@@ -294,9 +321,16 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     peer_cfg_default(&pcfg);
     pcfg.window_edge = opts->window_edge;
     pcfg.global_solve = opts->global_solve;
+    pcfg.knot_ratio = opts->knot_ratio;
     if (opts->window_edge < 4 || opts->window_edge > ARGIL_WINDOW_MAX) {
         snprintf(err, err_len, "window edge %d refused (4 … %d)", opts->window_edge,
                  ARGIL_WINDOW_MAX);
+        rc = ARGIL_ERR_ARG;
+        goto done;
+    }
+    if (opts->knot_ratio != 1 && opts->knot_ratio != 2 && opts->knot_ratio != 4) {
+        snprintf(err, err_len, "knot ratio %d refused (1, 2 or 4 samples per knot span)",
+                 opts->knot_ratio);
         rc = ARGIL_ERR_ARG;
         goto done;
     }
@@ -397,6 +431,19 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             }
         }
         s->player.paints_pending = 0;
+        for (int k = 0; k < s->player.refines_pending && rc == ARGIL_OK; k++) {
+            float dd = 0.0f;
+            const int32_t r0 = peer_knot_ratio(&s->peer);
+            const argil_err_t re = peer_refine(&s->peer, &dd);
+            if (re != ARGIL_OK) {
+                snprintf(err, err_len, "refine at R = %d failed: %s", (int)r0,
+                         re == ARGIL_ERR_STATE ? "already at one coefficient per sample"
+                         : re == ARGIL_ERR_NOMEM ? "out of memory"
+                                                 : "the model refused it");
+                rc = re;
+            }
+        }
+        s->player.refines_pending = 0;
         if (rc != ARGIL_OK)
             break;
         if (finished && t_s - finished_at_s >= SESSION_TAIL_S && !hold_open)
@@ -417,6 +464,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             msg_tool_t tool;
             tool_from_player(s, &tool);
             peer_set_tool(&s->peer, &tool);
+            /* Refused only with the springs solve (the live window keeps its own in step). */
+            (void)peer_set_host_tool(&s->peer, &s->player.host_tool);
             s->grid.material.stiffness = s->player.params[PARAM_CLAY_STIFFNESS];
             s->grid.material.damping = s->player.params[PARAM_CLAY_DAMPING];
             s->grid.material.plastic_rate_hz = s->player.params[PARAM_PLASTIC_RATE_HZ];
@@ -479,6 +528,9 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->telemetry_rows = s->csv_rows;
     sum->solves = s->peer.stats.solves;
     sum->solve_errors = s->peer.stats.solve_errors;
+    sum->refines = s->peer.stats.refines;
+    sum->refine_max_dd = s->peer.stats.refine_max_dd;
+    sum->knot_ratio_end = peer_knot_ratio(&s->peer);
     peer_solve_times_ms(&s->peer, &sum->solve_median_ms, &sum->solve_p99_ms, &sum->solve_max_ms);
     if (rc == ARGIL_OK && s->peer.stats.solve_errors > 0) {
         snprintf(err, err_len, "the global solve failed %u times (last error %d); the model "
@@ -522,6 +574,17 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         snprintf(path, sizeof(path), "%s/session.scn", opts->out_dir);
         if (opts->script_path &&
             copy_file(opts->script_path, path, ferr, sizeof(ferr)) != ARGIL_OK && rc == ARGIL_OK) {
+            snprintf(err, err_len, "%s", ferr);
+            rc = ARGIL_ERR_IO;
+        }
+        /* The model: densities, material and the painted channels (docs/files.md). */
+        argil_doc_t doc;
+        argil_doc_init(&doc);
+        doc.grid = s->grid; /* borrowed: the document is not freed */
+        doc.state.device_offset_m = s->model_offset_m;
+        doc.state.edits = s->journaling ? s->journal.seq : 0u;
+        snprintf(path, sizeof(path), "%s/model.argil", opts->out_dir);
+        if (argil_file_write(path, &doc, ferr, sizeof(ferr)) != ARGIL_OK && rc == ARGIL_OK) {
             snprintf(err, err_len, "%s", ferr);
             rc = ARGIL_ERR_IO;
         }

@@ -38,6 +38,8 @@ typedef struct {
     const char *out_dir;          /* NULL: write nothing */
     int window_edge;              /* 16 or 32 */
     peer_global_solve_t global_solve; /* what the host's global solve steps (docs/model.md) */
+    int knot_ratio;               /* B-spline: grid samples per knot span at the start, 1, 2 or
+                                   * 4 (--knot-ratio; each script 'refine' halves it) */
     bool progress;                /* a progress line on stderr */
     float settle_s;               /* time allowed for the board to become ACTIVE */
     bool deadline_faults;         /* an overrun streak faults the board (off only for profiling) */
@@ -86,6 +88,9 @@ typedef struct {
     double solve_p99_ms;
     double solve_max_ms;
     uint32_t solve_errors;        /* B-spline steps that failed and were skipped */
+    uint32_t refines;             /* knot insertions done (script 'refine', the live key) */
+    int knot_ratio_end;           /* samples per knot span at the end (0: springs solve) */
+    float refine_max_dd;          /* the largest |density change| a refinement made (grid) */
     double real_seconds;          /* wall time of the lockstep loop */
 } session_summary_t;
 

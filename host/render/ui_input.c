@@ -20,7 +20,7 @@ static const struct {
     {"B", GLFW_KEY_B},         {"C", GLFW_KEY_C},         {"TAB", GLFW_KEY_TAB},
     {"UP", GLFW_KEY_UP},       {"DOWN", GLFW_KEY_DOWN},   {"LEFT", GLFW_KEY_LEFT},
     {"RIGHT", GLFW_KEY_RIGHT}, {"PLUS", GLFW_KEY_EQUAL},  {"MINUS", GLFW_KEY_MINUS},
-    {"ESC", GLFW_KEY_ESCAPE},  {"I", GLFW_KEY_I},         {"M", GLFW_KEY_M},
+    {"ESC", GLFW_KEY_ESCAPE},  {"I", GLFW_KEY_I},         {"M", GLFW_KEY_M},         {"K", GLFW_KEY_K},
     {"LBRACKET", GLFW_KEY_LEFT_BRACKET},                 {"RBRACKET", GLFW_KEY_RIGHT_BRACKET},
 };
 

@@ -18,7 +18,8 @@ typedef enum {
     UI_CMD_MOUSE,                 /* arg: 1 while the left button is held; ray in model space */
     UI_CMD_STOP,                  /* end the session (window closed) */
     UI_CMD_ISO2,                  /* arg: 1 shows the second iso-surface at level value, 0 hides */
-    UI_CMD_COLOUR                 /* arg: colour_map_t, the material shown on the clay */
+    UI_CMD_COLOUR,                /* arg: colour_map_t, the material shown on the clay */
+    UI_CMD_REFINE                 /* knot insertion in the B-spline model (peer_refine) */
 } ui_cmd_kind_t;
 
 typedef struct {

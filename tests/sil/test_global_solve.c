@@ -56,10 +56,10 @@ static int setup(void **st)
 static int teardown(void **st)
 {
     (void)st;
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn"};
+    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
     char p[256];
     for (int d = 0; d < 2; d++) {
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 4; i++) {
             snprintf(p, sizeof(p), "%s/%s", d ? dir_b : dir_a, names[i]);
             unlink(p);
         }

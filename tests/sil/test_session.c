@@ -51,10 +51,10 @@ static int setup(void **st)
 static int teardown(void **st)
 {
     (void)st;
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn"};
+    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
     char p[256];
     for (int d = 0; d < 2; d++) {
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 4; i++) {
             snprintf(p, sizeof(p), "%s/%s", d ? dir_b : dir_a, names[i]);
             unlink(p);
         }
@@ -166,8 +166,8 @@ static int same_file(const char *a, const char *b)
 static void test_same_script_same_bytes(void **st)
 {
     (void)st;
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn"};
-    for (int i = 0; i < 3; i++) {
+    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
+    for (int i = 0; i < 4; i++) {
         char a[256], b[256];
         snprintf(a, sizeof(a), "%s/%s", dir_a, names[i]);
         snprintf(b, sizeof(b), "%s/%s", dir_b, names[i]);
