@@ -113,6 +113,7 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     argil_err_t e = field_init(&gs->field, g->spacing_m * (float)ratio, ratio, g->origin_m);
     if (e != ARGIL_OK)
         return e;
+    gs->settle_enabled = true;
     gs->field.iso = g->iso;
     gs->field.band_m = g->band_m; /* the grid's density ramp, so tools cut the same profile */
     solver_cfg_default(&gs->cfg);
@@ -126,11 +127,11 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     return e;
 }
 
+static void close_window(gsolve_t *gs);
+
 void gsolve_free(gsolve_t *gs)
 {
-    if (gs->win_open)
-        physwin_close(&gs->win);
-    gs->win_open = false;
+    close_window(gs);
     field_free(&gs->field);
     free(gs->buf);
     gs->buf = NULL;
@@ -144,6 +145,10 @@ static void close_window(gsolve_t *gs)
     gs->win_open = false;
     gs->stale = false;
     gs->resting = false;
+    if (gs->settle.open)
+        physwin_close(&gs->settle.win);
+    gs->settle.open = false;
+    gs->settle.active = false;
 }
 
 /* Reads the window's coefficients, their velocity, the rest shape and the fixed part of d
@@ -151,9 +156,8 @@ static void close_window(gsolve_t *gs)
  * after the window was shifted by whole knot spans, when the fixed flags and the material are
  * read too. The taps repeat every knot span, so they stay, and no array is reallocated (a
  * fresh physwin_open of a 32³ window faults in ~7 MB of new pages). */
-static argil_err_t reload_window(gsolve_t *gs, float dt_s, bool moved)
+static argil_err_t reload_win(gsolve_t *gs, physwin_t *w, float dt_s, bool moved, bool *plain_io)
 {
-    physwin_t *w = &gs->win;
     solver_t *s = &w->solver;
     const field_t *f = &gs->field;
     int32_t nc[3], ns[3];
@@ -195,22 +199,56 @@ static argil_err_t reload_window(gsolve_t *gs, float dt_s, bool moved)
         sparse_read_box(&f->samp, FS_RESTLEN, w->slo, ns, tmp);
         for (size_t i = 0; i < s->nsamp; i++)
             s->rest[i] += tmp[i];
-        if (!plain || !gs->win_plain || s->k_rest_n != f->material.stiffness_n ||
+        if (!plain || !*plain_io || s->k_rest_n != f->material.stiffness_n ||
             s->coupling_n != f->material.coupling_n) {
             s->k_rest_n = f->material.stiffness_n;
             s->coupling_n = f->material.coupling_n;
             solver_material_changed(s);
         }
-        gs->win_plain = plain;
+        *plain_io = plain;
     } else {
         sparse_read_box(&f->samp, FS_REST, w->slo, ns, s->rest);
         sparse_read_box(&f->samp, FS_RESTLEN, w->slo, ns, tmp);
         for (size_t i = 0; i < s->nsamp; i++)
             s->rest[i] += tmp[i];
     }
-    gs->stale = false;
-    gs->resting = false;
     return ARGIL_OK;
+}
+
+static argil_err_t reload_window(gsolve_t *gs, float dt_s, bool moved)
+{
+    const argil_err_t e = reload_win(gs, &gs->win, dt_s, moved, &gs->win_plain);
+    if (e == ARGIL_OK) {
+        gs->stale = false;
+        gs->resting = false;
+    }
+    return e;
+}
+
+/* Shifts an open window whose sample box was at old_lo to new_lo (same size, by whole knot
+ * spans: the taps repeat every span, so only the boxes move). */
+static void shift_win(physwin_t *w, int32_t ratio, const int32_t old_lo[3], const int32_t new_lo[3])
+{
+    for (int a = 0; a < 3; a++) {
+        const int32_t shift = new_lo[a] - old_lo[a];
+        w->clo[a] += shift / ratio;
+        w->chi[a] += shift / ratio;
+        w->slo[a] += shift;
+        w->shi[a] += shift;
+    }
+}
+
+/* Coefficient box of the sample box [lo, hi): every coefficient centred in it, at least 4 per
+ * axis. */
+static void coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
+                     int32_t chi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        clo[a] = floordiv(lo[a], f->ratio);
+        chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
+        if (chi[a] - clo[a] < 4)
+            chi[a] = clo[a] + 4;
+    }
 }
 
 void gsolve_close_window(gsolve_t *gs)
@@ -412,41 +450,224 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
     return ARGIL_OK;
 }
 
-argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
-                        float dt_s, int32_t dlo[3], int32_t dhi[3], float *max_change)
+/* After an implicit step of window w: d = A p + d_fixed once; plastic flow (the rest shape
+ * follows the current one at the material's rate); p, the coefficient velocity, d and the rest
+ * back to the field (what physwin_store does, without computing d twice) and d into the grid.
+ * Rest: no force acted and no sample of the view moved by rest_dd; the velocity is then
+ * zeroed (CG's 8 iterations leave the B-spline's high-frequency modes, which barely show in
+ * the samples, almost undamped: their round-off would otherwise drift on). */
+static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physwin_t *skip,
+                              float dt_s, bool forced, float rest_dd, float *change_out,
+                              bool *resting_out)
 {
-    for (int a = 0; a < 3; a++)
-        dlo[a] = dhi[a] = 0;
-    *max_change = 0.0f;
-    if (!(dt_s > 0.0f) || !isfinite(dt_s))
-        return ARGIL_ERR_ARG;
+    field_t *f = &gs->field;
+    solver_t *s = &w->solver;
+    int32_t nc[3], ns[3];
+    for (int a = 0; a < 3; a++) {
+        nc[a] = w->chi[a] - w->clo[a];
+        ns[a] = w->shi[a] - w->slo[a];
+    }
+    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
+    if (!d)
+        return ARGIL_ERR_NOMEM;
+    float *tmp = d + s->nsamp;
+    solver_densities(s, d);
+    argil_err_t e = ARGIL_OK;
+    const float plastic = gs->mat.plastic_rate_hz * dt_s > 1.0f ? 1.0f
+                                                                : gs->mat.plastic_rate_hz * dt_s;
+    if (plastic > 0.0f) {
+        sparse_read_box(&f->samp, FS_REST, w->slo, ns, tmp);
+        size_t i = 0;
+        for (int32_t z = w->slo[2]; z < w->shi[2]; z++)
+            for (int32_t y = w->slo[1]; y < w->shi[1]; y++)
+                for (int32_t x = w->slo[0]; x < w->shi[0]; x++, i++) {
+                    /* Samples of `skip` (the main window) flowed in its own step. */
+                    if (skip && x >= skip->slo[0] && x < skip->shi[0] && y >= skip->slo[1] &&
+                        y < skip->shi[1] && z >= skip->slo[2] && z < skip->shi[2])
+                        continue;
+                    const float delta = plastic * (d[i] - s->rest[i]);
+                    s->rest[i] += delta;
+                    tmp[i] += delta;
+                }
+        e = sparse_write_box(&f->samp, FS_REST, w->slo, ns, tmp);
+    }
+    const float change = dense_to_grid(g, d, w->slo, ns);
+    const bool resting = !forced && change < rest_dd;
+    if (resting)
+        memcpy(s->p_prev, s->p, s->ncoef * sizeof(float));
+    if (e == ARGIL_OK)
+        e = sparse_write_box(&f->coef, FC_P, w->clo, nc, s->p);
+    if (e == ARGIL_OK) {
+        /* Only the free coefficients' velocity: a fixed one's stays what the field holds
+         * (0 for a fixed point; the main window's own for those a settling region holds). */
+        sparse_read_box(&f->coef, FC_V, w->clo, nc, tmp);
+        for (size_t i = 0; i < s->ncoef; i++)
+            if (!s->fixed[i])
+                tmp[i] = (s->p[i] - s->p_prev[i]) / s->dt_prev_s;
+        e = sparse_write_box(&f->coef, FC_V, w->clo, nc, tmp);
+    }
+    if (e == ARGIL_OK)
+        e = sparse_write_box(&f->samp, FS_D, w->slo, ns, d);
+    *change_out = change;
+    *resting_out = resting;
+    return e;
+}
+
+/* Grows the changed box [dlo, dhi) (empty when dlo = dhi) by w's samples clipped to the grid. */
+static void grow_changed(const grid_t *g, const physwin_t *w, int32_t dlo[3], int32_t dhi[3])
+{
+    int32_t a0[3], a1[3];
+    if (!clip_to_grid(g, w->slo, w->shi, a0, a1))
+        return;
+    const bool empty = dhi[0] <= dlo[0];
+    for (int a = 0; a < 3; a++) {
+        dlo[a] = empty || a0[a] < dlo[a] ? a0[a] : dlo[a];
+        dhi[a] = empty || a1[a] > dhi[a] ? a1[a] : dhi[a];
+    }
+}
+
+/* The board's window moved away from the box [lo, hi) while the clay in it still moved: step
+ * that box on as the settling region (replacing an older one, whose velocity stays in the
+ * field and resumes when a window covers it again). */
+static void settle_take(gsolve_t *gs, const int32_t lo[3], const int32_t hi[3])
+{
+    gsolve_settle_t *st = &gs->settle;
+    if (st->active)
+        gs->stats.settle_dropped++;
+    memcpy(st->box_lo, lo, sizeof(st->box_lo));
+    memcpy(st->box_hi, hi, sizeof(st->box_hi));
+    st->active = true;
+    st->quiet_steps = 0;
+}
+
+/* One step of the settling region, after the main window's: every coefficient the main window
+ * holds free is fixed here (block Gauss-Seidel: each coefficient moves once per period), the
+ * rest of its box moves freely with no external force. Reloaded every step, since the main
+ * window has just moved coefficients it reads. */
+static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[3], int32_t dhi[3],
+                               float *max_change)
+{
+    gsolve_settle_t *st = &gs->settle;
+    field_t *f = &gs->field;
+    physwin_t *w = &st->win;
+    argil_err_t e;
+    int32_t clo[3], chi[3];
+    coef_box(f, st->box_lo, st->box_hi, clo, chi);
+    if (st->open) {
+        bool same = true;
+        for (int a = 0; a < 3; a++)
+            same = same && chi[a] - clo[a] == w->chi[a] - w->clo[a];
+        if (same) {
+            int32_t old_lo[3], new_lo[3];
+            for (int a = 0; a < 3; a++) {
+                old_lo[a] = w->clo[a] * f->ratio;
+                new_lo[a] = clo[a] * f->ratio;
+            }
+            shift_win(w, f->ratio, old_lo, new_lo);
+        } else {
+            physwin_close(w);
+            st->open = false;
+        }
+    }
+    if (!st->open) {
+        gs->cfg.dt_s = dt_s;
+        e = physwin_open(w, f, clo, chi, &gs->cfg);
+        if (e != ARGIL_OK) {
+            st->active = false;
+            return e;
+        }
+        st->open = true;
+        st->plain = false;
+    }
+    e = reload_win(gs, w, dt_s, true, &st->plain);
+    if (e != ARGIL_OK) {
+        physwin_close(w);
+        st->open = st->active = false;
+        return e;
+    }
+    /* Hold what the main window moves. */
+    solver_t *s = &w->solver;
+    size_t free_n = 0, k = 0;
+    for (int32_t z = w->clo[2]; z < w->chi[2]; z++)
+        for (int32_t y = w->clo[1]; y < w->chi[1]; y++)
+            for (int32_t x = w->clo[0]; x < w->chi[0]; x++, k++) {
+                const int32_t c[3] = {x, y, z};
+                bool held = gs->win_open;
+                for (int a = 0; a < 3 && held; a++)
+                    held = c[a] >= gs->win.clo[a] && c[a] < gs->win.chi[a];
+                if (held)
+                    s->fixed[k] = true;
+                free_n += !s->fixed[k];
+            }
+    if (free_n == 0) {
+        /* The main window took it all over. */
+        st->active = false;
+        return ARGIL_OK;
+    }
+    memset(s->force_n, 0, s->nsamp * sizeof(float));
+    s->cfg.dt_s = dt_s;
+    if (s->cfg.dt_min_s > dt_s)
+        s->cfg.dt_min_s = dt_s;
+    e = solver_step_implicit(s);
+    if (e != ARGIL_OK) {
+        physwin_close(w);
+        st->open = st->active = false;
+        return e;
+    }
+    gs->stats.settle_steps++;
+    float change = 0.0f;
+    bool quiet = false;
+    st->quiet_steps++;
+    /* Velocity zeroed only on the last of the quiet steps, when the region rests. */
+    e = store_step(gs, g, w, gs->win_open ? &gs->win : NULL, dt_s, false,
+                   st->quiet_steps >= GSOLVE_SETTLE_QUIET_STEPS ? GSOLVE_SETTLE_DD : 0.0f, &change,
+                   &quiet);
+    if (e != ARGIL_OK) {
+        physwin_close(w);
+        st->open = st->active = false;
+        return e;
+    }
+    if (change > 0.0f) {
+        grow_changed(g, w, dlo, dhi);
+        if (change > *max_change)
+            *max_change = change;
+        /* The main window's fixed part (d of the coefficients outside it) changed. */
+        gs->stale = gs->win_open;
+    }
+    if (change >= GSOLVE_SETTLE_DD)
+        st->quiet_steps = 0;
+    if (quiet) {
+        st->active = false;
+        gs->stats.settle_rested++;
+    }
+    return ARGIL_OK;
+}
+
+/* One step of the main window; *stepped false when it rested untouched. */
+static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
+                             float dt_s, int32_t dlo[3], int32_t dhi[3], float *max_change)
+{
     field_t *f = &gs->field;
     /* The coefficients whose samples cover the box (at least 4 per axis). */
     int32_t clo[3], chi[3];
-    for (int a = 0; a < 3; a++) {
-        clo[a] = floordiv(lo[a], f->ratio);
-        chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
-        if (chi[a] - clo[a] < 4)
-            chi[a] = clo[a] + 4;
-    }
+    coef_box(f, lo, hi, clo, chi);
     if (gs->win_open && (memcmp(clo, gs->win.clo, sizeof(clo)) != 0 ||
                          memcmp(chi, gs->win.chi, sizeof(chi)) != 0)) {
+        /* The clay the window leaves behind may still be moving: keep stepping it. */
+        if (!gs->resting && gs->settle_enabled)
+            settle_take(gs, gs->box_lo, gs->box_hi);
         /* Same size, shifted by whole knot spans (R samples each; a box that moved less stays
          * on the same coefficients): move the open window instead of reopening. */
         bool same = true;
-        int32_t shift[3];
-        for (int a = 0; a < 3; a++) {
-            shift[a] = clo[a] - gs->win.clo[a];
+        for (int a = 0; a < 3; a++)
             same = same && chi[a] - clo[a] == gs->win.chi[a] - gs->win.clo[a];
-        }
         if (same) {
-            physwin_t *w = &gs->win;
+            int32_t old_lo[3], new_lo[3];
             for (int a = 0; a < 3; a++) {
-                w->clo[a] += shift[a];
-                w->chi[a] += shift[a];
-                w->slo[a] += shift[a] * f->ratio;
-                w->shi[a] += shift[a] * f->ratio;
+                old_lo[a] = gs->win.clo[a] * f->ratio;
+                new_lo[a] = clo[a] * f->ratio;
             }
+            shift_win(&gs->win, f->ratio, old_lo, new_lo);
             const argil_err_t e = reload_window(gs, dt_s, true);
             if (e != ARGIL_OK) {
                 close_window(gs);
@@ -454,7 +675,8 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
             }
             gs->stats.windows_moved++;
         } else {
-            close_window(gs);
+            physwin_close(&gs->win);
+            gs->win_open = false;
         }
     }
     if (gs->win_open) {
@@ -472,6 +694,8 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
         if (e != ARGIL_OK)
             return e;
         gs->win_open = true;
+        gs->stale = false;
+        gs->resting = false;
         gs->win_plain = false; /* unknown: the next move rebuilds the derived arrays */
         memcpy(gs->box_lo, lo, sizeof(gs->box_lo));
         memcpy(gs->box_hi, hi, sizeof(gs->box_hi));
@@ -498,7 +722,8 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
                     g->force[gi] = 0.0f;
                 }
     }
-    /* At rest and left alone: nothing to step (and no round-off to integrate). */
+    /* At rest and left alone: nothing to step (and no round-off to integrate); the window is
+     * not stepped again until a force, a tool, the material or a new window moves it. */
     if (gs->resting && !forced) {
         gs->stats.rest_skips++;
         return ARGIL_OK;
@@ -518,58 +743,31 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
     gs->stats.last_residual = s->stats.residual;
     if (s->stats.residual > gs->stats.max_residual)
         gs->stats.max_residual = s->stats.residual;
-    /* d = A p + d_fixed once; plastic flow (the rest shape follows the current one at the
-     * material's rate); then p, the coefficient velocity, d and the rest go back to the field
-     * (what physwin_store does, without computing d twice) and d into the grid. */
-    int32_t nc[3], ns[3];
-    for (int a = 0; a < 3; a++) {
-        nc[a] = w->chi[a] - w->clo[a];
-        ns[a] = w->shi[a] - w->slo[a];
-    }
-    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
-    if (!d)
-        return ARGIL_ERR_NOMEM;
-    float *tmp = d + s->nsamp;
-    solver_densities(s, d);
-    const float plastic = gs->mat.plastic_rate_hz * dt_s > 1.0f ? 1.0f
-                                                                : gs->mat.plastic_rate_hz * dt_s;
-    if (plastic > 0.0f) {
-        sparse_read_box(&f->samp, FS_REST, w->slo, ns, tmp);
-        for (size_t i = 0; i < s->nsamp; i++) {
-            const float delta = plastic * (d[i] - s->rest[i]);
-            s->rest[i] += delta;
-            tmp[i] += delta;
-        }
-        e = sparse_write_box(&f->samp, FS_REST, w->slo, ns, tmp);
-    }
-    const float change = dense_to_grid(g, d, w->slo, ns);
-    /* Rest: no force acted and no sample of the view moved by GSOLVE_REST_DD. The velocity is
-     * zeroed (CG's 8 iterations leave the B-spline's high-frequency modes, which barely show
-     * in the samples, almost undamped: their round-off would otherwise drift on), and the
-     * window is not stepped again until a force, a tool, the material or a new window moves
-     * it. */
-    gs->resting = !forced && change < GSOLVE_REST_DD;
-    if (gs->resting)
-        memcpy(s->p_prev, s->p, s->ncoef * sizeof(float));
-    if (e == ARGIL_OK)
-        e = sparse_write_box(&f->coef, FC_P, w->clo, nc, s->p);
-    if (e == ARGIL_OK) {
-        for (size_t i = 0; i < s->ncoef; i++)
-            tmp[i] = (s->p[i] - s->p_prev[i]) / s->dt_prev_s;
-        e = sparse_write_box(&f->coef, FC_V, w->clo, nc, tmp);
-    }
-    if (e == ARGIL_OK)
-        e = sparse_write_box(&f->samp, FS_D, w->slo, ns, d);
+    float change = 0.0f;
+    e = store_step(gs, g, w, NULL, dt_s, forced, GSOLVE_REST_DD, &change, &gs->resting);
     if (e != ARGIL_OK) {
         close_window(gs);
         return e;
     }
-    *max_change = change;
-    if (change > 0.0f && clip_to_grid(g, w->slo, w->shi, dlo, dhi))
-        return ARGIL_OK;
+    if (change > 0.0f) {
+        grow_changed(g, w, dlo, dhi);
+        *max_change = change;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
+                        float dt_s, int32_t dlo[3], int32_t dhi[3], float *max_change)
+{
     for (int a = 0; a < 3; a++)
         dlo[a] = dhi[a] = 0;
-    return ARGIL_OK;
+    *max_change = 0.0f;
+    if (!(dt_s > 0.0f) || !isfinite(dt_s))
+        return ARGIL_ERR_ARG;
+    argil_err_t e = step_main(gs, g, lo, hi, dt_s, dlo, dhi, max_change);
+    if (e == ARGIL_OK && gs->settle.active)
+        e = step_settle(gs, g, dt_s, dlo, dhi, max_change);
+    return e;
 }
 
 argil_err_t gsolve_carve_sphere(gsolve_t *gs, grid_t *g, vec3_t centre_m, float radius_m,

@@ -37,6 +37,14 @@
 /* A window rests once a step without external force moves no sample of the view by more than
  * this (density units: 1e-3 /s at 100 Hz, a surface creeping ~0.01 mm/s). */
 #define GSOLVE_REST_DD 1e-5f
+/* A region the board's window left rests once a step moves no sample of it by more than
+ * this (4e-3 /s at 100 Hz: the surface creeps ~0.03 mm/s on the 7.5 mm density ramp). Looser
+ * than GSOLVE_REST_DD: the main window is stepped anyway, a settling region costs a second
+ * step per period while it moves, and CG's undamped high-frequency modes keep a window near
+ * 1e-5 for long after the clay visibly stopped. */
+#define GSOLVE_SETTLE_DD 5e-5f
+/* ... for this many steps in a row (a motion that turns round is slow for a step or two). */
+#define GSOLVE_SETTLE_QUIET_STEPS 10
 /* The grid view follows a field density once it differs by more than this. */
 #define GSOLVE_VIEW_EPS 1e-5f
 
@@ -53,7 +61,23 @@ typedef struct {
     float last_residual;
     float max_residual;
     uint64_t cg_iters_total;
+    uint32_t settle_steps;            /* steps of a region the board's window left */
+    uint32_t settle_rested;           /* such regions that came to rest */
+    uint32_t settle_dropped;          /* such regions given up still moving (a newer one came) */
 } gsolve_stats_t;
+
+/* A region the board's window left while it was still moving (clay springing back after the
+ * tool went on): stepped on, after the main window and with the main window's coefficients
+ * held, until it comes to rest (Hua & Qin §6.3: the window is how the solve keeps up, not a
+ * reason for the clay behind it to freeze). */
+typedef struct {
+    physwin_t win;
+    bool open;                        /* win holds arrays (reused while the size stays) */
+    bool active;                      /* box is still moving: step it */
+    bool plain;                       /* win's material is the base */
+    uint32_t quiet_steps;             /* steps in a row below GSOLVE_SETTLE_DD */
+    int32_t box_lo[3], box_hi[3];     /* sample box it simulates */
+} gsolve_settle_t;
 
 typedef struct {
     field_t field;
@@ -65,6 +89,8 @@ typedef struct {
     int32_t box_lo[3], box_hi[3];     /* sample box the open window was asked to cover */
     solver_cfg_t cfg;
     spring_material_t mat;            /* the grid material the field's material was made from */
+    gsolve_settle_t settle;           /* the region the window left last, while it moves */
+    bool settle_enabled;              /* true (gsolve_init); false: left regions freeze */
     float *buf;                       /* window-sized scratch (samples) */
     size_t buf_n;
     gsolve_stats_t stats;
@@ -91,14 +117,17 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
 void gsolve_set_material(gsolve_t *gs, const spring_material_t *m);
 
 /* One implicit step of dt_s over the coefficients of the sample box [lo, hi) (the physical
- * window; reopened when the box changes). The grid's external forces in the window's samples
- * act over the step and are consumed. Writes the sample box whose densities changed into
- * dlo/dhi (dlo = dhi: none) and the largest |density change|. */
+ * window; moved or reopened when the box changes). The grid's external forces in the window's
+ * samples act over the step and are consumed. When the box moves while the clay in the old one
+ * still moves, the old box keeps being stepped (after the window, with the window's
+ * coefficients held) until it rests; one such region at a time, the newest. Writes the sample
+ * box whose densities changed into dlo/dhi (dlo = dhi: none; the bounding box of both regions)
+ * and the largest |density change|. */
 argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
                         float dt_s, int32_t dlo[3], int32_t dhi[3], float *max_change);
 
-/* Frees the physical window (the field is current after every step); the next step opens a
- * new one. */
+/* Frees the physical window and any settling region (the field is current after every step);
+ * the next step opens a new window. */
 void gsolve_close_window(gsolve_t *gs);
 
 /* Samples per knot span now (R): the session's start value, halved by every gsolve_refine. */

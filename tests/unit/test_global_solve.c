@@ -218,6 +218,7 @@ static void moved_window_matches_a_fresh_one(bool painted)
     gsolve_t a, b;
     assert_int_equal(gsolve_init(&a, g1), ARGIL_OK);
     assert_int_equal(gsolve_init(&b, g2), ARGIL_OK);
+    a.settle_enabled = false; /* b's reopened window leaves nothing behind either */
     if (painted) {
         assert_int_equal(gsolve_paint(&a, GSOLVE_MAT_STIFFNESS, vec3(0, R, 0), 6e-3f, 3.0f),
                          ARGIL_OK);
