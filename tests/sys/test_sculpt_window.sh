@@ -19,43 +19,12 @@ py=/usr/bin/python3
 #   "wire PNG": pixels of the second iso-surface's wire colour (magenta) below the HUD
 #   "legend PNG": RGB at the left and right ends of the colour legend (row 50, x 8 and 188)
 cat >"$tmp/png.py" <<'PY'
-import struct, sys, zlib
+import sys
+from pngread import load, wire
 HUD_ROWS = 60  # the HUD's four lines and the colour legend under them
-def load(path):
-    data = open(path, 'rb').read()
-    assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
-    pos, idat = 8, b''
-    while pos < len(data):
-        n, kind = struct.unpack('>I4s', data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        if kind == b'IHDR':
-            w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
-            assert depth == 8 and ctype == 2, 'not 8-bit RGB'
-        elif kind == b'IDAT':
-            idat += body
-        pos += 12 + n
-    raw = zlib.decompress(idat)
-    stride, prev, px = w * 3, bytearray(w * 3), []
-    for y in range(h):
-        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - 3] if i >= 3 else 0
-            b = prev[i]
-            c = prev[i - 3] if i >= 3 else 0
-            if f == 1: line[i] = (line[i] + a) & 255
-            elif f == 2: line[i] = (line[i] + b) & 255
-            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        px.append([tuple(line[i:i + 3]) for i in range(0, stride, 3)])
-        prev = line
-    return w, h, px
 def clay(p): return p[0] > p[2] + 25 and p[0] >= p[1]
 def tool(p): return p[2] > p[0] + 20 and p[1] > p[0] + 10 and not (p[1] > p[0] + 60 and p[1] > p[2] + 60)
 def luma(p): return (299 * p[0] + 587 * p[1] + 114 * p[2]) // 1000
-def wire(p): return p[0] > p[1] + 60 and p[2] > p[1] + 60
 if sys.argv[1] == 'wire':
     w, h, px = load(sys.argv[2])
     print(sum(1 for row in px[HUD_ROWS:] for p in row if wire(p)))
@@ -83,10 +52,11 @@ else:
                 n += 1
     print(n)
 PY
-stats() { "$py" "$tmp/png.py" stats "$1"; }
-diffpx() { "$py" "$tmp/png.py" diff "$@"; }
-wirepx() { "$py" "$tmp/png.py" wire "$1"; }
-legend() { "$py" "$tmp/png.py" legend "$1"; }
+pngpy() { PYTHONPATH=tests/sys "$py" "$tmp/png.py" "$@"; }
+stats() { pngpy stats "$1"; }
+diffpx() { pngpy diff "$@"; }
+wirepx() { pngpy wire "$1"; }
+legend() { pngpy legend "$1"; }
 
 # 1. The default session in the window (as fast as it can), a screenshot every simulated second.
 xvfb "$rel" sculpt --script scripts/default.scn --out "$tmp/live" --fast --width 480 \

@@ -14,41 +14,14 @@ py=/usr/bin/python3
 
 # Prints "W H DISTINCT_COLOURS SHARE_NOT_BACKGROUND" for an 8-bit RGB PNG (stdlib only).
 png_stats() {
-    "$py" - "$@" <<'PY'
-import struct, sys, zlib
-data = open(sys.argv[1], 'rb').read()
-assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
-pos, idat, w = 8, b'', 0
-while pos < len(data):
-    n, kind = struct.unpack('>I4s', data[pos:pos + 8])
-    body = data[pos + 8:pos + 8 + n]
-    if kind == b'IHDR':
-        w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
-        assert depth == 8 and ctype == 2, 'not 8-bit RGB'
-    elif kind == b'IDAT':
-        idat += body
-    pos += 12 + n
-if len(sys.argv) > 2:  # header only
+    PYTHONPATH=tests/sys "$py" - "$@" <<'PY'
+import sys
+from pngread import load
+w, h, rows = load(sys.argv[1], header_only=len(sys.argv) > 2)
+if rows is None:
     print(w, h, 0, 0)
     sys.exit(0)
-raw = zlib.decompress(idat)
-stride, prev, rows = w * 3, bytearray(w * 3), []
-for y in range(h):
-    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-    for i in range(stride):
-        a = line[i - 3] if i >= 3 else 0
-        b = prev[i]
-        c = prev[i - 3] if i >= 3 else 0
-        if f == 1: line[i] = (line[i] + a) & 255
-        elif f == 2: line[i] = (line[i] + b) & 255
-        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
-        elif f == 4:
-            p = a + b - c
-            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-    rows.append(bytes(line))
-    prev = line
-px = [r[i:i + 3] for r in rows for i in range(0, stride, 3)]
+px = [p for r in rows for p in r]
 bg = px[0]
 print(w, h, len(set(px)), round(sum(p != bg for p in px) / len(px), 3))
 PY
@@ -76,33 +49,11 @@ set -- $(png_stats "$tmp/sculpt.png" header)
 # (Hua & Qin Fig. 12): magenta wire pixels appear that the plain view does not have.
 "$rel" fit "$tmp/out/final.ply" -o "$tmp/m.argil" --resolution 40 --quiet || fail "fit failed"
 wire_px() {
-    "$py" - "$1" <<'PY'
-import struct, sys, zlib
-data = open(sys.argv[1], 'rb').read()
-pos, idat = 8, b''
-while pos < len(data):
-    n, kind = struct.unpack('>I4s', data[pos:pos + 8])
-    if kind == b'IHDR':
-        w, h = struct.unpack('>II', data[pos + 8:pos + 16])
-    elif kind == b'IDAT':
-        idat += data[pos + 8:pos + 8 + n]
-    pos += 12 + n
-raw, stride, prev, n = zlib.decompress(idat), w * 3, bytearray(w * 3), 0
-for y in range(h):
-    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-    for i in range(stride):
-        a = line[i - 3] if i >= 3 else 0
-        b, c = prev[i], (prev[i - 3] if i >= 3 else 0)
-        if f == 1: line[i] = (line[i] + a) & 255
-        elif f == 2: line[i] = (line[i] + b) & 255
-        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
-        elif f == 4:
-            p = a + b - c
-            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-    n += sum(1 for i in range(0, stride, 3) if line[i] > line[i + 1] + 60 and line[i + 2] > line[i + 1] + 60)
-    prev = line
-print(n)
+    PYTHONPATH=tests/sys "$py" - "$1" <<'PY'
+import sys
+from pngread import load, wire
+w, h, rows = load(sys.argv[1])
+print(sum(1 for r in rows for p in r if wire(p)))
 PY
 }
 for lv in none 0.3 0.7; do
