@@ -147,6 +147,8 @@ static void close_window(gsolve_t *gs)
     gs->resting = false;
     if (gs->settle.open)
         physwin_close(&gs->settle.win);
+    free(gs->settle.next);
+    gs->settle.next = NULL;
     gs->settle.open = false;
     gs->settle.active = false;
 }
@@ -576,6 +578,14 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
             st->active = false;
             return e;
         }
+        free(st->next);
+        st->next = malloc(w->solver.ncoef * sizeof(float));
+        if (!st->next) {
+            physwin_close(w);
+            st->active = false;
+            return ARGIL_ERR_NOMEM;
+        }
+        w->solver.fixed_next = st->next;
         st->open = true;
         st->plain = false;
     }
@@ -585,8 +595,12 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
         st->open = st->active = false;
         return e;
     }
-    /* Hold what the main window moves. */
+    /* Hold what the main window moves, on the path it took this period: the field has them
+     * at p_i+1 already, so this step starts them at p_i = p_i+1 - v dt (p_i-1 = p_i - v dt:
+     * their velocity as if constant) and ends them at p_i+1. Held still instead, their mass
+     * (the B-spline's mass matrix couples neighbours) would drag the clay beside them. */
     solver_t *s = &w->solver;
+    float *next = st->next;
     size_t free_n = 0, k = 0;
     for (int32_t z = w->clo[2]; z < w->chi[2]; z++)
         for (int32_t y = w->clo[1]; y < w->chi[1]; y++)
@@ -595,8 +609,13 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
                 bool held = gs->win_open;
                 for (int a = 0; a < 3 && held; a++)
                     held = c[a] >= gs->win.clo[a] && c[a] < gs->win.chi[a];
-                if (held)
+                next[k] = s->p[k];
+                if (held) {
+                    const float step = s->p[k] - s->p_prev[k];
                     s->fixed[k] = true;
+                    s->p[k] -= step;
+                    s->p_prev[k] -= step;
+                }
                 free_n += !s->fixed[k];
             }
     if (free_n == 0) {

@@ -76,6 +76,7 @@ typedef struct {
     bool active;                      /* box is still moving: step it */
     bool plain;                       /* win's material is the base */
     uint32_t quiet_steps;             /* steps in a row below GSOLVE_SETTLE_DD */
+    float *next;                      /* where held coefficients end a step (win's ncoef) */
     int32_t box_lo[3], box_hi[3];     /* sample box it simulates */
 } gsolve_settle_t;
 

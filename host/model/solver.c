@@ -685,9 +685,11 @@ argil_err_t solver_step_implicit(solver_t *s)
             for (int32_t j = 0; j < row->n; j++)
                 rhs[row->idx[j]] += c2 * row->k_n * row->target * row->w[j];
         }
-        /* warm start: the previous motion continued; fixed coefficients stay; pivots from rows */
+        /* warm start: the previous motion continued; fixed coefficients stay (or go where
+         * fixed_next says); pivots from rows */
         for (size_t i = 0; i < s->ncoef; i++)
-            x[i] = s->fixed[i] ? s->p[i] : 2.0f * s->p[i] - pp[i];
+            x[i] = s->fixed[i] ? (s->fixed_next ? s->fixed_next[i] : s->p[i])
+                               : 2.0f * s->p[i] - pp[i];
         solver_expand(s, x, true);
         solver_apply_S(s, x, Sq, dt);
         solver_sub(r, rhs, Sq, s->ncoef);

@@ -62,6 +62,8 @@ typedef struct {
     float *p, *p_prev;           /* coefficients now and one step ago */
     float dt_prev_s;             /* step that separates p_prev from p */
     uint8_t *fixed;              /* 1 = coefficient held where it is (fixed point) */
+    const float *fixed_next;     /* NULL, or where each fixed coefficient is at the end of the
+                                  * next step (moved by another solve); caller-owned, ncoef */
     float *d_fixed;              /* samples: part of d from coefficients outside the region */
     float *mass_kg, *damp_n_s;   /* samples */
     float *kscale;               /* samples: painted stiffness scale (1 = base) */

@@ -147,13 +147,15 @@ static void test_shifted_window_and_settling_region_share_the_dent(void **st)
                   (double)diff_shift, (double)diff_frozen, (double)moved, s_shift.settle_steps);
     assert_true(s_shift.settle_steps == 30);
     assert_int_equal(s_union.settle_steps, 0); /* the grown window covers the old box */
-    /* Measured: 1.5e-3 against 6.6e-3 frozen, for clay that moved up to 6.2e-3. The rest is
-     * the boundary between the two: each holds the other's coefficients still through its
-     * step, and the B-spline's mass matrix couples neighbouring coefficients, so the fastest
-     * clay (the released dent, right at the boundary) is dragged a little. */
+    /* Measured: 9.7e-4 against 6.6e-3 frozen, for clay that moved up to 6.2e-3 (1.5e-3 when
+     * the settling region held the window's coefficients still instead of on their path).
+     * The rest is the window's side of the boundary: it sees the settling region's
+     * coefficients as still through its step, and the B-spline's mass matrix couples
+     * neighbouring coefficients, so the fastest clay (the released dent, right at the
+     * boundary) is dragged a little. */
     assert_true(diff_frozen > 0.9f * moved);
-    assert_true(diff_shift < 0.3f * moved);
-    assert_true(diff_shift < 0.3f * diff_frozen);
+    assert_true(diff_shift < 0.2f * moved);
+    assert_true(diff_shift < 0.2f * diff_frozen);
     grid_free(pushed); free(pushed);
     grid_free(both); free(both);
     grid_free(shift); free(shift);
