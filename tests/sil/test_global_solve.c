@@ -17,54 +17,26 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/session.h"
+#include "tests/sil/sil_runs.h"
 #include "host/io/ply.h"
 #include "host/mesh/mesh_check.h"
 
 #define CLAY_R_MM 30.0
 
-static char dir_a[64], dir_b[64];
-static session_summary_t sum_a, sum_b; /* a: B-spline, b: springs */
-
-static int run_into(const char *dir, session_summary_t *sum, peer_global_solve_t solve)
-{
-    session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = "scripts/default.scn";
-    o.out_dir = dir;
-    o.deadline_faults = false;
-    o.global_solve = solve;
-    char err[1024] = "";
-    const argil_err_t rc = session_run(&o, sum, err, sizeof(err));
-    if (rc != ARGIL_OK)
-        fprintf(stderr, "session failed: %s\n", err);
-    return rc == ARGIL_OK ? 0 : -1;
-}
+static sil_runs_t runs; /* 0: B-spline, 1: springs */
 
 static int setup(void **st)
 {
     (void)st;
-    strcpy(dir_a, "/tmp/argil-gsolve-XXXXXX");
-    strcpy(dir_b, "/tmp/argil-gsolve-XXXXXX");
-    if (!mkdtemp(dir_a) || !mkdtemp(dir_b))
-        return -1;
-    if (run_into(dir_a, &sum_a, PEER_SOLVE_BSPLINE) != 0 ||
-        run_into(dir_b, &sum_b, PEER_SOLVE_SPRINGS) != 0)
-        return -1;
-    return 0;
+    static const peer_global_solve_t bspline = PEER_SOLVE_BSPLINE, springs = PEER_SOLVE_SPRINGS;
+    const peer_global_solve_t *const solve[2] = {&bspline, &springs};
+    return sil_runs_start(&runs, "argil-gsolve", solve);
 }
 
 static int teardown(void **st)
 {
     (void)st;
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
-    char p[256];
-    for (int d = 0; d < 2; d++) {
-        for (int i = 0; i < 4; i++) {
-            snprintf(p, sizeof(p), "%s/%s", d ? dir_b : dir_a, names[i]);
-            unlink(p);
-        }
-        rmdir(d ? dir_b : dir_a);
-    }
+    sil_runs_remove(&runs);
     return 0;
 }
 
@@ -72,31 +44,31 @@ static void test_session_figures(void **st)
 {
     (void)st;
     printf("# solve steps %u, CPU ms per step median %.2f p99 %.2f max %.2f (ASan build)\n",
-           sum_a.solves, sum_a.solve_median_ms, sum_a.solve_p99_ms, sum_a.solve_max_ms);
-    printf("# peak force %.3f N, volume %.3f -> %.3f cm3, windows %u\n", (double)sum_a.peak_force_n,
-           sum_a.volume_before_m3 * 1e6, sum_a.volume_after_m3 * 1e6, sum_a.windows_sent);
-    assert_true(sum_a.sim_seconds > 10.0);
+           runs.sum[0].solves, runs.sum[0].solve_median_ms, runs.sum[0].solve_p99_ms, runs.sum[0].solve_max_ms);
+    printf("# peak force %.3f N, volume %.3f -> %.3f cm3, windows %u\n", (double)runs.sum[0].peak_force_n,
+           runs.sum[0].volume_before_m3 * 1e6, runs.sum[0].volume_after_m3 * 1e6, runs.sum[0].windows_sent);
+    assert_true(runs.sum[0].sim_seconds > 10.0);
     /* one solve per 10 ms of simulated time */
-    assert_true(sum_a.solves >= (uint32_t)(sum_a.sim_seconds * 100.0) - 2u);
-    assert_int_equal(sum_a.solve_errors, 0);
-    assert_true(sum_a.peak_force_n > 1.0f);
-    assert_true(sum_a.peak_force_n <= sum_a.force_limit_n + 1e-6f);
-    assert_int_equal(sum_a.final_state, SAFETY_ACTIVE);
-    assert_int_equal(sum_a.link_errors, 0);
-    assert_true(sum_a.windows_sent > 5);
-    assert_true(sum_a.impulse_frames > 10);
-    assert_int_equal(sum_a.journal_stray_records, 0); /* every change inside the dirty box */
-    assert_true(sum_a.journal_records > 10);
+    assert_true(runs.sum[0].solves >= (uint32_t)(runs.sum[0].sim_seconds * 100.0) - 2u);
+    assert_int_equal(runs.sum[0].solve_errors, 0);
+    assert_true(runs.sum[0].peak_force_n > 1.0f);
+    assert_true(runs.sum[0].peak_force_n <= runs.sum[0].force_limit_n + 1e-6f);
+    assert_int_equal(runs.sum[0].final_state, SAFETY_ACTIVE);
+    assert_int_equal(runs.sum[0].link_errors, 0);
+    assert_true(runs.sum[0].windows_sent > 5);
+    assert_true(runs.sum[0].impulse_frames > 10);
+    assert_int_equal(runs.sum[0].journal_stray_records, 0); /* every change inside the dirty box */
+    assert_true(runs.sum[0].journal_records > 10);
 }
 
 static void test_mesh_watertight_and_changed(void **st)
 {
     (void)st;
-    assert_true(sum_a.watertight);
+    assert_true(runs.sum[0].watertight);
     const double v0 = 4.0 / 3.0 * M_PI * pow(CLAY_R_MM * 1e-3, 3);
     /* the grid is the model's view from the start: still the sphere */
-    assert_true(fabs(sum_a.volume_before_m3 - v0) / v0 < 0.02);
-    const double dv = (sum_a.volume_after_m3 - sum_a.volume_before_m3) / sum_a.volume_before_m3;
+    assert_true(fabs(runs.sum[0].volume_before_m3 - v0) / v0 < 0.02);
+    const double dv = (runs.sum[0].volume_after_m3 - runs.sum[0].volume_before_m3) / runs.sum[0].volume_before_m3;
     assert_true(dv < -0.002);
     assert_true(dv > -0.2);
 }
@@ -144,7 +116,7 @@ static void test_surface_moved_where_the_script_worked(void **st)
 {
     (void)st;
     shape_t b;
-    measure(dir_a, &b);
+    measure(runs.dir[0], &b);
     printf("# B-spline: dent: +z surface %.2f mm; bump: +x surface %.2f mm; groove top %.2f mm, "
            "beside %.2f mm (sphere %.1f)\n", b.dent_mm, b.bump_mm, b.groove_mm, b.side_mm,
            CLAY_R_MM);
@@ -162,22 +134,22 @@ static void test_same_shape_and_feel_as_the_springs(void **st)
 {
     (void)st;
     shape_t b, s;
-    measure(dir_a, &b);
-    measure(dir_b, &s);
+    measure(runs.dir[0], &b);
+    measure(runs.dir[1], &s);
     printf("# springs:  dent %.2f mm, bump %.2f mm, groove %.2f mm; peak force %.3f / %.3f N\n",
-           s.dent_mm, s.bump_mm, s.groove_mm, (double)sum_a.peak_force_n,
-           (double)sum_b.peak_force_n);
+           s.dent_mm, s.bump_mm, s.groove_mm, (double)runs.sum[0].peak_force_n,
+           (double)runs.sum[1].peak_force_n);
     assert_true(fabs(b.dent_mm - s.dent_mm) < 0.6);
     assert_true(fabs(b.bump_mm - s.bump_mm) < 0.6);
     assert_true(fabs(b.groove_mm - s.groove_mm) < 0.6);
     assert_true(fabs(b.side_mm - s.side_mm) < 0.3);
-    const double dv_b = (sum_a.volume_after_m3 - sum_a.volume_before_m3) / sum_a.volume_before_m3;
-    const double dv_s = (sum_b.volume_after_m3 - sum_b.volume_before_m3) / sum_b.volume_before_m3;
+    const double dv_b = (runs.sum[0].volume_after_m3 - runs.sum[0].volume_before_m3) / runs.sum[0].volume_before_m3;
+    const double dv_s = (runs.sum[1].volume_after_m3 - runs.sum[1].volume_before_m3) / runs.sum[1].volume_before_m3;
     printf("# volume change %.3f %% (B-spline), %.3f %% (springs)\n", dv_b * 100.0, dv_s * 100.0);
     assert_true(fabs(dv_b - dv_s) < 0.002);
-    assert_true(fabs(sum_a.peak_force_n - sum_b.peak_force_n) < 0.1f * sum_b.peak_force_n);
-    assert_true(sum_a.impulse_frames > sum_b.impulse_frames / 2u);
-    assert_true(sum_a.impulse_frames < sum_b.impulse_frames * 2u);
+    assert_true(fabs(runs.sum[0].peak_force_n - runs.sum[1].peak_force_n) < 0.1f * runs.sum[1].peak_force_n);
+    assert_true(runs.sum[0].impulse_frames > runs.sum[1].impulse_frames / 2u);
+    assert_true(runs.sum[0].impulse_frames < runs.sum[1].impulse_frames * 2u);
 }
 
 /* A script that paints stiffness where the stylus touches the clay: the session's model holds

@@ -14,81 +14,53 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/session.h"
+#include "tests/sil/sil_runs.h"
 #include "host/io/ply.h"
 #include "host/mesh/mesh_check.h"
 
 #define CLAY_R_MM 30.0
 
-static char dir_a[64], dir_b[64];
-static session_summary_t sum_a, sum_b;
-
-static int run_into(const char *dir, session_summary_t *sum)
-{
-    session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = "scripts/default.scn";
-    o.out_dir = dir;
-    o.deadline_faults = false; /* misses are counted and asserted below, not turned into faults */
-    char err[1024] = "";
-    const argil_err_t rc = session_run(&o, sum, err, sizeof(err));
-    if (rc != ARGIL_OK)
-        fprintf(stderr, "session failed: %s\n", err);
-    return rc == ARGIL_OK ? 0 : -1;
-}
+static sil_runs_t runs; /* the same session twice */
 
 static int setup(void **st)
 {
     (void)st;
-    strcpy(dir_a, "/tmp/argil-sil-XXXXXX");
-    strcpy(dir_b, "/tmp/argil-sil-XXXXXX");
-    if (!mkdtemp(dir_a) || !mkdtemp(dir_b))
-        return -1;
-    if (run_into(dir_a, &sum_a) != 0 || run_into(dir_b, &sum_b) != 0)
-        return -1;
-    return 0;
+    return sil_runs_start(&runs, "argil-sil", NULL);
 }
 
 static int teardown(void **st)
 {
     (void)st;
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
-    char p[256];
-    for (int d = 0; d < 2; d++) {
-        for (int i = 0; i < 4; i++) {
-            snprintf(p, sizeof(p), "%s/%s", d ? dir_b : dir_a, names[i]);
-            unlink(p);
-        }
-        rmdir(d ? dir_b : dir_a);
-    }
+    sil_runs_remove(&runs);
     return 0;
 }
 
 static void test_realtime_figures(void **st)
 {
     (void)st;
-    assert_true(sum_a.sim_seconds > 10.0);
-    assert_true(sum_a.board_ticks >= (uint32_t)(sum_a.sim_seconds * 1000.0) - 1);
+    assert_true(runs.sum[0].sim_seconds > 10.0);
+    assert_true(runs.sum[0].board_ticks >= (uint32_t)(runs.sum[0].sim_seconds * 1000.0) - 1);
     /* Under ASan a tick runs ~5x slower and its worst case has come within 10 % of the 1 ms
      * period: here at most one miss per thousand ticks is tolerated, and the release build's
      * session (tests/sys/test_default_session_files.sh, what make run shows) must have none. */
-    assert_true(sum_a.deadline_misses <= sum_a.board_ticks / 1000u);
-    assert_true(sum_a.worst_compute_ns > 0);
-    assert_true(sum_a.peak_force_n > 1.0f);                       /* the clay was felt */
-    assert_true(sum_a.peak_force_n <= sum_a.force_limit_n + 1e-6f); /* never past the limit */
-    assert_int_equal(sum_a.final_state, SAFETY_ACTIVE);
-    assert_int_equal(sum_a.link_errors, 0);
-    assert_true(sum_a.windows_sent > 5);
-    assert_true(sum_a.impulse_frames > 10);
+    assert_true(runs.sum[0].deadline_misses <= runs.sum[0].board_ticks / 1000u);
+    assert_true(runs.sum[0].worst_compute_ns > 0);
+    assert_true(runs.sum[0].peak_force_n > 1.0f);                       /* the clay was felt */
+    assert_true(runs.sum[0].peak_force_n <= runs.sum[0].force_limit_n + 1e-6f); /* never past the limit */
+    assert_int_equal(runs.sum[0].final_state, SAFETY_ACTIVE);
+    assert_int_equal(runs.sum[0].link_errors, 0);
+    assert_true(runs.sum[0].windows_sent > 5);
+    assert_true(runs.sum[0].impulse_frames > 10);
 }
 
 static void test_mesh_watertight_and_changed(void **st)
 {
     (void)st;
-    assert_true(sum_a.watertight);
+    assert_true(runs.sum[0].watertight);
     const double v0 = 4.0 / 3.0 * M_PI * pow(CLAY_R_MM * 1e-3, 3);
-    assert_true(fabs(sum_a.volume_before_m3 - v0) / v0 < 0.02); /* the initial sphere */
+    assert_true(fabs(runs.sum[0].volume_before_m3 - v0) / v0 < 0.02); /* the initial sphere */
     /* Dent and groove remove clay, the bump adds some: net loss, and not a trivial one. */
-    const double dv = (sum_a.volume_after_m3 - sum_a.volume_before_m3) / sum_a.volume_before_m3;
+    const double dv = (runs.sum[0].volume_after_m3 - runs.sum[0].volume_before_m3) / runs.sum[0].volume_before_m3;
     assert_true(dv < -0.002);
     assert_true(dv > -0.2);
 }
@@ -122,7 +94,7 @@ static void test_surface_moved_where_the_script_worked(void **st)
 {
     (void)st;
     char path[256], err[512];
-    snprintf(path, sizeof(path), "%s/final.ply", dir_a);
+    snprintf(path, sizeof(path), "%s/final.ply", runs.dir[0]);
     mesh_t m;
     mesh_init(&m);
     assert_int_equal(ply_read_mesh(path, &m, err, sizeof(err)), ARGIL_OK);
@@ -169,13 +141,13 @@ static void test_same_script_same_bytes(void **st)
     const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
     for (int i = 0; i < 4; i++) {
         char a[256], b[256];
-        snprintf(a, sizeof(a), "%s/%s", dir_a, names[i]);
-        snprintf(b, sizeof(b), "%s/%s", dir_b, names[i]);
+        snprintf(a, sizeof(a), "%s/%s", runs.dir[0], names[i]);
+        snprintf(b, sizeof(b), "%s/%s", runs.dir[1], names[i]);
         if (!same_file(a, b))
             fail_msg("%s differs between two runs of the same script", names[i]);
     }
-    assert_int_equal(sum_a.telemetry_rows, sum_b.telemetry_rows);
-    assert_true(sum_a.telemetry_rows >= sum_a.board_ticks - 2);
+    assert_int_equal(runs.sum[0].telemetry_rows, runs.sum[1].telemetry_rows);
+    assert_true(runs.sum[0].telemetry_rows >= runs.sum[0].board_ticks - 2);
 }
 
 int main(void)
