@@ -107,14 +107,18 @@ size_t hud_font_layout(const char *text, float x, float y, float scale, float *q
             for (int col = 0; col < HUD_GLYPH_W; col++) {
                 if (!(rows[r] & (0x10u >> col)))
                     continue;
+                int end = col + 1; /* one past the run's last lit pixel */
+                while (end < HUD_GLYPH_W && (rows[r] & (0x10u >> end)))
+                    end++;
                 if (n < cap) {
                     float *q = quads + 4 * n;
                     q[0] = cx + (float)col * scale;
                     q[1] = cy + (float)r * scale;
-                    q[2] = q[0] + scale;
+                    q[2] = cx + (float)end * scale;
                     q[3] = q[1] + scale;
                 }
                 n++;
+                col = end;
             }
         }
         cx += (float)HUD_ADVANCE * scale;

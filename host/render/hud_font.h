@@ -16,8 +16,10 @@
 bool hud_font_glyph(char c, uint8_t rows[HUD_GLYPH_H]);
 
 /* Lays text out from (x, y), the top-left corner in pixels, scale pixels per font pixel;
- * writes each lit pixel as a quad (x0, y0, x1, y1) into quads, at most cap of them, and returns
- * how many the whole text needs ('\n' starts a new line). */
+ * writes each horizontal run of lit pixels in a glyph row as one quad (x0, y0, x1, y1) into
+ * quads, at most cap of them, and returns how many the whole text needs ('\n' starts a new
+ * line). One quad per run, not per pixel: llvmpipe's cost is per triangle, and a HUD of four
+ * lines drawn pixel by pixel took 5.3 of a frame's 14.5 ms. */
 size_t hud_font_layout(const char *text, float x, float y, float scale, float *quads,
                        size_t cap);
 

@@ -48,25 +48,39 @@ static void test_layout_places_pixels(void **state)
 {
     (void)state;
     float q[4 * 200];
-    /* 'I' is 0E 04 04 04 04 04 0E: 3 + 5 + 3 = 11 pixels; scale 2 from (10, 20). */
+    /* 'I' is 0E 04 04 04 04 04 0E: a 3-pixel run, five single pixels, a 3-pixel run = 7 quads
+     * covering 11 pixels; scale 2 from (10, 20). */
     const size_t n = hud_font_layout("I", 10.0f, 20.0f, 2.0f, q, 200);
-    assert_int_equal(n, 11);
+    assert_int_equal(n, 7);
     assert_float_equal(q[0], 10.0f + 1 * 2.0f, 1e-6); /* top row, columns 1..3 */
     assert_float_equal(q[1], 20.0f, 1e-6);
-    assert_float_equal(q[2] - q[0], 2.0f, 1e-6);
+    assert_float_equal(q[2] - q[0], 3 * 2.0f, 1e-6);
     assert_float_equal(q[3] - q[1], 2.0f, 1e-6);
+    assert_float_equal(q[4 + 0], 10.0f + 2 * 2.0f, 1e-6); /* second row: column 2 alone */
+    assert_float_equal(q[4 + 2] - q[4 + 0], 2.0f, 1e-6);
+    float lit = 0.0f;
+    for (size_t i = 0; i < n; i++)
+        lit += (q[4 * i + 2] - q[4 * i]) * (q[4 * i + 3] - q[4 * i + 1]);
+    assert_float_equal(lit, 11 * 2.0f * 2.0f, 1e-4); /* the same pixels as one quad each */
+    /* '#' has rows with two runs (0A = 01010: two quads) and full rows (1F: one). */
+    const size_t nz = hud_font_layout("#", 0.0f, 0.0f, 1.0f, q, 200);
+    lit = 0.0f;
+    for (size_t i = 0; i < nz; i++)
+        lit += (q[4 * i + 2] - q[4 * i]) * (q[4 * i + 3] - q[4 * i + 1]);
+    assert_float_equal(lit, 2 + 2 + 5 + 2 + 5 + 2 + 2, 1e-4); /* '#': 0A 0A 1F 0A 1F 0A 0A */
+    assert_int_equal(nz, 2 + 2 + 1 + 2 + 1 + 2 + 2);
     /* The second character starts one advance to the right; a newline goes down a line. */
     const size_t n2 = hud_font_layout("II", 0.0f, 0.0f, 1.0f, q, 200);
-    assert_int_equal(n2, 22);
-    assert_float_equal(q[4 * 11], (float)HUD_ADVANCE + 1.0f, 1e-6);
+    assert_int_equal(n2, 14);
+    assert_float_equal(q[4 * 7], (float)HUD_ADVANCE + 1.0f, 1e-6);
     const size_t n3 = hud_font_layout("I\nI", 0.0f, 0.0f, 1.0f, q, 200);
-    assert_int_equal(n3, 22);
-    assert_float_equal(q[4 * 11], 1.0f, 1e-6);
-    assert_float_equal(q[4 * 11 + 1], (float)(HUD_GLYPH_H + 3), 1e-6);
+    assert_int_equal(n3, 14);
+    assert_float_equal(q[4 * 7], 1.0f, 1e-6);
+    assert_float_equal(q[4 * 7 + 1], (float)(HUD_GLYPH_H + 3), 1e-6);
     /* A short buffer is never overrun, and the count says how much was needed. */
     float small[4 * 3];
     memset(small, 0, sizeof(small));
-    assert_int_equal(hud_font_layout("II", 0.0f, 0.0f, 1.0f, small, 3), 22);
+    assert_int_equal(hud_font_layout("II", 0.0f, 0.0f, 1.0f, small, 3), 14);
     assert_int_equal(hud_font_layout("", 0.0f, 0.0f, 1.0f, NULL, 0), 0);
 }
 
