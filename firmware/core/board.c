@@ -131,23 +131,77 @@ typedef struct {
     bool nonfinite;
 } host_events_t;
 
-/* Decodes every frame the host sent; a refused frame is skipped byte by byte until the next
- * frame boundary is found, so one bad frame costs only itself. */
-static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
+/* Acts on one decoded frame from the host. */
+static void handle_frame(board_t *b, const proto_msg_t *m, host_events_t *ev)
+{
+    b->stats.link_frames_rx++;
+    switch (m->type) {
+    case MSG_HELLO:
+        if (m->u.hello.role == PROTO_ROLE_HOST) {
+            b->hello_due = true;
+            b->fault_reported = false; /* a (re)connected host learns a latched fault too */
+        }
+        break;
+    case MSG_HEARTBEAT:
+        ev->heartbeat = true;
+        b->host_window_version = m->u.heartbeat.window_version;
+        b->host_impulse_ack = m->u.heartbeat.impulse_seq;
+        if (m->u.heartbeat.command == PROTO_CMD_ARM)
+            ev->arm = true;
+        else if (m->u.heartbeat.command == PROTO_CMD_DISARM)
+            ev->disarm = true;
+        break;
+    case MSG_WINDOW: {
+        const proto_err_t we = window_feed_decoded(&b->window, &m->u.window);
+        if (we == PROTO_ERR_VALUE)
+            ev->nonfinite = true;
+        if (we != PROTO_OK) {
+            b->stats.link_errors++;
+            b->stats.last_link_error = we;
+        }
+        break;
+    }
+    case MSG_TOOL:
+        b->tool = m->u.tool; /* the decoder has checked every field */
+        b->tool_valid = true;
+        break;
+    default:
+        break; /* TELEMETRY, IMPULSE, FAULT are board → host only */
+    }
+}
+
+/* Decodes the frames in buf[0, len) and acts on them; a refused frame is skipped byte by byte
+ * until the next frame boundary is found, so one bad frame costs only itself. With defer, up
+ * to BOARD_DEFER_FRAMES whole WINDOW frames (magic, type and declared length checked only)
+ * are copied aside undecoded for the next tick. */
+static void decode_frames(board_t *b, const uint8_t *buf, size_t len, bool defer,
+                          host_events_t *ev)
 {
     proto_msg_t *const m = &b->scratch;
     size_t at = 0;
-    const size_t len = in->link_rx ? in->link_rx_len : 0;
     while (at < len) {
+        if (defer && b->deferred_n < BOARD_DEFER_FRAMES && len - at >= PROTO_HEADER_SIZE &&
+            buf[at] == 'A' && buf[at + 1u] == 'R' && buf[at + 2u] == 'G' && buf[at + 3u] == 'L' &&
+            buf[at + 5u] == MSG_WINDOW) {
+            const size_t flen = PROTO_HEADER_SIZE + PROTO_CRC_SIZE +
+                                ((size_t)buf[at + 6u] | (size_t)buf[at + 7u] << 8);
+            if (flen <= PROTO_FRAME_MAX && flen <= len - at) {
+                memcpy(b->deferred[b->deferred_n], buf + at, flen);
+                b->deferred_len[b->deferred_n++] = (uint16_t)flen;
+                b->stats.window_frames_deferred++;
+                at += flen;
+                continue;
+            }
+        }
         size_t flen = 0;
-        const proto_err_t e = proto_decode(in->link_rx + at, len - at, m, &flen);
+        const proto_err_t e = proto_decode(buf + at, len - at, m, &flen);
         if (e != PROTO_OK) {
             b->stats.link_errors++;
             b->stats.last_link_error = e;
             /* A window or tool with NaN, Inf or an out-of-range value: the host is broken, and
              * the safe state is a fault, not a guess. */
             if (e == PROTO_ERR_VALUE && len - at > 5u &&
-                (in->link_rx[at + 5u] == MSG_WINDOW || in->link_rx[at + 5u] == MSG_TOOL))
+                (buf[at + 5u] == MSG_WINDOW || buf[at + 5u] == MSG_TOOL))
                 ev->nonfinite = true;
             if (e == PROTO_ERR_TRUNCATED)
                 break; /* frames arrive whole; the rest of this buffer is a torn frame */
@@ -155,41 +209,20 @@ static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev)
             continue;
         }
         at += flen;
-        b->stats.link_frames_rx++;
-        switch (m->type) {
-        case MSG_HELLO:
-            if (m->u.hello.role == PROTO_ROLE_HOST) {
-                b->hello_due = true;
-                b->fault_reported = false; /* a (re)connected host learns a latched fault too */
-            }
-            break;
-        case MSG_HEARTBEAT:
-            ev->heartbeat = true;
-            b->host_window_version = m->u.heartbeat.window_version;
-            b->host_impulse_ack = m->u.heartbeat.impulse_seq;
-            if (m->u.heartbeat.command == PROTO_CMD_ARM)
-                ev->arm = true;
-            else if (m->u.heartbeat.command == PROTO_CMD_DISARM)
-                ev->disarm = true;
-            break;
-        case MSG_WINDOW: {
-            const proto_err_t we = window_feed_decoded(&b->window, &m->u.window);
-            if (we == PROTO_ERR_VALUE)
-                ev->nonfinite = true;
-            if (we != PROTO_OK) {
-                b->stats.link_errors++;
-                b->stats.last_link_error = we;
-            }
-            break;
-        }
-        case MSG_TOOL:
-            b->tool = m->u.tool; /* the decoder has checked every field */
-            b->tool_valid = true;
-            break;
-        default:
-            break; /* TELEMETRY, IMPULSE, FAULT are board → host only */
-        }
+        handle_frame(b, m, ev);
     }
+}
+
+/* Decodes the WINDOW frames the last tick put off, then every frame the host sent this tick.
+ * A tick that will send impulses (the flush: ~63k instructions of gathering, encoding and
+ * CRC) puts its WINDOW frames off by one tick (~11.5k each), so the two never add up. */
+static void receive_link(board_t *b, const board_in_t *in, host_events_t *ev, bool flush_due)
+{
+    const uint32_t n = b->deferred_n;
+    b->deferred_n = 0;
+    for (uint32_t k = 0; k < n; k++)
+        decode_frames(b, b->deferred[k], b->deferred_len[k], false, ev);
+    decode_frames(b, in->link_rx, in->link_rx ? in->link_rx_len : 0, flush_due, ev);
 }
 
 /* Kinematics: joint angles from the encoders, tip in device and model space, velocity. */
@@ -403,7 +436,9 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     host_events_t ev = {false, false, false, false};
     if (in->can_rx)
         drives_receive(&b->drives, in->can_rx);
-    receive_link(b, in, &ev);
+    receive_link(b, in, &ev,
+                 b->impulse_pending && (b->since_impulse_us + dt_us >= b->cfg.impulse_period_us ||
+                                        window_pending(&b->window)));
     if (ev.arm) {
         drives_clear_emcy(&b->drives);
         /* Re-arm after a drive trip: reset the drives' faults (power stays off) and let the

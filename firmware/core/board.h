@@ -23,6 +23,7 @@
 #define BOARD_IMPULSE_FRAMES_MAX 4u    /* IMPULSE frames per flush; the rest waits a tick */
 #define BOARD_IMPULSE_LOG 4096u        /* sent impulses remembered until the host's window has them */
 #define BOARD_SUBSTEPS_MAX 8u          /* adaptive step halving: at most 3 halvings */
+#define BOARD_DEFER_FRAMES 2u          /* WINDOW frames a tick that sends impulses puts off */
 #define BOARD_SETTLE_TICKS 100u        /* the window's springs run this long after the last push */
 
 /* How long a host's ARM waits in FAULT/IDLE for the drives' fault reset to clear a drive trip
@@ -81,6 +82,7 @@ typedef struct {
     uint32_t link_errors;              /* frames the decoder refused */
     uint32_t link_tx_dropped;          /* frames that did not fit in a tick's output */
     uint32_t windows_swapped;
+    uint32_t window_frames_deferred;   /* decoded a tick late: they came with an impulse flush */
     uint32_t impulses_reapplied;       /* unacknowledged impulses carried into a new window */
     uint32_t impulse_log_overflow;     /* sent impulses forgotten before the host acknowledged them */
     uint32_t max_substeps;             /* most spring sub-steps one tick needed */
@@ -135,6 +137,11 @@ typedef struct {
     bool sculpting;
     board_stats_t stats;
     proto_msg_t scratch;               /* one decoded or outgoing message (a WINDOW chunk is ~1 KiB) */
+    /* WINDOW frames that arrived on a tick that sends impulses, decoded first on the next tick
+     * (the two together were the worst tick: see docs/board.md "Worst tick"). */
+    uint8_t deferred[BOARD_DEFER_FRAMES][PROTO_FRAME_MAX];
+    uint16_t deferred_len[BOARD_DEFER_FRAMES];
+    uint32_t deferred_n;
 } board_t;
 
 void board_cfg_default(board_cfg_t *cfg);
