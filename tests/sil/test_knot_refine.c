@@ -75,9 +75,9 @@ static argil_err_t run(const char *script, const char *out, int ratio, peer_glob
 
 static void cleanup(const char *out)
 {
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn"};
+    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil"};
     char p[256];
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         snprintf(p, sizeof(p), "%s/%s", out, names[i]);
         unlink(p);
     }
