@@ -156,6 +156,22 @@ static void close_window(gsolve_t *gs)
     gs->settle.active = false;
 }
 
+/* The window's coefficient and sample extents, and scratch for one sample array (returned)
+ * followed by one array of max(samples, coefficients) (*tmp); NULL when out of memory. */
+static float *win_scratch(gsolve_t *gs, const physwin_t *w, int32_t nc[3], int32_t ns[3],
+                          float **tmp)
+{
+    const solver_t *s = &w->solver;
+    for (int a = 0; a < 3; a++) {
+        nc[a] = w->chi[a] - w->clo[a];
+        ns[a] = w->shi[a] - w->slo[a];
+    }
+    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
+    if (d)
+        *tmp = d + s->nsamp;
+    return d;
+}
+
 /* Reads the window's coefficients, their velocity, the rest shape and the fixed part of d
  * (coefficients outside the window) again, as physwin_open does: after a tool edit, or (moved)
  * after the window was shifted by whole knot spans, when the fixed flags and the material are
@@ -166,14 +182,10 @@ static argil_err_t reload_win(gsolve_t *gs, physwin_t *w, float dt_s, bool moved
     solver_t *s = &w->solver;
     const field_t *f = &gs->field;
     int32_t nc[3], ns[3];
-    for (int a = 0; a < 3; a++) {
-        nc[a] = w->chi[a] - w->clo[a];
-        ns[a] = w->shi[a] - w->slo[a];
-    }
-    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
+    float *tmp;
+    float *d = win_scratch(gs, w, nc, ns, &tmp);
     if (!d)
         return ARGIL_ERR_NOMEM;
-    float *tmp = d + s->nsamp;
     sparse_read_box(&f->coef, FC_P, w->clo, nc, s->p);
     sparse_read_box(&f->coef, FC_V, w->clo, nc, tmp);
     for (size_t i = 0; i < s->ncoef; i++)
@@ -468,14 +480,10 @@ static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physw
     field_t *f = &gs->field;
     solver_t *s = &w->solver;
     int32_t nc[3], ns[3];
-    for (int a = 0; a < 3; a++) {
-        nc[a] = w->chi[a] - w->clo[a];
-        ns[a] = w->shi[a] - w->slo[a];
-    }
-    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
+    float *tmp;
+    float *d = win_scratch(gs, w, nc, ns, &tmp);
     if (!d)
         return ARGIL_ERR_NOMEM;
-    float *tmp = d + s->nsamp;
     solver_densities(s, d);
     argil_err_t e = ARGIL_OK;
     const float plastic = gs->mat.plastic_rate_hz * dt_s > 1.0f ? 1.0f
