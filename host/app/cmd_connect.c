@@ -17,8 +17,11 @@
 
 #include "firmware/core/safety.h"
 #include "firmware/core/spsc_ring.h"
+#include "host/app/cli_opts.h"
 #include "host/app/commands.h"
+#include "host/app/host_tool.h"
 #include "host/app/peer.h"
+#include "host/app/peer_journal.h"
 #include "host/io/argil_file.h"
 #include "host/io/ply.h"
 #include "host/link/link.h"
@@ -40,6 +43,7 @@
 #define CONNECT_SPACING_M 0.00125f
 #define CONNECT_CLAY_RADIUS_M 0.030f
 #define CONNECT_CLAY_BELOW_M 0.040f       /* clay centre below the workspace centre */
+#define CONNECT_CHECKPOINT_S 60.0f        /* the journal rotates onto a new snapshot this often */
 
 static volatile sig_atomic_t g_connect_stop;
 
@@ -93,6 +97,10 @@ typedef struct {
     double rtt_ms, rtt_worst_ms;
     uint32_t rtt_samples;
     uint32_t windows_seen;
+    /* autosave journal (host/app/peer_journal.h) */
+    journal_t journal;
+    peer_journal_t journal_steps;
+    bool journaling;
 } conn_solver_t;
 
 static uint64_t mono_us(void)
@@ -259,9 +267,10 @@ static int make_dir(const char *path)
     return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
 }
 
-/* Writes DIR/final.ply and DIR/model.argil from the clay; one line into err on failure. */
-static argil_err_t write_model(const grid_t *g, const char *dir, size_t *triangles, char *err,
-                               size_t err_len)
+/* Writes DIR/final.ply and DIR/model.argil (edits: the journal's edit count) from the clay;
+ * one line into err on failure. */
+static argil_err_t write_model(const grid_t *g, const char *dir, uint32_t edits,
+                               size_t *triangles, char *err, size_t err_len)
 {
     char path[4096];
     mesh_t m;
@@ -281,17 +290,48 @@ static argil_err_t write_model(const grid_t *g, const char *dir, size_t *triangl
     argil_doc_t doc;
     argil_doc_init(&doc);
     doc.grid = *g; /* borrowed: the document is not freed */
+    doc.state.edits = edits;
     snprintf(path, sizeof(path), "%s/model.argil", dir);
     return argil_file_write(path, &doc, err, err_len);
 }
 
 /* ---- the command ---- */
 
+/* The host tool's names for help and errors, ", "-separated: which 'a' every action, 's' the
+ * actions that take a strength, 'h' the shapes. wrap > 0: a new line indented by 19 spaces
+ * (the help's option column) before a name that would end past column wrap. */
+static void host_tool_names(char which, size_t wrap, char *out, size_t cap)
+{
+    out[0] = '\0';
+    size_t line_at = 0; /* where the current line starts in out */
+    const int n = which == 'h' ? HOST_SHAPE_COUNT : HOST_ACT_COUNT;
+    for (int k = 0; k < n; k++) {
+        if (which == 's' && !host_action_has_strength((host_action_t)k))
+            continue;
+        const char *name = which == 'h' ? host_shape_name((host_shape_t)k)
+                                        : host_action_name((host_action_t)k);
+        const size_t len = strlen(out);
+        const bool wrap_now =
+            wrap > 0 && len > 0 && 19 + (len - line_at) + strlen(name) + 2 > wrap;
+        const char *sep = len == 0 ? "" : wrap_now ? ",\n                   " : ", ";
+        snprintf(out + len, cap - len, "%s%s", sep, name);
+        if (wrap_now)
+            line_at = len + 2;
+    }
+}
+
 static void usage_connect(FILE *f)
 {
+    char actions[256], strengths[256], shapes[128];
+    host_tool_names('a', 88, actions, sizeof(actions));
+    host_tool_names('s', 88, strengths, sizeof(strengths));
+    host_tool_names('h', 0, shapes, sizeof(shapes));
     fprintf(f,
             "usage: argil connect [--device DEV] [--seconds N] [--arm] [--telemetry FILE.csv]\n"
-            "                     [--out DIR] [--quiet]\n"
+            "                     [--out DIR] [--quiet] [--global-solve bspline|springs]\n"
+            "                     [--knot-ratio 1|2|4] [--action NAME [--strength S]]\n"
+            "                     [--shape NAME] [--mirror AXES] [--autosave-s S]\n"
+            "                     [--no-journal] [--discard-journal]\n"
             "\n"
             "A live session with a board: the host keeps the global clay, sends the board its\n"
             "local window and tool, applies the impulses the board sends back, and records the\n"
@@ -315,12 +355,36 @@ static void usage_connect(FILE *f)
             "  --out DIR        where to write final.ply, model.argil and telemetry.csv at the\n"
             "                   end (default out; created if missing)\n"
             "  --quiet          no status line and no summary\n"
+            "  --global-solve bspline|springs\n"
+            "                   the host's global solve: the implicit B-spline model or the\n"
+            "                   explicit density springs on the grid (default springs; bspline\n"
+            "                   when --knot-ratio, --action, --shape or --mirror ask for it)\n"
+            "  --knot-ratio 1|2|4\n"
+            "                   B-spline: grid samples per knot span (default 1, one coefficient\n"
+            "                   per sample); 2 or 4 solve fewer coefficients\n"
+            "  --action NAME    the board's tool becomes carve, and while stylus button 1 is held\n"
+            "                   the host model does NAME at the tip (B-spline; docs/script.md):\n"
+            "                   %s\n"
+            "  --strength S     per second held, 0..100, for the actions that take one:\n"
+            "                   %s\n"
+            "  --shape NAME     the host tool's shape: %s (default sphere)\n"
+            "  --mirror AXES    also act mirrored across the model's planes: none (default), x,\n"
+            "                   y, z or axes together such as xz\n"
+            "  --autosave-s S   journal every edit into DIR/journal.log and make it durable\n"
+            "                   within S seconds (default 1; docs/files.md); a clean end (also\n"
+            "                   Ctrl-C) removes it, after a crash 'argil recover DIR' restores\n"
+            "                   the model\n"
+            "  --no-journal     no autosave journal\n"
+            "  --discard-journal\n"
+            "                   start even though DIR holds an unfinished session's journal,\n"
+            "                   deleting it\n"
             "  -h, --help       this text\n"
             "\n"
             "exit status: 0 ran for --seconds; 130 ended by Ctrl-C or SIGTERM (files written);\n"
             "1 the link could not be opened (no such device, permission), the board never\n"
             "answered, or a file could not be written; 2 a bad option or device string.\n"
-            "USB without root needs firmware/board/70-argil.rules (docs/link.md).\n");
+            "USB without root needs firmware/board/70-argil.rules (docs/link.md).\n",
+            actions, strengths, shapes);
 }
 
 typedef struct {
@@ -330,7 +394,41 @@ typedef struct {
     const char *telemetry;
     const char *out_dir;
     bool quiet;
+    peer_global_solve_t global_solve;
+    int knot_ratio;                 /* B-spline: grid samples per knot span, 1, 2 or 4 */
+    host_tool_t host_tool;          /* what the board's carve does on the host */
+    bool host_tool_set;             /* --action, --shape or --mirror given: the tool is carve */
+    bool journal;                   /* autosave journal in out_dir */
+    bool discard_journal;
+    float autosave_s;
 } connect_opts_t;
+
+/* The host-model settings after the options: strength against the action, the B-spline model
+ * for knots and host tools. Returns -1 to go on, else the exit status (one line said why). */
+static int check_model_opts(connect_opts_t *o, bool solve_given, bool strength_given,
+                            const char *host_opt)
+{
+    host_tool_t *t = &o->host_tool;
+    if (strength_given && !host_action_has_strength(t->action)) {
+        char list[256];
+        host_tool_names('s', 0, list, sizeof(list));
+        fprintf(stderr, "argil connect: --strength: action '%s' takes none (only %s do)\n",
+                host_action_name(t->action), list);
+        return 2;
+    }
+    if (!strength_given)
+        t->strength = host_action_default_strength(t->action);
+    const char *needs = o->knot_ratio > 1 ? "--knot-ratio" : host_opt;
+    if (needs && o->global_solve == PEER_SOLVE_SPRINGS) {
+        if (solve_given) {
+            fprintf(stderr, "argil connect: %s needs the B-spline model (--global-solve "
+                            "bspline), not springs\n", needs);
+            return 2;
+        }
+        o->global_solve = PEER_SOLVE_BSPLINE;
+    }
+    return -1;
+}
 
 /* Parses the options; returns -1 to go on, else the exit status. */
 static int parse_opts(int argc, char **argv, connect_opts_t *o)
@@ -338,6 +436,13 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
     memset(o, 0, sizeof(*o));
     o->device = "usb";
     o->out_dir = "out";
+    o->global_solve = PEER_SOLVE_SPRINGS; /* connect's default (peer_cfg_default) */
+    o->knot_ratio = 1;
+    host_tool_default(&o->host_tool);
+    o->journal = true;
+    o->autosave_s = 1.0f;
+    bool solve_given = false, strength_given = false;
+    const char *host_opt = NULL;    /* the first of --action, --shape, --mirror given */
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -348,6 +453,66 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             o->arm = true;
         } else if (strcmp(a, "--quiet") == 0) {
             o->quiet = true;
+        } else if (strcmp(a, "--no-journal") == 0) {
+            o->journal = false;
+        } else if (strcmp(a, "--discard-journal") == 0) {
+            o->discard_journal = true;
+        } else if (strcmp(a, "--global-solve") == 0) {
+            if (!cli_global_solve(v, &o->global_solve)) {
+                fprintf(stderr, "argil connect: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS
+                                "\n");
+                return 2;
+            }
+            i++;
+            solve_given = true;
+        } else if (strcmp(a, "--knot-ratio") == 0) {
+            if (!cli_knot_ratio(v, &o->knot_ratio)) {
+                fprintf(stderr, "argil connect: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
+                return 2;
+            }
+            i++;
+        } else if (strcmp(a, "--autosave-s") == 0) {
+            if (!cli_autosave_s(v, &o->autosave_s)) {
+                fprintf(stderr, "argil connect: --autosave-s needs " CLI_AUTOSAVE_EXPECTS
+                                " (see --help)\n");
+                return 2;
+            }
+            i++;
+        } else if (strcmp(a, "--strength") == 0) {
+            char *end = NULL;
+            const double x = v ? strtod(v, &end) : 0.0;
+            if (!v || end == v || *end != '\0' || !(x >= 0.0 && x <= HOST_STRENGTH_MAX)) {
+                fprintf(stderr, "argil connect: --strength needs a number 0..%g (per second "
+                                "held)\n", (double)HOST_STRENGTH_MAX);
+                return 2;
+            }
+            i++;
+            o->host_tool.strength = (float)x;
+            strength_given = true;
+        } else if (strcmp(a, "--action") == 0 || strcmp(a, "--shape") == 0 ||
+                   strcmp(a, "--mirror") == 0) {
+            const int k = !v                 ? -1
+                          : a[2] == 'a'      ? host_action_from_name(v)
+                          : a[2] == 's'      ? host_shape_from_name(v)
+                                             : host_mirror_from_name(v);
+            if (k < 0) {
+                char list[256];
+                host_tool_names(a[2] == 's' ? 'h' : 'a', 0, list, sizeof(list));
+                fprintf(stderr, "argil connect: %s needs %s, got '%s'\n", a,
+                        a[2] == 'm' ? "none, or the axes x, y, z (e.g. xz)" : list,
+                        v ? v : "nothing");
+                return 2;
+            }
+            i++;
+            if (a[2] == 'a')
+                o->host_tool.action = (host_action_t)k;
+            else if (a[2] == 's')
+                o->host_tool.shape = (host_shape_t)k;
+            else
+                o->host_tool.mirror = (uint32_t)k;
+            o->host_tool_set = true;
+            if (!host_opt)
+                host_opt = a;
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--seconds") == 0 ||
                    strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0) {
             if (!v) {
@@ -377,6 +542,9 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             return 2;
         }
     }
+    const int st = check_model_opts(o, solve_given, strength_given, host_opt);
+    if (st >= 0)
+        return st;
     link_spec_t spec;
     const link_spec_err_t pe = link_spec_parse(o->device, &spec);
     if (pe != LINK_SPEC_OK) {
@@ -422,6 +590,11 @@ int cmd_connect(int argc, char **argv)
     const int st = parse_opts(argc, argv, &o);
     if (st >= 0)
         return st;
+    if (o.journal) {
+        const int offer = recover_offer(o.out_dir, o.discard_journal, isatty(STDIN_FILENO) != 0);
+        if (offer >= 0)
+            return offer;
+    }
     const bool tty = isatty(STDERR_FILENO);
     char err[1024] = "";
     int exit_code = 0;
@@ -460,6 +633,8 @@ int cmd_connect(int argc, char **argv)
     peer_cfg_t pc;
     peer_cfg_default(&pc);
     pc.adaptive_region = true; /* real time: a slow solve narrows its region, never the board */
+    pc.global_solve = o.global_solve;
+    pc.knot_ratio = o.knot_ratio;
     if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
             ARGIL_OK ||
         peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
@@ -469,8 +644,15 @@ int cmd_connect(int argc, char **argv)
     }
     grid_fill_sphere(&s->grid, vec3_sub(centre, vec3(0, 0, CONNECT_CLAY_BELOW_M)),
                      CONNECT_CLAY_RADIUS_M);
+    if (peer_set_host_tool(&s->peer, &o.host_tool) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: the host tool was refused (needs the B-spline model)\n");
+        exit_code = 1;
+        goto free_clay;
+    }
     msg_tool_t tool;
     default_tool(&tool);
+    if (o.host_tool_set)
+        tool.kind = TOOL_CARVE; /* the host tool acts while the board's carve is held */
     peer_set_tool(&s->peer, &tool);
     if (o.arm)
         peer_request_arm(&s->peer);
@@ -490,6 +672,15 @@ int cmd_connect(int argc, char **argv)
         fprintf(stderr, "argil connect: %s\n", err);
         exit_code = 1;
         goto free_clay;
+    }
+    if (o.journal) {
+        if (peer_journal_open(&s->journal, o.out_dir, &s->grid, o.autosave_s,
+                              CONNECT_CHECKPOINT_S, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil connect: %s\n", err);
+            exit_code = 1;
+            goto close_csv;
+        }
+        s->journaling = true;
     }
 
     g_connect_stop = 0;
@@ -516,6 +707,7 @@ int cmd_connect(int argc, char **argv)
     uint32_t seen_resyncs = 0, restarts_seen = 0, rx_at_status = 0, tx_at_status = 0;
     uint32_t windows_at_last = 0;
     bool interrupted = false;
+    char journal_err[1024] = "";
     /* What the host knew when the link was lost (for the re-arm rule below). */
     uint32_t faults_at_loss = 0, faults_seen = 0;
     bool loss_by_transport = false, bad_before_loss = false;
@@ -592,6 +784,18 @@ int cmd_connect(int argc, char **argv)
             peer_tick(&s->peer, (uint32_t)dt_us);
             last_us = s->now_us;
         }
+        if (s->journaling) {
+            bool stop_now = false;
+            if (peer_journal_step(&s->journal, &s->journal_steps, &s->peer, elapsed_s,
+                                  &stop_now, err, sizeof(err)) != ARGIL_OK) {
+                /* The person keeps sculpting; the end says the journal broke (exit 1). */
+                fprintf(stderr, "%sargil connect: autosave journal stopped: %s\n",
+                        tty ? "\n" : "", err);
+                snprintf(journal_err, sizeof(journal_err), "%s", err);
+                journal_close(&s->journal);
+                s->journaling = false;
+            }
+        }
         if (s->peer.stats.windows_sent != windows_at_last) {
             windows_at_last = s->peer.stats.windows_sent;
             s->rtt_version = s->peer.current.version;
@@ -639,10 +843,21 @@ int cmd_connect(int argc, char **argv)
             fprintf(stderr, "argil connect: %s: cannot write: %s\n", csv_path, strerror(errno));
             exit_code = 1;
         }
-        if (write_model(&s->grid, o.out_dir, &triangles, err, sizeof(err)) != ARGIL_OK) {
+        if (write_model(&s->grid, o.out_dir, s->journaling ? s->journal.seq : 0u, &triangles,
+                        err, sizeof(err)) != ARGIL_OK) {
             fprintf(stderr, "argil connect: %s\n", err);
             exit_code = 1;
         }
+        /* A clean end: the files are whole, so the journal is no longer needed. */
+        if (s->journaling && exit_code == 0) {
+            s->journaling = false;
+            if (journal_finish(&s->journal, err, sizeof(err)) != ARGIL_OK) {
+                fprintf(stderr, "argil connect: %s\n", err);
+                exit_code = 1;
+            }
+        }
+        if (journal_err[0] != '\0')
+            exit_code = 1;
     }
     if (!o.quiet) {
         const uint32_t rx_drop = atomic_load(&c->rx.dropped);
@@ -672,11 +887,25 @@ int cmd_connect(int argc, char **argv)
         {
             double med = 0, p99 = 0, mx = 0;
             peer_solve_times_ms(&s->peer, &med, &p99, &mx);
-            printf("  global solve        %u steps, CPU time per step median %.2f ms, 99th "
+            printf("  global solve        %s, %u steps, CPU time per step median %.2f ms, 99th "
                    "percentile %.2f ms, max %.2f ms; region narrowed %u times (margin %d..%d "
                    "samples)\n",
-                   s->peer.stats.solves, med, p99, mx, s->peer.stats.region_shrinks,
-                   (int)s->peer.stats.margin_min, PEER_MARGIN_MAX);
+                   cli_global_solve_text(o.global_solve), s->peer.stats.solves, med, p99, mx,
+                   s->peer.stats.region_shrinks, (int)s->peer.stats.margin_min, PEER_MARGIN_MAX);
+        }
+        if (o.global_solve == PEER_SOLVE_BSPLINE)
+            printf("  knots               %d sample%s per knot span\n", o.knot_ratio,
+                   o.knot_ratio == 1 ? "" : "s");
+        {
+            char mirror[8], strength[48] = "";
+            const host_tool_t *t = &s->peer.host_tool;
+            host_mirror_name(t->mirror, mirror);
+            if (host_action_has_strength(t->action))
+                snprintf(strength, sizeof(strength), ", strength %g per s", (double)t->strength);
+            printf("  tool                board %s; host action %s, shape %s, mirror %s%s%s\n",
+                   tool.kind == TOOL_CARVE ? "carve" : "touch", host_action_name(t->action),
+                   host_shape_name(t->shape), mirror, strength,
+                   tool.kind == TOOL_CARVE ? " (while stylus button 1 is held)" : " (idle)");
         }
         if (s->rtt_samples > 0)
             printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
@@ -684,6 +913,16 @@ int cmd_connect(int argc, char **argv)
         printf("  files               %s (%u rows), %s/final.ply (%zu triangles), "
                "%s/model.argil\n",
                csv_path, s->csv_rows, o.out_dir, triangles, o.out_dir);
+        const journal_stats_t *js = &s->journal.stats;
+        if (journal_err[0] != '\0')
+            printf("  autosave journal    STOPPED: %s\n", journal_err);
+        else if (o.journal)
+            printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u "
+                   "checkpoints, %.1f ms of work; %s\n",
+                   js->records, (double)js->bytes / 1024.0, js->syncs, js->checkpoints,
+                   s->journal_steps.real_s * 1e3,
+                   s->journaling ? "KEPT (the end was not clean): 'argil recover' restores"
+                                 : "removed at this clean end");
     }
     if (frames_rx == 0) {
         fprintf(stderr, "argil connect: the board never answered on %s\n", o.device);
@@ -697,6 +936,8 @@ close_csv:
     fclose(s->csv);
     unlink(csv_tmp);
 free_clay:
+    if (s->journaling)
+        journal_close(&s->journal); /* keeps its files: the end was not clean */
     peer_free(&s->peer);
     grid_free(&s->grid);
 close_link:

@@ -66,6 +66,45 @@ static void print_painted(const grid_t *g)
         printf("  painted   nothing (the base material everywhere)\n");
 }
 
+/* The painted colour (section COLR): how many samples differ from the unpainted clay's grey,
+ * the most common such colour, and the sample box they lie in. */
+static void print_colour(const grid_t *g, const uint8_t *rgb)
+{
+    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    size_t count = 0, best_n = 0;
+    uint8_t best[3] = {0, 0, 0};
+    int32_t b0[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, b1[3] = {-1, -1, -1};
+    /* The most common colour by a majority vote (Boyer-Moore), then its exact count. */
+    size_t votes = 0;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *c = rgb + 3 * i;
+        if (c[0] == GRID_RGB_DEFAULT && c[1] == GRID_RGB_DEFAULT && c[2] == GRID_RGB_DEFAULT)
+            continue;
+        count++;
+        if (votes == 0)
+            memcpy(best, c, 3);
+        votes = memcmp(best, c, 3) == 0 ? votes + 1 : votes - 1;
+        const int32_t s[3] = {(int32_t)(i % (size_t)g->dims[0]),
+                              (int32_t)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
+                              (int32_t)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]))};
+        for (int a = 0; a < 3; a++) {
+            b0[a] = s[a] < b0[a] ? s[a] : b0[a];
+            b1[a] = s[a] > b1[a] ? s[a] : b1[a];
+        }
+    }
+    for (size_t i = 0; i < n && count > 0; i++)
+        best_n += memcmp(best, rgb + 3 * i, 3) == 0;
+    if (count == 0) {
+        printf("  colour    unpainted (every sample the clay's %u %u %u)\n", GRID_RGB_DEFAULT,
+               GRID_RGB_DEFAULT, GRID_RGB_DEFAULT);
+        return;
+    }
+    printf("  colour    painted on %zu samples (%u %u %u on %zu of them), box (%d, %d, %d) .. "
+           "(%d, %d, %d); unpainted %u %u %u\n",
+           count, best[0], best[1], best[2], best_n, b0[0], b0[1], b0[2], b1[0], b1[1], b1[2],
+           GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT);
+}
+
 int cmd_info(int argc, char **argv)
 {
     if (argc != 1 || strcmp(argv[0], "-h") == 0 || strcmp(argv[0], "--help") == 0) {
@@ -91,6 +130,8 @@ int cmd_info(int argc, char **argv)
                g->material.node_mass, g->material.stiffness, g->material.coupling,
                g->material.damping, g->material.plastic_rate_hz);
         print_painted(g);
+        if (d.rgb != NULL)
+            print_colour(g, d.rgb);
         printf("  tool      kind %u, radius %.4g mm, strength %.3g\n", d.tool.tool_kind,
                d.tool.radius_m * 1e3, d.tool.strength);
         if (d.has_rbf)

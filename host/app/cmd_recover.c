@@ -188,6 +188,9 @@ int cmd_recover(int argc, char **argv)
                    doc.grid.mat[GRID_MAT_DAMPING] || doc.grid.mat[GRID_MAT_RESTLEN]
                ? "the model holds painted channels"
                : "the model holds none");
+    printf("  painted colour      %llu samples replayed; %s\n",
+           (unsigned long long)info.rgb_samples,
+           doc.rgb != NULL ? "the model holds painted colour" : "the model holds none");
     printf("  model as of         edit %u, %.3f s into the session\n", info.edits,
            info.last_sim_s);
     printf("  last record written %s (unix ms %llu)\n", when,

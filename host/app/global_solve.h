@@ -64,6 +64,7 @@ typedef struct {
     uint32_t settle_steps;            /* steps of a region the board's window left */
     uint32_t settle_rested;           /* such regions that came to rest */
     uint32_t settle_dropped;          /* such regions given up still moving (a newer one came) */
+    uint32_t settle_reloads;          /* main window re-read because such a region moved it */
 } gsolve_stats_t;
 
 /* A region the board's window left while it was still moving (clay springing back after the
@@ -192,5 +193,30 @@ argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g);
 argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, float radius_m,
                               vec3_t axis, const vec3_t *pts_m, size_t n_pts, float dt_s,
                               int32_t lo[3], int32_t hi[3]);
+
+/* ---- painted colour (helper "colour"; docs/model.md "In the session") ---- */
+
+/* Mirrors the model's colour (FS_R, FS_G, FS_B, 0..1) in sample box [lo, hi) (clipped to the
+ * grid) into the grid's rgb as bytes (round(255 v)), allocating g->rgb only once a sample
+ * differs from GRID_RGB_DEFAULT; bumps g->rgb_writes when anything changed (the journal then
+ * records it). gsolve_apply_tool calls it after a paint; call it after anything else that
+ * changes the model's colour (an undo) with the box it changed. ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3],
+                                  const int32_t hi[3]);
+
+/* The other way, for a model loaded into the grid: the grid's rgb (when present) becomes the
+ * model's FS_R/G/B (byte / 255, which colour_to_grid turns back into the same byte).
+ * ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_colour_from_grid(gsolve_t *gs, const grid_t *g);
+
+/* ---- undo and redo in the session (helper "undo"; host/app/session_undo.h) ---- */
+
+/* After the field was set back to an earlier state in sample box [lo, hi) (undo or redo): the
+ * physical window and any settling region close (the next step reopens them from the field),
+ * and the grid view follows in the box clipped to the grid: densities (the GSOLVE_VIEW_EPS
+ * rule), velocity 0, painted material and colour. The grid box goes to glo/ghi (glo = ghi:
+ * none). ARGIL_ERR_NOMEM. */
+argil_err_t gsolve_restored(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
+                            int32_t glo[3], int32_t ghi[3]);
 
 #endif

@@ -6,16 +6,19 @@
 
 static const char *const ACTION_NAMES[HOST_ACT_COUNT] = {
     "carve", "add", "toothpaste", "soft-erase", "smooth",
-    "stamp", "chisel", "squirt", "interior-carve"};
+    "stamp", "chisel", "squirt", "interior-carve", "paint", "soft-paint"};
 static const char *const SHAPE_NAMES[HOST_SHAPE_COUNT] = {"sphere", "box", "cylinder", "torus"};
 
 /* Per second held: toothpaste / soft erase move the density at the tool centre by 5 a second
  * (0.05 a 10 ms solve step, so a stroke builds up over a few tenths of a second); smoothing
  * blends a fifth of the way to the neighbours' mean per step; a stamp presses its full dent in
- * about half a second; chisel and squirt move the surface 2 mm a second. */
+ * about half a second; chisel and squirt move the surface 2 mm a second; soft paint blends at
+ * most a fifth of the way to its colour per step (x the tool's profile and the density: 86 % in
+ * 0.1 s at a 4 mm ball's centre, tests/unit/test_gsolve_colour.c). */
 static const float DEFAULT_STRENGTH[HOST_ACT_COUNT] = {
     [HOST_ACT_TOOTHPASTE] = 5.0f, [HOST_ACT_SOFT_ERASE] = 5.0f, [HOST_ACT_SMOOTH] = 20.0f,
-    [HOST_ACT_STAMP] = 2.0f,      [HOST_ACT_CHISEL] = 2.0f,     [HOST_ACT_SQUIRT] = 2.0f};
+    [HOST_ACT_STAMP] = 2.0f,      [HOST_ACT_CHISEL] = 2.0f,     [HOST_ACT_SQUIRT] = 2.0f,
+    [HOST_ACT_SOFT_PAINT] = 20.0f};
 
 void host_tool_default(host_tool_t *t)
 {
@@ -24,6 +27,9 @@ void host_tool_default(host_tool_t *t)
     t->shape = HOST_SHAPE_SPHERE;
     t->mirror = 0;
     t->strength = 0.0f;
+    t->rgb[0] = HOST_PAINT_R;
+    t->rgb[1] = HOST_PAINT_G;
+    t->rgb[2] = HOST_PAINT_B;
 }
 
 bool host_tool_is_default(const host_tool_t *t)
@@ -72,6 +78,11 @@ bool host_action_has_strength(host_action_t a)
 float host_action_default_strength(host_action_t a)
 {
     return (unsigned)a < HOST_ACT_COUNT ? DEFAULT_STRENGTH[a] : 0.0f;
+}
+
+bool host_action_paints(host_action_t a)
+{
+    return a == HOST_ACT_PAINT || a == HOST_ACT_SOFT_PAINT;
 }
 
 void host_mirror_name(uint32_t mirror, char *out)

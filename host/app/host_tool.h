@@ -18,6 +18,8 @@ typedef enum {
     HOST_ACT_CHISEL,          /* the surface sinks along its normal (strength: mm per second) */
     HOST_ACT_SQUIRT,          /* the surface rises along its normal */
     HOST_ACT_INTERIOR_CARVE,  /* carve inside the solid, the outer shell kept */
+    HOST_ACT_PAINT,           /* Ferley's paint: the samples inside the tool take its colour */
+    HOST_ACT_SOFT_PAINT,      /* colour blended in progressively (strength per second) */
     HOST_ACT_COUNT
 } host_action_t;
 
@@ -35,6 +37,10 @@ typedef enum {
 #define HOST_MIRROR_ALL 7u
 #define HOST_STRENGTH_MAX 100.0f
 #define HOST_TORUS_TUBE_FRACTION (1.0f / 3.0f)
+/* The paint colour a session starts with: terracotta red, far from the clay's grey. */
+#define HOST_PAINT_R 200u
+#define HOST_PAINT_G 60u
+#define HOST_PAINT_B 40u
 
 typedef struct {
     host_action_t action;
@@ -42,10 +48,13 @@ typedef struct {
     uint32_t mirror;          /* HOST_MIRROR_* bits, about the model's origin planes */
     float strength;           /* per second held: toothpaste / soft erase (density at the tool
                                * centre), smooth (low-pass rate), stamp (def amplitude); chisel /
-                               * squirt: mm per second; unused by carve, add, interior carve */
+                               * squirt: mm per second; soft paint: blend rate; unused by
+                               * carve, add, interior carve, paint */
+    uint8_t rgb[3];           /* the colour paint and soft paint lay down */
 } host_tool_t;
 
-/* Carve, sphere, no mirror (what the board's carve always did on the host). */
+/* Carve, sphere, no mirror, paint colour HOST_PAINT_R/G/B (what the board's carve always did
+ * on the host). */
 void host_tool_default(host_tool_t *t);
 
 /* True for the default setting: the session applies exactly the one-sphere eraser it always
@@ -65,6 +74,9 @@ int host_shape_from_name(const char *name);
 /* Whether the action takes a strength, and its default (per second held). */
 bool host_action_has_strength(host_action_t a);
 float host_action_default_strength(host_action_t a);
+
+/* True for paint and soft paint: the action changes colour only, never the clay's shape. */
+bool host_action_paints(host_action_t a);
 
 /* "none", "x", "xz", ... into out (≥ 5 bytes). */
 void host_mirror_name(uint32_t mirror, char *out);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
+#include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/app/sculpt_window.h"
 #include "host/app/session.h"
@@ -75,6 +76,9 @@ static void usage_sculpt(FILE *f)
             "                  B-spline: grid samples per knot span at the start (default 1,\n"
             "                  one coefficient per sample); 2 or 4 solve fewer coefficients and\n"
             "                  a script's 'refine' (or the K key) inserts knots: R halves\n"
+            "  --undo-mb N     memory for undo and redo, MiB (default 256; 0: no undo): one\n"
+            "                  step per stroke, the oldest dropped first (script verbs undo,\n"
+            "                  redo; Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y in the window)\n"
             "  --quiet         no progress line and no summary\n"
             "  --screenshot FILE.png\n"
             "                  afterwards, render the final clay with the tool where it ended\n"
@@ -106,6 +110,13 @@ static void usage_sculpt(FILE *f)
             "  -h, --help      this text\n");
 }
 
+/* A refused undo / redo of the script, as it happens (the session goes on). */
+static void print_note(void *ctx, const char *msg)
+{
+    (void)ctx;
+    fprintf(stderr, "argil sculpt: %s\n", msg);
+}
+
 int cmd_sculpt(int argc, char **argv)
 {
     session_opts_t o;
@@ -131,14 +142,12 @@ int cmd_sculpt(int argc, char **argv)
         } else if (strcmp(a, "--discard-journal") == 0) {
             discard_journal = true;
         } else if (strcmp(a, "--autosave-s") == 0 || strcmp(a, "--checkpoint-s") == 0) {
-            char *end = NULL;
-            const double sec = v ? strtod(v, &end) : 0.0;
-            if (!v || *end != '\0' || !(sec >= 0.001 && sec <= 3600.0)) {
-                fprintf(stderr, "argil sculpt: %s needs seconds in 0.001..3600 (see --help)\n", a);
+            if (!cli_autosave_s(v, a[2] == 'a' ? &o.autosave_s : &o.checkpoint_s)) {
+                fprintf(stderr, "argil sculpt: %s needs " CLI_AUTOSAVE_EXPECTS " (see --help)\n",
+                        a);
                 return 2;
             }
             i++;
-            *(a[2] == 'a' ? &o.autosave_s : &o.checkpoint_s) = (float)sec;
         } else if (strcmp(a, "--debug-journal-dump") == 0) {
             /* Tests: --debug-journal-dump N FILE.argil writes the model as of journal record N
              * and ends the session there (tests/sys/test_crash_recovery.sh). */
@@ -178,20 +187,28 @@ int cmd_sculpt(int argc, char **argv)
             i++;
             *(a[2] == 'w' ? &wo.width : &wo.height) = (int)px;
         } else if (strcmp(a, "--global-solve") == 0) {
-            if (!v || (strcmp(v, "bspline") != 0 && strcmp(v, "springs") != 0)) {
-                fprintf(stderr, "argil sculpt: --global-solve needs 'bspline' or 'springs'\n");
+            if (!cli_global_solve(v, &o.global_solve)) {
+                fprintf(stderr,
+                        "argil sculpt: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS "\n");
                 return 2;
             }
             i++;
-            o.global_solve = v[0] == 'b' ? PEER_SOLVE_BSPLINE : PEER_SOLVE_SPRINGS;
+        } else if (strcmp(a, "--undo-mb") == 0) {
+            char *end = NULL;
+            const long mb = v ? strtol(v, &end, 10) : -1;
+            if (!v || v[0] == '\0' || *end != '\0' || mb < 0 || mb > (long)SESSION_UNDO_MB_MAX) {
+                fprintf(stderr, "argil sculpt: --undo-mb needs MiB 0..%u (0: no undo)\n",
+                        SESSION_UNDO_MB_MAX);
+                return 2;
+            }
+            i++;
+            o.undo_mb = (uint32_t)mb;
         } else if (strcmp(a, "--knot-ratio") == 0) {
-            if (!v || (strcmp(v, "1") != 0 && strcmp(v, "2") != 0 && strcmp(v, "4") != 0)) {
-                fprintf(stderr, "argil sculpt: --knot-ratio needs 1, 2 or 4 (grid samples per "
-                                "knot span)\n");
+            if (!cli_knot_ratio(v, &o.knot_ratio)) {
+                fprintf(stderr, "argil sculpt: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
                 return 2;
             }
             i++;
-            o.knot_ratio = v[0] - '0';
         } else if (strcmp(a, "--iso2") == 0) {
             char *end = NULL;
             const double x = v ? strtod(v, &end) : 0.0;
@@ -260,6 +277,7 @@ int cmd_sculpt(int argc, char **argv)
     }
     o.progress = !quiet && isatty(STDERR_FILENO);
     o.stop = &g_stop;
+    o.on_note = print_note;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     session_summary_t s;
@@ -321,14 +339,23 @@ int cmd_sculpt(int argc, char **argv)
                    s.rt.compute_max_ns / 1000.0, s.rt.overruns, s.rt.worst_streak);
         printf("  global solve        %s, %u steps, CPU time per step median %.2f ms, 99th "
                "percentile %.2f ms, max %.2f ms; session wall time %.2f s\n",
-               o.global_solve == PEER_SOLVE_BSPLINE ? "B-spline model (implicit)"
-                                                    : "density springs (explicit)",
+               cli_global_solve_text(o.global_solve),
                s.solves, s.solve_median_ms, s.solve_p99_ms, s.solve_max_ms, s.real_seconds);
         if (o.global_solve == PEER_SOLVE_BSPLINE)
             printf("  knots               %d sample%s per knot span at the start, %d at the end; "
                    "%u refinement%s (largest density change %.2g)\n",
                    o.knot_ratio, o.knot_ratio == 1 ? "" : "s", s.knot_ratio_end, s.refines,
                    s.refines == 1 ? "" : "s", (double)s.refine_max_dd);
+        if (s.undo_on)
+            printf("  undo                %u stroke%s recorded (%u undone, %u redone, %u refused), "
+                   "%.1f KiB held of %u MiB (largest %.1f KiB), shadow %.1f MiB, slowest "
+                   "boundary %.1f ms\n",
+                   s.undo_steps, s.undo_steps == 1 ? "" : "s", s.undos, s.redos, s.undo_refused,
+                   (double)s.undo_bytes / 1024.0, o.undo_mb,
+                   (double)s.undo_max_step_bytes / 1024.0,
+                   (double)s.undo_shadow_bytes / (1024.0 * 1024.0), s.undo_max_work_ms);
+        else
+            printf("  undo                %s\n", s.undo_note);
         printf("  peak force          %.3f N (limit %.2f N)\n", (double)s.peak_force_n,
                (double)s.force_limit_n);
         printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,

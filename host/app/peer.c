@@ -56,8 +56,13 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
         }
         argil_err_t e = gsolve_init_ratio(p->gs, grid, cfg->knot_ratio);
         /* A loaded model's painted material (.argil MTLS, journal recovery). */
-        if (e == ARGIL_OK && (e = gsolve_material_from_grid(p->gs, grid)) != ARGIL_OK)
-            gsolve_free(p->gs);
+        if (e == ARGIL_OK) {
+            e = gsolve_material_from_grid(p->gs, grid);
+            if (e == ARGIL_OK) /* and its painted colour (grid rgb, from .argil COLR) */
+                e = gsolve_colour_from_grid(p->gs, grid);
+            if (e != ARGIL_OK)
+                gsolve_free(p->gs);
+        }
         if (e != ARGIL_OK) {
             free(p->gs);
             p->gs = NULL;
@@ -430,8 +435,9 @@ static void solve_bspline(peer_t *p)
         if (e != ARGIL_OK) {
             solve_error(p, e);
         } else if (hi[0] > lo[0]) {
+            /* Re-meshed (and journaled) either way; a paint leaves the board's densities be. */
             mark_dirty(p, lo, hi);
-            p->field_dirty = true;
+            p->field_dirty = p->field_dirty || !host_action_paints(p->host_tool.action);
         }
     } else {
         p->host_prev_valid = false;
@@ -654,4 +660,14 @@ void peer_set_solve_period_us(peer_t *p, uint32_t us)
     if (us < PEER_SOLVE_PERIOD_MIN_US) us = PEER_SOLVE_PERIOD_MIN_US;
     if (us > PEER_SOLVE_PERIOD_MAX_US) us = PEER_SOLVE_PERIOD_MAX_US;
     p->cfg.solve_period_us = us;
+}
+
+void peer_model_restored(peer_t *p, const int32_t lo[3], const int32_t hi[3])
+{
+    if (hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])
+        mark_dirty(p, lo, hi);
+    /* A window being sent was cut before the change: the one after it carries the new state. */
+    p->field_dirty = true;
+    p->since_window_us = p->cfg.window_min_period_us;
+    p->host_prev_valid = false;
 }

@@ -196,4 +196,10 @@ void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *m
  * row under 40 % raise it by one (not above PEER_MARGIN_MAX). Called by the peer itself. */
 void peer_adapt_region(peer_t *p, double step_ms);
 
+/* The model was set back to an earlier state (undo or redo, host/app/session_undo.h) and the
+ * grid follows in sample box [lo, hi): re-mesh it (dirty box; the journal records it with the
+ * next solve step), send the board a fresh window (so its local window keeps no undone dent)
+ * and let the host tool start a new stroke. */
+void peer_model_restored(peer_t *p, const int32_t lo[3], const int32_t hi[3]);
+
 #endif

@@ -155,27 +155,63 @@ static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c,
         c->arg_int = k;
         return ARGIL_OK;
     }
-    if (n != 2 && n != 4)
-        FAIL("line %d: 'action' takes a name (%s) and optionally strength S", lineno, list);
-    if (strcmp(w[1], "paint") == 0)
-        FAIL("line %d: 'action paint': painted colour would not show (the session's grid, mesh "
-             "and files carry no colour; docs/model.md)", lineno);
+    if (n < 2)
+        FAIL("line %d: 'action' takes a name (%s) and optionally strength S (paint and "
+             "soft-paint: rgb R G B)", lineno, list);
     const int k = host_action_from_name(w[1]);
     if (k < 0)
         FAIL("line %d: unknown action '%s' (%s)", lineno, w[1], list);
+    const bool paints = host_action_paints((host_action_t)k);
     c->op = SCRIPT_ACTION;
     c->arg_int = k;
     c->value = host_action_default_strength((host_action_t)k);
-    if (n == 4) {
-        if (strcmp(w[2], "strength") != 0)
-            FAIL("line %d: 'action' takes NAME [strength S], not '%s'", lineno, w[2]);
-        if (!host_action_has_strength((host_action_t)k))
-            FAIL("line %d: 'action %s' takes no strength (it acts in full at once)", lineno, w[1]);
-        if (!parse_float(w[3], &c->value))
-            FAIL("line %d: '%s' is not a number", lineno, w[3]);
-        if (!(c->value >= 0.0f && c->value <= HOST_STRENGTH_MAX))
-            FAIL("line %d: strength must be within 0 … %g, got %s", lineno,
-                 (double)HOST_STRENGTH_MAX, w[3]);
+    /* An action's paint colour rides in target_m (r, g, b as 0 … 255). */
+    c->target_m = vec3(HOST_PAINT_R, HOST_PAINT_G, HOST_PAINT_B);
+    bool have_strength = false, have_rgb = false;
+    for (int i = 2; i < n;) {
+        if (strcmp(w[i], "strength") == 0) {
+            if (i + 1 >= n)
+                FAIL("line %d: 'action' takes a name (%s) and optionally strength S", lineno,
+                     list);
+            if (!host_action_has_strength((host_action_t)k))
+                FAIL("line %d: 'action %s' takes no strength (it acts in full at once)", lineno,
+                     w[1]);
+            if (have_strength)
+                FAIL("line %d: 'strength' given twice", lineno);
+            if (!parse_float(w[i + 1], &c->value))
+                FAIL("line %d: '%s' is not a number", lineno, w[i + 1]);
+            if (!(c->value >= 0.0f && c->value <= HOST_STRENGTH_MAX))
+                FAIL("line %d: strength must be within 0 … %g, got %s", lineno,
+                     (double)HOST_STRENGTH_MAX, w[i + 1]);
+            have_strength = true;
+            i += 2;
+        } else if (strcmp(w[i], "rgb") == 0 && paints) {
+            if (have_rgb)
+                FAIL("line %d: 'rgb' given twice", lineno);
+            if (i + 3 >= n)
+                FAIL("line %d: 'rgb' takes three whole numbers 0 … 255 (R G B)", lineno);
+            float v[3];
+            for (int a = 0; a < 3; a++) {
+                char *end;
+                errno = 0;
+                const long x = strtol(w[i + 1 + a], &end, 10);
+                if (end == w[i + 1 + a] || *end != '\0' || errno == ERANGE || x < 0 || x > 255)
+                    FAIL("line %d: 'rgb' takes three whole numbers 0 … 255, got '%s'", lineno,
+                         w[i + 1 + a]);
+                v[a] = (float)x;
+            }
+            c->target_m = vec3(v[0], v[1], v[2]);
+            have_rgb = true;
+            i += 4;
+        } else if (strcmp(w[i], "rgb") == 0) {
+            FAIL("line %d: 'action %s' takes no colour (rgb is for paint and soft-paint)", lineno,
+                 w[1]);
+        } else if (paints) {
+            FAIL("line %d: 'action %s' takes NAME [rgb R G B]%s, not '%s'", lineno, w[1],
+                 host_action_has_strength((host_action_t)k) ? " [strength S]" : "", w[i]);
+        } else {
+            FAIL("line %d: 'action' takes NAME [strength S], not '%s'", lineno, w[i]);
+        }
     }
     return ARGIL_OK;
 }
@@ -294,10 +330,16 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
         c->op = SCRIPT_REFINE;
         return ARGIL_OK;
     }
+    if (strcmp(op, "undo") == 0 || strcmp(op, "redo") == 0) {
+        if (n != 1)
+            FAIL("line %d: '%s' takes no arguments", lineno, op);
+        c->op = op[0] == 'u' ? SCRIPT_UNDO : SCRIPT_REDO;
+        return ARGIL_OK;
+    }
     if (strcmp(op, "action") == 0 || strcmp(op, "action_shape") == 0 || strcmp(op, "mirror") == 0)
         return parse_host_tool(w, n, lineno, c, err, err_len);
     FAIL("line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
-         "wait, paint, refine, action, action_shape, mirror)",
+         "wait, paint, refine, action, action_shape, mirror, undo, redo)",
          lineno, op);
 }
 
@@ -323,11 +365,12 @@ argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, s
         if (memchr(line, '\0', l) != NULL)
             FAIL("line %d: contains a NUL byte", lineno);
         at = end + 1;
-        char *w[6];
-        const int n = split_words(line, w, 5);
+        char *w[9];
+        const int n = split_words(line, w, 8);
         if (n == 0)
             continue;
-        if (n > 5)
+        /* At most 5 words, but `action soft-paint rgb R G B strength S` takes 8. */
+        if (n > 8 || (n > 5 && strcmp(w[0], "action") != 0))
             FAIL("line %d: too many words", lineno);
         script_cmd_t c;
         const argil_err_t e = parse_line(w, n, lineno, &c, err, err_len);
@@ -406,6 +449,14 @@ int script_first_host_tool_line(const script_t *s)
     return 0;
 }
 
+int script_first_history_line(const script_t *s)
+{
+    for (size_t i = 0; i < s->count; i++)
+        if (s->cmds[i].op == SCRIPT_UNDO || s->cmds[i].op == SCRIPT_REDO)
+            return s->cmds[i].line;
+    return 0;
+}
+
 int script_refine_line(const script_t *s, int nth)
 {
     int k = 0;
@@ -439,7 +490,7 @@ int script_player_step(script_player_t *p, float dt_s)
      * the previous step were the caller's to apply before this call. */
     p->paints_pending = 0;
     p->refines_pending = 0;
-    while (!p->active && p->next < p->script->count) {
+    while (!p->active && !p->history_op && p->next < p->script->count) {
         if (p->script->cmds[p->next].op == SCRIPT_PAINT &&
             p->paints_pending >= (int)SCRIPT_PAINTS_PENDING_MAX)
             return 0;
@@ -456,9 +507,18 @@ int script_player_step(script_player_t *p, float dt_s)
         case SCRIPT_REFINE:
             p->refines_pending++;
             break;
+        case SCRIPT_UNDO:
+        case SCRIPT_REDO:
+            /* Waits (the hand holding still) until the session did it or refused it. */
+            p->history_op = c->op;
+            p->history_line = c->line;
+            break;
         case SCRIPT_ACTION:
             p->host_tool.action = (host_action_t)c->arg_int;
             p->host_tool.strength = c->value;
+            p->host_tool.rgb[0] = (uint8_t)c->target_m.x;
+            p->host_tool.rgb[1] = (uint8_t)c->target_m.y;
+            p->host_tool.rgb[2] = (uint8_t)c->target_m.z;
             p->params_changed = 1;
             break;
         case SCRIPT_ACTION_SHAPE:
@@ -513,7 +573,7 @@ int script_player_step(script_player_t *p, float dt_s)
     }
     if (!p->active) {
         p->vel_m_s = vec3(0, 0, 0);
-        return 1;
+        return p->history_op ? 0 : 1;
     }
     p->elapsed_s += dt_s;
     /* Half a step of slack so float rounding never adds a tick to a move. */

@@ -23,7 +23,9 @@ typedef enum {
     SCRIPT_REFINE,    /* refine: a knot in every span of the B-spline model (R halves) */
     SCRIPT_ACTION,    /* action NAME [strength S]: what carve does on the host (host_tool.h) */
     SCRIPT_ACTION_SHAPE, /* action_shape sphere|box|cylinder|torus */
-    SCRIPT_MIRROR     /* mirror none|x|y|z|xy|...: the host tool's mirror planes */
+    SCRIPT_MIRROR,    /* mirror none|x|y|z|xy|...: the host tool's mirror planes */
+    SCRIPT_UNDO,      /* undo: the last stroke (host/app/session_undo.h); the player waits */
+    SCRIPT_REDO       /* redo: the stroke undone last */
 } script_op_t;
 
 typedef enum { SCRIPT_PAINT_STIFFNESS = 0, SCRIPT_PAINT_MASS } script_paint_ch_t;
@@ -114,6 +116,9 @@ typedef struct {
     int paints_pending;       /* caller applies them before the next step (which drops them) */
     int refines_pending;      /* refine commands reached by the last step (the same rule) */
     host_tool_t host_tool;    /* action, action_shape, mirror (sets params_changed) */
+    int history_op;           /* an undo (SCRIPT_UNDO) or redo reached: the player holds still
+                               * until the caller clears it (done or refused) */
+    int history_line;         /* its line */
 } script_player_t;
 
 /* The first paint command's line, or 0 when the script has none. */
@@ -121,6 +126,9 @@ int script_first_paint_line(const script_t *s);
 
 /* The first action, action_shape or mirror command's line, or 0 when the script has none. */
 int script_first_host_tool_line(const script_t *s);
+
+/* The first undo or redo command's line, or 0 when the script has none. */
+int script_first_history_line(const script_t *s);
 
 /* The line of the nth (1-based) refine command, or 0 when the script has fewer. */
 int script_refine_line(const script_t *s, int nth);

@@ -68,6 +68,7 @@ static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussia
 #define PANEL_HOST_SHAPE (-3)
 #define PANEL_HOST_MIRROR (-4)
 #define PANEL_HOST_STRENGTH (-5)
+#define PANEL_HOST_COLOUR (-6)        /* -/+ (or key P) step through PAINT_PALETTE */
 #define HOST_MIRROR_TOGGLE_X 2.0f     /* UI_CMD_PARAM value on the mirror row: toggle x (+1 y, +2 z) */
 
 /* The panel's parameters: ranges as scripts accept them (host/app/script.c), a step factor,
@@ -92,7 +93,34 @@ static const struct {
     {PANEL_HOST_SHAPE, "host shape", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_MIRROR, "mirror", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_STRENGTH, "host strength /s", 0.0f, HOST_STRENGTH_MAX, 1.25f, 0.1f},
+    {PANEL_HOST_COLOUR, "paint colour", 0.0f, 0.0f, 1.0f, 0.0f},
 };
+
+/* The colours the window's paint and soft paint pick from (key P, or the panel row); the first
+ * is the session's default (HOST_PAINT_R/G/B); the last is the unpainted clay's own colour, so
+ * painting with it takes paint off again. Scripts may paint any colour (docs/script.md). */
+static const struct {
+    const char *name;
+    uint8_t rgb[3];
+} PAINT_PALETTE[] = {
+    {"terracotta", {HOST_PAINT_R, HOST_PAINT_G, HOST_PAINT_B}},
+    {"ochre", {215, 160, 40}},
+    {"olive", {90, 140, 60}},
+    {"blue", {50, 90, 190}},
+    {"charcoal", {50, 50, 55}},
+    {"white", {240, 240, 235}},
+    {"clay (no paint)", {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT}},
+};
+#define PAINT_PALETTE_N ((int)(sizeof(PAINT_PALETTE) / sizeof(PAINT_PALETTE[0])))
+
+/* The palette entry holding rgb, or -1. */
+static int palette_index(const uint8_t rgb[3])
+{
+    for (int k = 0; k < PAINT_PALETTE_N; k++)
+        if (memcmp(PAINT_PALETTE[k].rgb, rgb, 3) == 0)
+            return k;
+    return -1;
+}
 #define PANEL_N ((int)(sizeof(PANEL) / sizeof(PANEL[0])))
 
 /* One snapshot from the session to the window. */
@@ -131,6 +159,9 @@ typedef struct {
     int knot_ratio;               /* B-spline samples per knot span (0: springs solve) */
     char knot_note[64];           /* what the last K (refine) did */
     host_tool_t host_tool;        /* what carve does on the host */
+    bool undo_on;                 /* undo / redo (off: springs solve, --undo-mb 0) */
+    uint32_t undo_n, redo_n;      /* steps that can be undone / redone */
+    char undo_note[96];           /* what the last Ctrl+Z / redo did, or why undo is off */
 } live_frame_t;
 
 typedef struct {
@@ -218,6 +249,10 @@ static void host_panel(session_frame_t *f, int row, float value)
         const int bit = (int)lroundf(value - HOST_MIRROR_TOGGLE_X);
         t.mirror = bit >= 0 && bit < 3 ? t.mirror ^ (1u << bit)
                                        : (t.mirror + (uint32_t)(step + 8)) % 8u;
+    } else if (row == PANEL_HOST_COLOUR) {
+        const int k = palette_index(t.rgb);
+        const int next = k < 0 ? 0 : (k + step + PAINT_PALETTE_N) % PAINT_PALETTE_N;
+        memcpy(t.rgb, PAINT_PALETTE[next].rgb, 3);
     } else if (host_action_has_strength(t.action)) {
         const float v = step > 0 ? (t.strength > 0.0f ? t.strength * 1.25f : 0.1f)
                                  : (t.strength / 1.25f < 0.1f ? 0.0f : t.strength / 1.25f);
@@ -312,10 +347,19 @@ static void apply_cmd(live_t *L, session_frame_t *f, const ui_cmd_t *c)
                 L->serial++; /* every slot's mesh is coloured again */
         }
         break;
+    case UI_CMD_UNDO:
+        /* Done by the session after its next solve step (refused while button 1 is held);
+         * the HUD shows the note. */
+        if (f->undo)
+            (void)session_undo_request(f->undo, c->arg == 2 ? SESSION_UNDO_OP_REDO
+                                                            : SESSION_UNDO_OP_UNDO, 0);
+        break;
     case UI_CMD_REFINE: {
         /* Knot insertion: the shape stays, so nothing is re-meshed; the HUD says what it did. */
         const int r0 = (int)peer_knot_ratio(f->peer);
         float dd = 0.0f;
+        if (f->undo) /* the open stroke becomes a step first: undo then says the history is cut */
+            session_undo_peer_edit_start(f->undo, f->peer);
         const argil_err_t e = peer_refine(f->peer, &dd);
         if (e == ARGIL_OK)
             snprintf(L->knot_note, sizeof(L->knot_note), "refined %d -> %d, |dd| %.0e",
@@ -366,6 +410,40 @@ static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo
         L->serial2++;
 }
 
+/* Colours within this many levels (largest channel difference) of the model's unpainted grey
+ * are drawn shifted toward the window's clay colour (fully at the grey itself). */
+#define CLAY_BLEND_LEVELS 64
+
+/* A painted mesh's unpainted vertices (the model's base grey, GRID_RGB_DEFAULT) take the
+ * window's clay colour, so the clay looks as it did before the first paint; colours near the
+ * grey (a soft stroke's fading rim) are shifted part of the way, so the rim fades into the clay
+ * rather than into grey. */
+static void unpainted_as_clay(mesh_t *m)
+{
+    if (!m->has_rgb || m->rgb == NULL)
+        return;
+    render_scene_t sc;
+    render_scene_default(&sc);
+    const float shift[3] = {sc.clay_rgb.x * 255.0f - (float)GRID_RGB_DEFAULT,
+                            sc.clay_rgb.y * 255.0f - (float)GRID_RGB_DEFAULT,
+                            sc.clay_rgb.z * 255.0f - (float)GRID_RGB_DEFAULT};
+    for (size_t v = 0; v < m->n_vert; v++) {
+        uint8_t *c = &m->rgb[3 * v];
+        int far = 0;
+        for (int k = 0; k < 3; k++) {
+            const int d = abs((int)c[k] - (int)GRID_RGB_DEFAULT);
+            far = d > far ? d : far;
+        }
+        if (far >= CLAY_BLEND_LEVELS)
+            continue;
+        const float w = 1.0f - (float)far / (float)CLAY_BLEND_LEVELS;
+        for (int k = 0; k < 3; k++) {
+            const float x = (float)c[k] + shift[k] * w;
+            c[k] = (uint8_t)lrintf(x < 0.0f ? 0.0f : (x > 255.0f ? 255.0f : x));
+        }
+    }
+}
+
 /* Re-meshes what changed and publishes a snapshot. */
 static void publish(live_t *L, session_frame_t *f)
 {
@@ -383,7 +461,8 @@ static void publish(live_t *L, session_frame_t *f)
     if (L->mcb_ready) {
         if (!empty)
             mc_blocks_mark(&L->mcb, p->dirty_lo, p->dirty_hi);
-        if (mc_blocks_update(&L->mcb, g->density, NULL) == ARGIL_OK && L->mcb.blocks_meshed > 0)
+        /* Painted colour once anything was painted (the first paint re-meshes everything). */
+        if (mc_blocks_update(&L->mcb, g->density, g->rgb) == ARGIL_OK && L->mcb.blocks_meshed > 0)
             L->serial++;
     }
     update_iso2(L, g, empty, p->dirty_lo, p->dirty_hi);
@@ -397,6 +476,7 @@ static void publish(live_t *L, session_frame_t *f)
             fr->mesh_serial = L->serial;
             fr->colour = L->colour;
             fr->colour_lo = fr->colour_hi = 1.0f;
+            unpainted_as_clay(&fr->mesh);
             if (L->colour != COLOUR_MAP_NONE) {
                 const material_sampler_t ms = {
                     p, L->colour == COLOUR_MAP_MASS ? PEER_MAT_MASS : PEER_MAT_STIFFNESS};
@@ -469,6 +549,10 @@ static void publish(live_t *L, session_frame_t *f)
     fr->knot_ratio = (int)peer_knot_ratio(p);
     memcpy(fr->knot_note, L->knot_note, sizeof(fr->knot_note));
     fr->host_tool = f->player->host_tool;
+    fr->undo_on = f->undo && f->undo->on;
+    fr->undo_n = f->undo ? (uint32_t)session_undo_undo_count(f->undo) : 0u;
+    fr->redo_n = f->undo ? (uint32_t)session_undo_redo_count(f->undo) : 0u;
+    snprintf(fr->undo_note, sizeof(fr->undo_note), "%s", f->undo ? f->undo->note : "");
     fr->inverted = L->inverted;
     fr->published_ns = now_ns();
     triple_buffer_publish(&L->tb);
@@ -605,7 +689,7 @@ typedef struct {
     bool quit;                    /* Esc: no lingering after the session */
     /* Input state (from GLFW, or from the input file when one is given). */
     double cx, cy;
-    bool left, right, shift;
+    bool left, right, shift, ctrl;
     double prev_cx, prev_cy;
     bool prev_right, prev_shift, prev_left;
     ui_input_t script;
@@ -647,7 +731,10 @@ static int panel_row(int param)
 
 static void on_key(live_t *L, view_t *v, int key)
 {
-    if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + TOOL_KIND_COUNT) {
+    if (v->ctrl && (key == GLFW_KEY_Z || key == GLFW_KEY_Y)) {
+        /* Ctrl+Z undo; Ctrl+Shift+Z and Ctrl+Y redo (not the mirror keys Y, Z). */
+        ui_send(L, UI_CMD_UNDO, key == GLFW_KEY_Y || v->shift ? 2 : 1, 0.0f);
+    } else if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + TOOL_KIND_COUNT) {
         ui_send(L, UI_CMD_TOOL, key - GLFW_KEY_1, 0);
     } else if (key == GLFW_KEY_B) {
         const live_frame_t *fr = &L->slot[L->tb.front];
@@ -681,6 +768,8 @@ static void on_key(live_t *L, view_t *v, int key)
     } else if (key == GLFW_KEY_A || key == GLFW_KEY_S) {
         ui_send(L, UI_CMD_PARAM, panel_row(key == GLFW_KEY_A ? PANEL_HOST_ACTION : PANEL_HOST_SHAPE),
                 1.0f);
+    } else if (key == GLFW_KEY_P) {
+        ui_send(L, UI_CMD_PARAM, panel_row(PANEL_HOST_COLOUR), v->shift ? -1.0f : 1.0f);
     } else if (key == GLFW_KEY_X || key == GLFW_KEY_Y || key == GLFW_KEY_Z) {
         ui_send(L, UI_CMD_PARAM, panel_row(PANEL_HOST_MIRROR),
                 HOST_MIRROR_TOGGLE_X + (float)(key - GLFW_KEY_X));
@@ -706,7 +795,7 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
     const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
     const int sel = v->panel_sel;
     const host_tool_t *ht = &fr->host_tool;
-    char mirror[8], host[96], sel_v[48];
+    char mirror[8], host[160], sel_v[48];
     host_mirror_name(ht->mirror, mirror);
     snprintf(host, sizeof(host), "%s %s  mirror %s", host_action_name(ht->action),
              host_shape_name(ht->shape), mirror);
@@ -714,6 +803,12 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
         snprintf(host + strlen(host), sizeof(host) - strlen(host), "  strength %.3g %s",
                  (double)ht->strength,
                  ht->action == HOST_ACT_CHISEL || ht->action == HOST_ACT_SQUIRT ? "mm/s" : "/s");
+    const int pal = palette_index(ht->rgb);
+    char paint[48];
+    snprintf(paint, sizeof(paint), "%s%s%u %u %u", pal >= 0 ? PAINT_PALETTE[pal].name : "",
+             pal >= 0 ? " " : "", ht->rgb[0], ht->rgb[1], ht->rgb[2]);
+    if (host_action_paints(ht->action))
+        snprintf(host + strlen(host), sizeof(host) - strlen(host), "  colour %s", paint);
     if (fr->knot_ratio == 0)
         snprintf(host, sizeof(host), "carve (springs solve: no host actions)");
     const int prm = PANEL[sel].param;
@@ -723,12 +818,19 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
         snprintf(sel_v, sizeof(sel_v), "%s", host_shape_name(ht->shape));
     else if (prm == PANEL_HOST_MIRROR)
         snprintf(sel_v, sizeof(sel_v), "%s", mirror);
+    else if (prm == PANEL_HOST_COLOUR)
+        snprintf(sel_v, sizeof(sel_v), "%s", paint);
     else
         snprintf(sel_v, sizeof(sel_v), "%.4g",
                  prm == PANEL_HOST_STRENGTH ? (double)ht->strength
                  : prm == PANEL_SOLVE_STEP  ? (double)fr->solve_step_ms
                                             : (double)pr[prm]);
-    char iso2[32] = "off", colour[96] = "none";
+    char iso2[32] = "off", colour[96] = "none", undo[128];
+    if (fr->undo_on)
+        snprintf(undo, sizeof(undo), "undo %u | redo %u%s%s", fr->undo_n, fr->redo_n,
+                 fr->undo_note[0] ? ": " : "", fr->undo_note);
+    else
+        snprintf(undo, sizeof(undo), "%s", fr->undo_note[0] ? fr->undo_note : "undo off");
     if (fr->iso2_on)
         snprintf(iso2, sizeof(iso2), "%.2f (clay %.2f)", (double)fr->iso2_level, (double)fr->iso);
     if (fr->colour != COLOUR_MAP_NONE)
@@ -740,9 +842,10 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
              "view %.0f fps%s\n"
              "tool %s%s  beta %s  radius %.1f mm  stiffness %.2f N/mm  clay k %.3g  damping %.3g"
              "  plastic %.3g Hz  alpha %.3g  solve step %.1f ms\n"
-             "iso2 %s  colour %s  knots R %d%s%s  carve does %s\n"
+             "iso2 %s  colour %s  knots R %d%s%s  carve does %s  %s\n"
              "> %s = %s   [1-6 tool  B beta  TAB/UP/DOWN pick  -/+ change  SHIFT add<>remove"
-             "  C shading  I iso2  [ ] level  M colour  K refine  A action  S shape  X Y Z mirror"
+             "  C shading  I iso2  [ ] level  M colour  K refine  A action  S shape  X Y Z mirror  P paint colour"
+             "  CTRL+Z undo  CTRL+SHIFT+Z/CTRL+Y redo"
              "  ESC quit]",
              fr->have_tm ? safety_state_name((safety_state_t)fr->tm.state) : "NO BOARD",
              (double)fr->loop_hz, fr->worst_tick_ns / 1000.0, (double)fr->link_latency_ms,
@@ -752,7 +855,7 @@ static void hud_text(const live_t *L, const view_t *v, const live_frame_t *fr, c
              (double)pr[PARAM_CLAY_STIFFNESS], (double)pr[PARAM_CLAY_DAMPING],
              (double)pr[PARAM_PLASTIC_RATE_HZ], (double)pr[PARAM_ALPHA],
              (double)fr->solve_step_ms, iso2, colour, fr->knot_ratio,
-             fr->knot_note[0] ? ": " : "", fr->knot_note, host, PANEL[sel].label, sel_v);
+             fr->knot_note[0] ? ": " : "", fr->knot_note, host, undo, PANEL[sel].label, sel_v);
 }
 
 /* True when fr, with the meshes the last frame showed, would draw that frame again but for the
@@ -884,6 +987,7 @@ static bool play_script(live_t *L, view_t *v, double t_s)
         switch (e->kind) {
         case UI_EV_KEY: on_key(L, v, e->code); break;
         case UI_EV_SHIFT: v->shift = e->down; break;
+        case UI_EV_CTRL: v->ctrl = e->down; break;
         case UI_EV_CURSOR:
             v->cx = e->x;
             v->cy = e->y;
@@ -932,6 +1036,10 @@ static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
             atomic_store(&L->want_stop, 1);
         bool input = false;
         int key;
+        if (v->script.count == 0) { /* the modifiers the keys below were pressed with */
+            v->ctrl = in.ctrl;
+            v->shift = in.shift;
+        }
         while (glfw_window_take_key(&v->win, &key)) {
             on_key(L, v, key);
             input = true;

@@ -15,7 +15,9 @@
 #include "host/app/histogram.h"
 #include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
+#include "host/app/peer_journal.h"
 #include "host/app/script.h"
+#include "host/app/session_undo.h"
 #include "host/io/journal.h"
 #include "host/io/ply.h"
 #include "host/mesh/mc.h"
@@ -47,6 +49,9 @@ void session_opts_default(session_opts_t *o)
     o->checkpoint_s = 60.0f;
     o->debug_dump_record = 0;
     o->debug_dump_path = NULL;
+    o->undo_mb = SESSION_UNDO_MB_DEFAULT;
+    o->on_note = NULL;
+    o->note_ctx = NULL;
 }
 
 /* Everything a session owns; large, so it lives on the heap. */
@@ -65,9 +70,12 @@ typedef struct {
     uint8_t rx[HAL_SIM_LINK_BYTES];
     vec3_t model_offset_m;             /* model = device + offset (scale 1) */
     uint32_t compute_hist_us[COMPUTE_HIST_BINS]; /* tick compute times, 1 µs bins */
+    session_undo_t undo;               /* undo / redo of strokes (B-spline model) */
+    uint32_t undo_solves;              /* peer solves seen by the undo */
+    bool undo_script_queued;           /* the player's undo / redo is queued */
     journal_t journal;                 /* autosave journal (when journaling) */
     bool journaling;
-    uint32_t journal_solves;           /* peer solves already looked at by the journal */
+    peer_journal_t journal_steps;      /* what the journal has looked at, and its costs */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -191,46 +199,52 @@ static double clock_s(clockid_t id)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-/* Journal: after a solve step, one record of what it changed; durable within autosave_s. Sets
- * *stop_now once the debug dump of record debug_dump_record is written. */
-static argil_err_t journal_step(session_t *s, const session_opts_t *opts, double t_s,
-                                session_summary_t *sum, bool *stop_now, char *err, size_t err_len)
+/* Undo and redo requests (the script's, the live window's keys), after the peer's tick: done
+ * right after a solve step, so the journal's record of that step holds the change. A script's
+ * request releases its player once done or refused; a refusal is told through on_note. */
+static void undo_requests(session_t *s, const session_opts_t *opts)
 {
-    /* Only a solve step (100 Hz) changes the field, inside the peer's dirty box (the box the
-     * re-mesher relies on too; the window hook may clear it, but only after this call). The
-     * clocks are read here only: on some virtual machines every read is a system call. */
-    if (s->peer.stats.solves == s->journal_solves)
-        return ARGIL_OK;
-    s->journal_solves = s->peer.stats.solves;
-    const double real0_s = clock_s(CLOCK_MONOTONIC);
-    const uint64_t wall_ms = (uint64_t)(clock_s(CLOCK_REALTIME) * 1e3);
-    journal_box_t box;
-    for (int a = 0; a < 3; a++) {
-        box.lo[a] = s->peer.dirty_lo[a];
-        box.hi[a] = s->peer.dirty_hi[a];
+    script_player_t *pl = &s->player;
+    if (pl->history_op && !s->undo_script_queued)
+        s->undo_script_queued = session_undo_request(
+            &s->undo, pl->history_op == SCRIPT_UNDO ? SESSION_UNDO_OP_UNDO : SESSION_UNDO_OP_REDO,
+            pl->history_line);
+    const bool solved = s->peer.stats.solves != s->undo_solves;
+    s->undo_solves = s->peer.stats.solves;
+    for (;;) {
+        int line = 0;
+        char msg[160];
+        const session_undo_result_t r = session_undo_process(&s->undo, &s->peer,
+                                                             (pl->buttons & 1) != 0, solved,
+                                                             &line, msg, sizeof(msg));
+        if (r == SESSION_UNDO_NONE || r == SESSION_UNDO_WAIT)
+            break;
+        if (line > 0 && line == pl->history_line) {
+            pl->history_op = 0;
+            s->undo_script_queued = false;
+        }
+        if (r == SESSION_UNDO_REFUSED && opts->on_note) {
+            char full[4352];
+            if (line > 0)
+                snprintf(full, sizeof(full), "%s: line %d: %s",
+                         opts->script_path ? opts->script_path : "script", line, msg);
+            else
+                snprintf(full, sizeof(full), "%s", msg);
+            opts->on_note(opts->note_ctx, full);
+        }
     }
-    bool appended = false;
-    argil_err_t e = journal_record(&s->journal, &s->grid, &box, s->journal.seq + 1u, t_s,
-                                   real0_s, wall_ms, &appended, err, err_len);
-    if (e == ARGIL_OK && journal_sync_due(&s->journal, t_s, real0_s)) {
-        /* Before each write, the whole grid: a change outside the dirty box still gets saved
-         * (and counted: there should be none). */
-        bool stray = false;
-        e = journal_record(&s->journal, &s->grid, NULL, s->journal.seq + 1u, t_s, real0_s,
-                           wall_ms, &stray, err, err_len);
-        sum->journal_stray_records += stray;
-        appended = appended || stray;
+    if (pl->history_op && !s->undo_script_queued) {
+        /* The queue is full (keys pressed many times): refuse the script's line, go on. */
+        if (opts->on_note) {
+            char full[4352];
+            snprintf(full, sizeof(full), "%s: line %d: %s refused: too many requests waiting",
+                     opts->script_path ? opts->script_path : "script", pl->history_line,
+                     pl->history_op == SCRIPT_UNDO ? "undo" : "redo");
+            opts->on_note(opts->note_ctx, full);
+        }
+        s->undo.stats.refused++;
+        pl->history_op = 0;
     }
-    if (e == ARGIL_OK && appended && opts->debug_dump_record == s->journal.seq &&
-        opts->debug_dump_path) {
-        e = journal_write_model(&s->journal, &s->grid, s->journal.seq,
-                                opts->debug_dump_path, err, err_len);
-        *stop_now = true;
-    }
-    if (e == ARGIL_OK)
-        e = journal_tick(&s->journal, t_s, real0_s, err, err_len);
-    sum->journal_real_s += clock_s(CLOCK_MONOTONIC) - real0_s;
-    return e;
 }
 
 argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char *err,
@@ -260,6 +274,14 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             snprintf(err, err_len, "%s: line %d: 'paint' needs the B-spline model "
                      "(--global-solve bspline); the springs' material is uniform",
                      opts->script_path, paint_line);
+            rc = ARGIL_ERR_ARG;
+            goto done;
+        }
+        const int history_line = script_first_history_line(&s->script);
+        if (history_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
+            snprintf(err, err_len, "%s: line %d: 'undo' and 'redo' need the B-spline model "
+                     "(--global-solve bspline); the springs keep no history",
+                     opts->script_path, history_line);
             rc = ARGIL_ERR_ARG;
             goto done;
         }
@@ -346,6 +368,10 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         snprintf(err, err_len, "meshing the initial clay failed");
         goto done;
     }
+    /* Undo: off with the springs (their grid keeps no history) or --undo-mb 0, said in the
+     * summary; out of memory leaves it off too, and the session goes on. */
+    (void)session_undo_init(&s->undo, s->peer.gs ? &s->peer.gs->field : NULL,
+                            (size_t)opts->undo_mb << 20);
 
     const vec3_t centre = sim_device_tip_m(&s->dev);
     s->model_offset_m = vec3_sub(vec3(0, 0, SESSION_START_Z_M), centre);
@@ -371,15 +397,13 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     }
 
     if (opts->out_dir && opts->journal) {
-        journal_cfg_t jcfg;
-        journal_cfg_default(&jcfg);
-        jcfg.autosave_s = opts->autosave_s;
-        jcfg.checkpoint_s = opts->checkpoint_s;
-        rc = journal_open(&s->journal, opts->out_dir, &s->grid, &jcfg, 0.0,
-                          clock_s(CLOCK_MONOTONIC), err, err_len);
+        rc = peer_journal_open(&s->journal, opts->out_dir, &s->grid, opts->autosave_s,
+                               opts->checkpoint_s, err, err_len);
         if (rc != ARGIL_OK)
             goto done;
         s->journaling = true;
+        s->journal_steps.dump_record = opts->debug_dump_record;
+        s->journal_steps.dump_path = opts->debug_dump_path;
     }
 
     /* The lockstep loop. */
@@ -414,6 +438,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         }
         for (int k = 0; k < s->player.paints_pending; k++) {
             const script_paint_t *pt = &s->player.paints[k];
+            session_undo_peer_edit_start(&s->undo, &s->peer); /* a paint is a stroke of its own */
             /* At the stylus tip the board reports (the hand's target before any telemetry). */
             const vec3_t at = s->peer.have_tm ? vec3(s->peer.last_tm.pos_m[0],
                                                      s->peer.last_tm.pos_m[1],
@@ -434,6 +459,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         for (int k = 0; k < s->player.refines_pending && rc == ARGIL_OK; k++) {
             float dd = 0.0f;
             const int32_t r0 = peer_knot_ratio(&s->peer);
+            /* The open stroke becomes a step first: undo then says the history is cut. */
+            session_undo_peer_edit_start(&s->undo, &s->peer);
             const argil_err_t re = peer_refine(&s->peer, &dd);
             if (re != ARGIL_OK) {
                 snprintf(err, err_len, "refine at R = %d failed: %s", (int)r0,
@@ -488,16 +515,19 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
         const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
+        session_undo_observe(&s->undo, &s->peer); /* button 1 down at the host: a new stroke */
         peer_tick(&s->peer, dt_us);
+        undo_requests(s, opts);
         if (s->journaling) {
             bool stop_now = false;
-            rc = journal_step(s, opts, (double)(tick + 1u) * dt_s, sum, &stop_now, err, err_len);
+            rc = peer_journal_step(&s->journal, &s->journal_steps, &s->peer,
+                                   (double)(tick + 1u) * dt_s, &stop_now, err, err_len);
             if (rc != ARGIL_OK || stop_now)
                 break;
         }
         if (opts->hook) {
             session_frame_t f = {(double)(tick + 1u) * dt_s, started, finished, &s->peer,
-                                 &s->player, s->model_offset_m};
+                                 &s->player, s->model_offset_m, &s->undo};
             opts->hook->on_tick(opts->hook->ctx, &f);
         }
         if (tick % 1000u == 0)
@@ -529,6 +559,17 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->solves = s->peer.stats.solves;
     sum->solve_errors = s->peer.stats.solve_errors;
     sum->refines = s->peer.stats.refines;
+    sum->undo_on = s->undo.on;
+    sum->undo_steps = s->undo.stats.steps;
+    sum->undos = s->undo.stats.undos;
+    sum->redos = s->undo.stats.redos;
+    sum->undo_refused = s->undo.stats.refused;
+    sum->undo_bytes = session_undo_bytes(&s->undo);
+    sum->undo_max_step_bytes = s->undo.stats.max_step_bytes;
+    sum->undo_shadow_bytes = session_undo_shadow_bytes(&s->undo);
+    sum->undo_max_work_ms = s->undo.stats.max_work_ms;
+    snprintf(sum->undo_note, sizeof(sum->undo_note), "%s",
+             s->undo.on ? s->undo.note : s->undo.off_reason);
     sum->refine_max_dd = s->peer.stats.refine_max_dd;
     sum->knot_ratio_end = peer_knot_ratio(&s->peer);
     peer_solve_times_ms(&s->peer, &sum->solve_median_ms, &sum->solve_p99_ms, &sum->solve_max_ms);
@@ -581,6 +622,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         argil_doc_t doc;
         argil_doc_init(&doc);
         doc.grid = s->grid; /* borrowed: the document is not freed */
+        /* painted colour (COLR; none when nothing shows paint, as a recovery writes it) */
+        doc.rgb = grid_rgb_painted(&s->grid) ? s->grid.rgb : NULL;
         doc.state.device_offset_m = s->model_offset_m;
         doc.state.edits = s->journaling ? s->journal.seq : 0u;
         snprintf(path, sizeof(path), "%s/model.argil", opts->out_dir);
@@ -596,6 +639,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         sum->journal_syncs = s->journal.stats.syncs;
         sum->journal_checkpoints = s->journal.stats.checkpoints;
         sum->journal_bytes = s->journal.stats.bytes;
+        sum->journal_stray_records = s->journal_steps.stray_records;
+        sum->journal_real_s = s->journal_steps.real_s;
         if (rc == ARGIL_OK || rc == ARGIL_ERR_STATE) {
             char jerr[512];
             if (journal_finish(&s->journal, jerr, sizeof(jerr)) != ARGIL_OK && rc == ARGIL_OK) {
@@ -613,6 +658,7 @@ done:
         unlink(csv_tmp);
     }
     mesh_free(&mesh);
+    session_undo_free(&s->undo);
     peer_free(&s->peer);
     grid_free(&s->grid);
     script_free(&s->script);

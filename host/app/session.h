@@ -12,6 +12,7 @@
 
 #include "host/app/peer.h"
 #include "host/app/script.h"
+#include "host/app/session_undo.h"
 #include "shared/argil_err.h"
 
 /* What a per-tick hook sees of the running session (e.g. the live window, docs/render.md). */
@@ -25,6 +26,8 @@ typedef struct {
                                    * params_changed: the same path as script commands) and,
                                    * once script_done, the hand (pos_m, vel_m_s, buttons) */
     vec3_t model_offset_m;        /* model = device + offset */
+    session_undo_t *undo;         /* undo / redo: the hook may queue requests
+                                   * (session_undo_request) and read counts and note */
 } session_frame_t;
 
 typedef struct {
@@ -51,6 +54,12 @@ typedef struct {
     float checkpoint_s;           /* rotation onto a new base snapshot, simulated seconds */
     uint32_t debug_dump_record;   /* tests: at journal record N (1-based; 0 = never) write the */
     const char *debug_dump_path;  /* model as of it to this .argil and end the session */
+    uint32_t undo_mb;             /* undo journal budget, MiB (--undo-mb; 0: no undo) */
+    /* Called (session thread) with a one-line message for each undo / redo a script asked for
+     * that was refused ("FILE: line N: undo refused: nothing to undo"); the session goes on.
+     * NULL: not told (the summary counts them). */
+    void (*on_note)(void *ctx, const char *msg);
+    void *note_ctx;
 } session_opts_t;
 
 typedef struct {
@@ -92,6 +101,15 @@ typedef struct {
     int knot_ratio_end;           /* samples per knot span at the end (0: springs solve) */
     float refine_max_dd;          /* the largest |density change| a refinement made (grid) */
     double real_seconds;          /* wall time of the lockstep loop */
+    bool undo_on;                 /* the session recorded undo steps */
+    uint32_t undo_steps;          /* steps recorded (one per stroke) */
+    uint32_t undos, redos;        /* done */
+    uint32_t undo_refused;        /* undo / redo requests refused */
+    size_t undo_bytes;            /* journal bytes the steps held at the end */
+    size_t undo_max_step_bytes;   /* the largest step */
+    size_t undo_shadow_bytes;     /* the shadow of the model at the last boundary */
+    double undo_max_work_ms;      /* thread CPU time of the slowest stroke boundary or undo */
+    char undo_note[96];           /* why undo is off, or what it did last */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);

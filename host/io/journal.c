@@ -1,5 +1,5 @@
-/* Autosave journal: base .argil snapshot + CRC'd records of changed density and painted material
- * samples; the writer
+/* Autosave journal: base .argil snapshot + CRC'd records of changed density, painted material
+ * and painted colour samples; the writer
  * buffers records and makes them durable at a bounded interval, the reader replays them. */
 #define _POSIX_C_SOURCE 200809L
 #include "journal.h"
@@ -128,12 +128,22 @@ static bool mat_painted(const float *m, size_t n, grid_mat_t ch)
     return false;
 }
 
+/* True when rgb (n samples, NULL = unpainted) holds any byte other than GRID_RGB_DEFAULT. */
+static bool rgb_painted(const uint8_t *rgb, size_t n)
+{
+    for (size_t i = 0; rgb != NULL && i < 3 * n; i++)
+        if (rgb[i] != GRID_RGB_DEFAULT)
+            return true;
+    return false;
+}
+
 /* The base's identity: CRC-32C of its densities as little-endian binary32, continued over each
  * painted channel (its id as uint32, then its values); a channel holding only the default counts
  * as absent, so an unpainted model's CRC is its densities' alone (as in version 1). (Not a CRC
  * over the file: a CRC over data followed by its own CRC is a constant, so over an .argil, whose
  * sections each end in their CRC, it would not depend on the sections' contents at all.) */
-static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], size_t n)
+static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], const uint8_t *rgb,
+                          size_t n)
 {
     uint32_t crc = f32s_crc(0, density, n);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
@@ -144,7 +154,25 @@ static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], si
         crc = crc32c(crc, id, 4);
         crc = f32s_crc(crc, mat[ch], n);
     }
+    if (rgb_painted(rgb, n)) { /* then the colour as id 4 and 3 bytes per sample */
+        uint8_t id[4];
+        io_put_u32le(id, JOURNAL_RGB_CRC_ID);
+        crc = crc32c(crc, id, 4);
+        crc = crc32c(crc, rgb, 3 * n);
+    }
     return crc;
+}
+
+/* A copy of rgb (3 n bytes) as doc's colour; false when out of memory. */
+static bool doc_set_rgb(argil_doc_t *doc, const uint8_t *rgb, size_t n)
+{
+    if (rgb == NULL || !rgb_painted(rgb, n))
+        return true;
+    doc->rgb = malloc(3 * n);
+    if (doc->rgb == NULL)
+        return false;
+    memcpy(doc->rgb, rgb, 3 * n);
+    return true;
 }
 
 /* ---- the model as a journal holds it ---- */
@@ -202,6 +230,8 @@ argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t ed
     argil_doc_t doc;
     argil_err_t e = g != NULL ? journal_model_doc(&info, g->density, g->mat, &doc)
                               : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
+    if (e == ARGIL_OK && !doc_set_rgb(&doc, g != NULL ? g->rgb : j->rgb_shadow, j->n))
+        e = ARGIL_ERR_NOMEM;
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", path);
         argil_doc_free(&doc);
@@ -264,8 +294,8 @@ static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t er
         goto out;
     }
     uint8_t h[JOURNAL_HEADER_BYTES];
-    encode_header(j, base, (uint64_t)st.st_size, model_crc(j->shadow, j->mat_shadow, j->n), edits,
-                  h);
+    encode_header(j, base, (uint64_t)st.st_size,
+                  model_crc(j->shadow, j->mat_shadow, j->rgb_shadow, j->n), edits, h);
     fd = open(tmp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     e = ARGIL_ERR_IO;
     if (fd < 0) {
@@ -337,6 +367,16 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
         memcpy(j->mat_shadow[ch], g->mat[ch], j->n * sizeof(float));
     }
     j->mat_writes = g->mat_writes;
+    if (g->rgb != NULL) {
+        j->rgb_shadow = malloc(3 * j->n);
+        if (j->rgb_shadow == NULL) {
+            io_err(err, err_len, "%s: out of memory for the journal", dir);
+            journal_close(j);
+            return ARGIL_ERR_NOMEM;
+        }
+        memcpy(j->rgb_shadow, g->rgb, 3 * j->n);
+    }
+    j->rgb_writes = g->rgb_writes;
     if (journal_exists(dir)) {
         io_err(err, err_len, "%s holds an unfinished session's journal: run 'argil recover %s' "
                              "or start with --discard-journal", dir, dir);
@@ -469,6 +509,73 @@ static bool put_mat_block(journal_t *j, grid_mat_t ch, const float *gm, uint32_t
     return true;
 }
 
+/* Appends the colour run [start, end) (rgb: the grid's, NULL = the default everywhere) to the
+ * open record and to the colour shadow. */
+static bool put_rgb_run(journal_t *j, const uint8_t *rgb, size_t start, size_t end)
+{
+    const size_t count = end - start;
+    if (!reserve(j, 8 + 3 * count))
+        return false;
+    uint8_t *p = j->buf + j->buf_len;
+    io_put_u32le(p, (uint32_t)start);
+    io_put_u32le(p + 4, (uint32_t)count);
+    if (rgb != NULL)
+        memcpy(p + 8, rgb + 3 * start, 3 * count);
+    else
+        memset(p + 8, (int)GRID_RGB_DEFAULT, 3 * count);
+    memcpy(j->rgb_shadow + 3 * start, p + 8, 3 * count);
+    j->buf_len += 8 + 3 * count;
+    j->stats.rgb_samples += count;
+    return true;
+}
+
+/* Appends the colour's changes since the last record as runs; *runs counts them (0: no change).
+ * false when out of memory. */
+static bool put_rgb_runs(journal_t *j, const uint8_t *rgb, uint32_t *runs)
+{
+    *runs = 0;
+    if (rgb == NULL && j->rgb_shadow == NULL)
+        return true;
+    if (j->rgb_shadow == NULL) {
+        j->rgb_shadow = malloc(3 * j->n);
+        if (j->rgb_shadow == NULL)
+            return false;
+        memset(j->rgb_shadow, (int)GRID_RGB_DEFAULT, 3 * j->n);
+    }
+    const uint8_t *sh = j->rgb_shadow;
+    static const uint8_t def[3] = {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT};
+    bool open_run = false;
+    size_t run_start = 0, run_end = 0;
+    const size_t chunk = 256;
+    for (size_t i0 = 0; i0 < j->n; i0 += chunk) {
+        const size_t i1 = j->n - i0 < chunk ? j->n : i0 + chunk;
+        if (rgb != NULL && same_bits(rgb + 3 * i0, sh + 3 * i0, 3 * (i1 - i0)))
+            continue;
+        for (size_t i = i0; i < i1; i++) {
+            if (same_bits(rgb != NULL ? rgb + 3 * i : def, sh + 3 * i, 3))
+                continue;
+            if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
+                run_end = i + 1;
+                continue;
+            }
+            if (open_run) {
+                if (!put_rgb_run(j, rgb, run_start, run_end))
+                    return false;
+                (*runs)++;
+            }
+            open_run = true;
+            run_start = i;
+            run_end = i + 1;
+        }
+    }
+    if (open_run) {
+        if (!put_rgb_run(j, rgb, run_start, run_end))
+            return false;
+        (*runs)++;
+    }
+    return true;
+}
+
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len)
@@ -529,23 +636,41 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
             goto nomem;
         runs++;
     }
-    /* Painted channels: whole, when they may have changed (record type 2). */
-    uint32_t blocks = 0;
-    if (box == NULL || g->mat_writes != j->mat_writes) {
-        const size_t blocks_at = j->buf_len;
+    /* Painted channels: whole, when they may have changed (record type 2); then the painted
+     * colour likewise (type 3: the material block count, maybe 0, always precedes it). */
+    uint32_t blocks = 0, rgb_runs = 0;
+    const bool look_mat = box == NULL || g->mat_writes != j->mat_writes;
+    const bool look_rgb = box == NULL || g->rgb_writes != j->rgb_writes;
+    const size_t blocks_at = j->buf_len;
+    if (look_mat || look_rgb) {
         if (!reserve(j, 4))
             goto nomem;
         j->buf_len += 4;
+    }
+    if (look_mat) {
         for (int ch = 0; ch < GRID_MAT_N; ch++)
             if (!put_mat_block(j, (grid_mat_t)ch, g->mat[ch], &blocks))
                 goto nomem;
-        if (blocks == 0)
-            j->buf_len = blocks_at;
-        else
-            io_put_u32le(j->buf + blocks_at, blocks);
         j->mat_writes = g->mat_writes;
     }
-    if (runs == 0 && !material_changed && blocks == 0) {
+    if (look_rgb) {
+        const size_t rgb_at = j->buf_len;
+        if (!reserve(j, 4))
+            goto nomem;
+        j->buf_len += 4;
+        if (!put_rgb_runs(j, g->rgb, &rgb_runs))
+            goto nomem;
+        if (rgb_runs == 0)
+            j->buf_len = rgb_at;
+        else
+            io_put_u32le(j->buf + rgb_at, rgb_runs);
+        j->rgb_writes = g->rgb_writes;
+    }
+    if (blocks == 0 && rgb_runs == 0)
+        j->buf_len = blocks_at;
+    else
+        io_put_u32le(j->buf + blocks_at, blocks);
+    if (runs == 0 && !material_changed && blocks == 0 && rgb_runs == 0) {
         j->buf_len = rec_at;
         return ARGIL_OK;
     }
@@ -558,7 +683,8 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
     uint8_t *p = j->buf + rec_at;
     io_put_u32le(p, (uint32_t)payload);
     uint8_t *h = p + 4;
-    io_put_u32le(h, blocks > 0 ? 2u : 1u); /* record type: edit step (2: with painted material) */
+    /* record type: edit step (2: with painted material, 3: with painted colour) */
+    io_put_u32le(h, rgb_runs > 0 ? 3u : (blocks > 0 ? 2u : 1u));
     io_put_u32le(h + 4, j->seq);
     const double sim_us = sim_s > 0.0 ? sim_s * 1e6 + 0.5 : 0.0;
     put_u64(h + 8, (uint64_t)sim_us);
@@ -661,6 +787,8 @@ void journal_close(journal_t *j)
         free(j->mat_shadow[ch]);
         j->mat_shadow[ch] = NULL;
     }
+    free(j->rgb_shadow);
+    j->rgb_shadow = NULL;
     j->dir = NULL;
     j->shadow = NULL;
     j->buf = NULL;
@@ -799,11 +927,11 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
     return ARGIL_OK;
 }
 
-/* Checks the painted-material blocks of a type-2 record (from payload offset *off) against n
- * samples; advances *off past them and adds their values to *samples. */
+/* Checks the painted-material blocks of a type-2 record (type 3: min_blocks 0) from payload
+ * offset *off against n samples; advances *off past them and adds their values to *samples. */
 static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *off, size_t at,
-                                    const char *name, size_t n, uint32_t rec, uint64_t *samples,
-                                    char *err, size_t err_len)
+                                    const char *name, size_t n, uint32_t rec, uint32_t min_blocks,
+                                    uint64_t *samples, char *err, size_t err_len)
 {
     char why[200];
     size_t o = *off;
@@ -812,8 +940,9 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
         return fail(err, err_len, name, at + 4 + o, why);
     }
     const uint32_t blocks = io_get_u32le(p + o);
-    if (blocks < 1 || blocks > GRID_MAT_N) {
-        snprintf(why, sizeof(why), "record %u: material block count %u not in 1..4", rec, blocks);
+    if (blocks < min_blocks || blocks > GRID_MAT_N) {
+        snprintf(why, sizeof(why), "record %u: material block count %u not in %u..4", rec, blocks,
+                 min_blocks);
         return fail(err, err_len, name, at + 4 + o, why);
     }
     o += 4;
@@ -856,6 +985,67 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
         }
     }
     *off = o;
+    return ARGIL_OK;
+}
+
+/* Checks the painted colour of a type-3 record (from payload offset *off: uint32 run count >= 1,
+ * runs of uint32 first sample, uint32 count >= 1, 3 count bytes) against n samples; advances *off
+ * past it and adds its samples to *samples. */
+static argil_err_t check_rgb_runs(const uint8_t *p, size_t payload, size_t *off, size_t at,
+                                  const char *name, size_t n, uint32_t rec, uint64_t *samples,
+                                  char *err, size_t err_len)
+{
+    char why[200];
+    size_t o = *off;
+    if (payload - o < 4) {
+        snprintf(why, sizeof(why), "record %u: colour run count runs past the record", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    const uint32_t runs = io_get_u32le(p + o);
+    if (runs < 1) {
+        snprintf(why, sizeof(why), "record %u: colour run count 0", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    o += 4;
+    uint64_t next = 0; /* runs are in sample order and do not overlap */
+    for (uint32_t r = 0; r < runs; r++) {
+        if (payload - o < 8) {
+            snprintf(why, sizeof(why), "record %u: colour run %u head runs past the record", rec,
+                     r);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        if (count == 0 || start < next || start + count > (uint64_t)n ||
+            count > (payload - o - 8) / 3) {
+            snprintf(why, sizeof(why), "record %u: colour run %u (%llu samples from %llu) empty, "
+                     "out of order, beyond the grid or past the record", rec, r,
+                     (unsigned long long)count, (unsigned long long)start);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        next = start + count;
+        o += 8 + 3 * (size_t)count;
+        *samples += count;
+    }
+    *off = o;
+    return ARGIL_OK;
+}
+
+/* Applies the checked colour runs at payload offset off to g's rgb. */
+static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, grid_t *g, const char *name,
+                                  char *err, size_t err_len)
+{
+    if (grid_rgb_alloc(g) == NULL) {
+        io_err(err, err_len, "%s: out of memory for the painted colour", name);
+        return ARGIL_ERR_NOMEM;
+    }
+    const uint32_t runs = io_get_u32le(p + off);
+    size_t o = off + 4;
+    for (uint32_t r = 0; r < runs; r++) {
+        const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        memcpy(g->rgb + 3 * start, p + o + 8, 3 * count);
+        o += 8 + 3 * count;
+    }
+    g->rgb_writes++;
     return ARGIL_OK;
 }
 
@@ -904,7 +1094,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         return fail(err, err_len, name, at, why);
     }
     const uint32_t type = io_get_u32le(p);
-    if (type != 1u && (type != 2u || info->version < 2u)) {
+    if (type != 1u && ((type != 2u && type != 3u) || info->version < 2u)) {
         snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, type);
         return fail(err, err_len, name, at + 4, why);
     }
@@ -949,9 +1139,14 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         samples += count;
     }
     const size_t mat_off = off;
-    if (type == 2u) {
-        const argil_err_t e = check_mat_blocks(p, payload, &off, at, name, n, rec, &mat_samples,
-                                               err, err_len);
+    uint64_t rgb_samples = 0;
+    size_t rgb_off = 0;
+    if (type >= 2u) {
+        argil_err_t e = check_mat_blocks(p, payload, &off, at, name, n, rec, type == 3u ? 0u : 1u,
+                                         &mat_samples, err, err_len);
+        rgb_off = off;
+        if (e == ARGIL_OK && type == 3u)
+            e = check_rgb_runs(p, payload, &off, at, name, n, rec, &rgb_samples, err, err_len);
         if (e != ARGIL_OK)
             return e;
     }
@@ -959,8 +1154,13 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
         return fail(err, err_len, name, at + 4 + off, why);
     }
-    if (type == 2u && g != NULL) {
+    if (type >= 2u && g != NULL && io_get_u32le(p + mat_off) > 0) {
         const argil_err_t e = apply_mat_blocks(p, mat_off, g, name, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    if (type == 3u && g != NULL) {
+        const argil_err_t e = apply_rgb_runs(p, rgb_off, g, name, err, err_len);
         if (e != ARGIL_OK)
             return e;
     }
@@ -981,6 +1181,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     info->material = m;
     info->samples += samples;
     info->mat_samples += mat_samples;
+    info->rgb_samples += rgb_samples;
     return ARGIL_OK;
 }
 
@@ -1101,7 +1302,7 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     const size_t bn = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    const uint32_t crc = model_crc(g->density, g->mat, bn);
+    const uint32_t crc = model_crc(g->density, g->mat, b.rgb, bn);
     if (blen != info->base_len || crc != info->base_crc ||
         !same_bits(&g->material, &info->material, sizeof(g->material)) ||
         b.state.edits != info->edits) {
@@ -1123,11 +1324,16 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
+    /* The base's colour becomes the grid's, which the records then paint on. */
+    b.grid.rgb = b.rgb;
+    b.rgb = NULL;
     e = journal_replay_grid(data, len, path, &b.grid, info, err, err_len);
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         goto out;
     /* After a bad record (PARSE) the grid holds the model as of the record before it. */
-    const argil_err_t me = journal_model_doc(info, b.grid.density, b.grid.mat, doc);
+    argil_err_t me = journal_model_doc(info, b.grid.density, b.grid.mat, doc);
+    if (me == ARGIL_OK && !doc_set_rgb(doc, b.grid.rgb, bn))
+        me = ARGIL_ERR_NOMEM;
     if (me != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the recovered model", path);
         e = me;

@@ -1,6 +1,7 @@
 /* The autosave journal of a sculpting session: every applied edit step is appended as the
  * density samples it changed (sparse runs of new values, CRC-32C per record), and the painted
- * material samples it changed (grid_t.mat, record type 2), on top of a base
+ * material samples it changed (grid_t.mat, record type 2) and the painted colour samples it
+ * changed (grid_t.rgb, record type 3), on top of a base
  * .argil snapshot; records are written and fdatasync'ed at a bounded interval, and the journal
  * is rotated onto a new snapshot at checkpoints. After a crash the model is rebuilt bit for bit
  * as of the last whole record. Layout byte by byte: docs/files.md. */
@@ -23,6 +24,7 @@
 #define JOURNAL_FILE "journal.log"         /* inside the session's output directory */
 #define JOURNAL_BASE_PREFIX "journal-base-" /* + checkpoint number + ".argil" */
 #define JOURNAL_RUN_GAP 2u                 /* unchanged samples bridged inside one run */
+#define JOURNAL_RGB_CRC_ID 4u              /* the colour's id in the base identity CRC */
 
 typedef struct {
     float autosave_s;        /* write + fdatasync once records are this old (sim or real s) */
@@ -37,6 +39,7 @@ typedef struct {
     uint32_t checkpoints;     /* rotations onto a new base */
     uint64_t samples;         /* sample values journaled */
     uint64_t mat_samples;     /* painted material values journaled */
+    uint64_t rgb_samples;     /* painted colour samples (3 bytes each) journaled */
 } journal_stats_t;
 
 /* The open journal of a running session (writer side). */
@@ -52,6 +55,9 @@ typedef struct {
     float *mat_shadow[GRID_MAT_N]; /* painted channels as of the last record (NULL: never
                                * painted, all grid_mat_default) */
     uint32_t mat_writes;      /* the grid's mat_writes when its channels were last compared */
+    uint8_t *rgb_shadow;      /* painted colour as of the last record (NULL: never painted, all
+                               * GRID_RGB_DEFAULT) */
+    uint32_t rgb_writes;      /* the grid's rgb_writes when its colour was last compared */
     spring_material_t material; /* as of the last record */
     uint8_t *buf;             /* records not yet written to the file */
     size_t buf_len, buf_cap;
@@ -77,6 +83,7 @@ typedef struct {
     spring_material_t material; /* as of the last record (the base's when there is none) */
     uint64_t samples;         /* sample values replayed */
     uint64_t mat_samples;     /* painted material values replayed */
+    uint64_t rgb_samples;     /* painted colour samples replayed */
     size_t good_bytes;        /* header + good records */
     size_t torn_bytes;        /* an incomplete last record, ignored */
     char base_name[JOURNAL_BASE_NAME_MAX + 1];
@@ -100,11 +107,11 @@ typedef struct {
     int32_t lo[3], hi[3];
 } journal_box_t;
 
-/* Appends one record when the grid's densities, material or painted channels differ from the
- * last record (buffered; *appended says whether one was made). Only densities inside box are
- * compared when box is not NULL: the caller promises nothing changed outside it; the painted
- * channels are compared whole when box is NULL or the grid's mat_writes moved. edits counts the
- * session's edit steps. */
+/* Appends one record when the grid's densities, material, painted channels or painted colour
+ * differ from the last record (buffered; *appended says whether one was made). Only densities
+ * inside box are compared when box is not NULL: the caller promises nothing changed outside it;
+ * the painted channels are compared whole when box is NULL or the grid's mat_writes moved, the
+ * colour when box is NULL or rgb_writes moved. edits counts the session's edit steps. */
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len);
@@ -123,7 +130,7 @@ argil_err_t journal_sync(journal_t *j, char *err, size_t err_len);
  * the old journal stays valid until the new one has replaced it by rename. */
 argil_err_t journal_checkpoint(journal_t *j, double sim_s, char *err, size_t err_len);
 
-/* Writes g's densities and painted channels (g: the journal's grid; NULL: the journal's copy as
+/* Writes g's densities, painted channels and colour (g: the journal's grid; NULL: the journal's copy as
  * of the last record) with the material of the last record and edits to path as .argil, in
  * exactly the form argil recover writes, so a model and its recovery compare byte for byte. */
 argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
@@ -154,8 +161,8 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
 argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
                            size_t n, journal_info_t *info, char *err, size_t err_len);
 
-/* journal_replay onto a whole grid (dims matching the header's): densities and painted
- * channels (allocated as records need them); ARGIL_ERR_NOMEM when a channel cannot be. */
+/* journal_replay onto a whole grid (dims matching the header's): densities, painted channels and
+ * colour (allocated as records need them); ARGIL_ERR_NOMEM when a channel cannot be. */
 argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
                                 journal_info_t *info, char *err, size_t err_len);
 

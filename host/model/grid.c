@@ -81,6 +81,8 @@ void grid_free(grid_t *g)
         free(g->mat[c]);
         g->mat[c] = NULL;
     }
+    free(g->rgb);
+    g->rgb = NULL;
     g->dims[0] = g->dims[1] = g->dims[2] = 0;
 }
 
@@ -123,6 +125,42 @@ float *grid_mat_alloc(grid_t *g, grid_mat_t ch)
         m[i] = def;
     g->mat[ch] = m;
     return m;
+}
+
+uint8_t *grid_rgb_alloc(grid_t *g)
+{
+    if (g->density == NULL)
+        return NULL;
+    if (g->rgb != NULL)
+        return g->rgb;
+    const size_t n = grid_count(g);
+    g->rgb = malloc(3 * n);
+    if (g->rgb != NULL)
+        memset(g->rgb, (int)GRID_RGB_DEFAULT, 3 * n);
+    return g->rgb;
+}
+
+bool grid_rgb_painted(const grid_t *g)
+{
+    const size_t n = 3 * grid_count(g);
+    for (size_t i = 0; g->rgb != NULL && i < n; i++)
+        if (g->rgb[i] != GRID_RGB_DEFAULT)
+            return true;
+    return false;
+}
+
+bool grid_rgb_equal(const grid_t *a, const grid_t *b)
+{
+    const size_t n = grid_count(a);
+    if (n != grid_count(b))
+        return false;
+    if (a->rgb != NULL && b->rgb != NULL)
+        return memcmp(a->rgb, b->rgb, 3 * n) == 0;
+    const uint8_t *c = a->rgb != NULL ? a->rgb : b->rgb;
+    for (size_t i = 0; c != NULL && i < 3 * n; i++)
+        if (c[i] != GRID_RGB_DEFAULT)
+            return false;
+    return true;
 }
 
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)

@@ -37,7 +37,14 @@ typedef struct {
     float *mat[GRID_MAT_N];     /* painted channels, one value per sample; NULL until first
                                  * painted (every sample then holds grid_mat_default) */
     uint32_t mat_writes;        /* +1 whenever a mat channel changes (the journal then looks) */
+    uint8_t *rgb;               /* painted colour, r g b per sample; NULL until first painted
+                                 * (every sample then holds GRID_RGB_DEFAULT) */
+    uint32_t rgb_writes;        /* +1 whenever rgb changes (the journal then looks) */
 } grid_t;
+
+/* The colour of unpainted clay in every channel: the model's FS_R/G/B default 0.8 as a byte
+ * (host/model/field.c; 0.8 x 255 = 204, a light grey). */
+#define GRID_RGB_DEFAULT 204u
 
 /* Allocates a grid with all densities 0, iso 0.5, band 4 spacings, the default material.
  * ARGIL_ERR_ARG for dims < 1, more than GRID_SAMPLES_MAX samples, or a spacing that is not
@@ -64,6 +71,17 @@ float *grid_mat_alloc(grid_t *g, grid_mat_t ch);
 /* True when the two grids' samples hold the same bits in channel ch (an absent channel reads
  * as the default everywhere); false when their sample counts differ. */
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch);
+
+/* Makes the colour channel present (every sample GRID_RGB_DEFAULT when newly allocated) and
+ * returns it; NULL when out of memory. */
+uint8_t *grid_rgb_alloc(grid_t *g);
+
+/* True when the grid's colour is present and some sample differs from GRID_RGB_DEFAULT. */
+bool grid_rgb_painted(const grid_t *g);
+
+/* True when the two grids hold the same colour at every sample (an absent channel reads as
+ * GRID_RGB_DEFAULT everywhere); false when their sample counts differ. */
+bool grid_rgb_equal(const grid_t *a, const grid_t *b);
 
 /* A spring_field_t view onto the grid's own arrays (no copy). */
 spring_field_t grid_springs(grid_t *g);

@@ -40,6 +40,20 @@ argil_err_t undo_init(undo_t *u, size_t budget_bytes)
     return ARGIL_OK;
 }
 
+argil_err_t undo_init_lazy(undo_t *u, size_t budget_bytes)
+{
+    memset(u, 0, sizeof(*u));
+    u->budget_bytes = budget_bytes;
+    if (budget_bytes == 0)
+        return ARGIL_OK;
+    void *p = mmap(NULL, budget_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED)
+        return ARGIL_ERR_NOMEM;
+    u->ring = (uint8_t *)p;
+    u->ring_cap = budget_bytes;
+    return ARGIL_OK;
+}
+
 void undo_free(undo_t *u)
 {
     if (u->ring != NULL)
@@ -407,4 +421,13 @@ argil_err_t undo_redo(undo_t *u, field_t *f)
     if (e == ARGIL_OK)
         u->done++;
     return e;
+}
+
+void undo_clear_redo(undo_t *u)
+{
+    if (u->open || u->done == u->nsteps)
+        return;
+    u->cur.off = undo_head(u);
+    u->cur.len = 0;
+    undo_drop_redo(u);
 }

@@ -53,6 +53,11 @@ typedef struct {
  * 64 MB here, and that memory is resident from then on), so that recording a step never waits on
  * a first-touch page fault. ARGIL_ERR_NOMEM (the journal then grows on demand instead). */
 argil_err_t undo_init(undo_t *u, size_t budget_bytes);
+/* The same ring of budget_bytes, mapped but not faulted in: memory becomes resident only as
+ * steps fill it (~4 us per first-touched 4 kB page while recording), for an owner that records
+ * outside a real-time path and should not hold the whole budget from the start (the session's
+ * undo: host/app/session_undo.h). ARGIL_ERR_NOMEM. */
+argil_err_t undo_init_lazy(undo_t *u, size_t budget_bytes);
 void undo_free(undo_t *u);
 
 /* Snapshots the channels in cmask (coefficients, box [clo, chi)) and smask (samples, [slo, shi))
@@ -84,5 +89,9 @@ argil_err_t undo_commit(undo_t *u, const field_t *f);
  * become dirty. */
 argil_err_t undo_undo(undo_t *u, field_t *f);
 argil_err_t undo_redo(undo_t *u, field_t *f);
+
+/* Drops the redo steps now (a new edit has begun that will be recorded later); nothing when a
+ * step is open (undo_commit drops them then) or there are none. */
+void undo_clear_redo(undo_t *u);
 
 #endif

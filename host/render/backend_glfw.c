@@ -144,6 +144,8 @@ void glfw_window_poll(glfw_window_t *w, glfw_input_t *in)
     in->right_down = f->glfwGetMouseButton(w->window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     in->shift = f->glfwGetKey(w->window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
                 f->glfwGetKey(w->window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+    in->ctrl = f->glfwGetKey(w->window, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+               f->glfwGetKey(w->window, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
 }
 
 void glfw_window_wait(glfw_window_t *w, double timeout_s)

@@ -26,6 +26,7 @@ typedef struct {
     bool escape;        /* Esc pressed */
     bool right_down;    /* right mouse button held */
     bool shift;         /* either Shift key held */
+    bool ctrl;          /* either Control key held (Ctrl+Z undo in the live window) */
 } glfw_input_t;
 
 /* Opens a width × height window (hidden when !visible) with a current GL 3.3 core context,

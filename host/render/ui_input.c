@@ -1,5 +1,6 @@
 /* Scripted window input (see ui_input.h). One event per line:
- *   AT_S key NAME | shift down|up | cursor X Y | left down|up | right down|up | wheel STEPS */
+ *   AT_S key NAME | shift down|up | ctrl down|up | cursor X Y | left down|up | right down|up |
+ *   wheel STEPS */
 #define GLFW_INCLUDE_NONE
 #include "host/render/ui_input.h"
 
@@ -21,6 +22,7 @@ static const struct {
     {"UP", GLFW_KEY_UP},       {"DOWN", GLFW_KEY_DOWN},   {"LEFT", GLFW_KEY_LEFT},
     {"RIGHT", GLFW_KEY_RIGHT}, {"PLUS", GLFW_KEY_EQUAL},  {"MINUS", GLFW_KEY_MINUS},
     {"ESC", GLFW_KEY_ESCAPE},  {"I", GLFW_KEY_I},         {"M", GLFW_KEY_M},         {"K", GLFW_KEY_K},
+    {"P", GLFW_KEY_P},         {"Y", GLFW_KEY_Y},         {"Z", GLFW_KEY_Z},
     {"LBRACKET", GLFW_KEY_LEFT_BRACKET},                 {"RBRACKET", GLFW_KEY_RIGHT_BRACKET},
 };
 
@@ -133,10 +135,13 @@ argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *e
             if (e.code < 0)
                 return fail(in, line, "unknown key", w[2], err, err_len);
         } else if (strcmp(ev, "shift") == 0 || strcmp(ev, "left") == 0 ||
-                   strcmp(ev, "right") == 0) {
+                   strcmp(ev, "right") == 0 || strcmp(ev, "ctrl") == 0) {
             if (n != 3 || (strcmp(w[2], "down") != 0 && strcmp(w[2], "up") != 0))
                 return fail(in, line, "needs down or up:", ev, err, err_len);
-            e.kind = ev[0] == 's' ? UI_EV_SHIFT : ev[0] == 'l' ? UI_EV_LEFT : UI_EV_RIGHT;
+            e.kind = ev[0] == 's'   ? UI_EV_SHIFT
+                     : ev[0] == 'c' ? UI_EV_CTRL
+                     : ev[0] == 'l' ? UI_EV_LEFT
+                                    : UI_EV_RIGHT;
             e.down = strcmp(w[2], "down") == 0;
         } else if (strcmp(ev, "cursor") == 0) {
             if (n != 4 || !number(w[2], -1e5, 1e5, &e.x) || !number(w[3], -1e5, 1e5, &e.y))

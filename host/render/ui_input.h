@@ -16,7 +16,8 @@ typedef enum {
     UI_EV_CURSOR,                 /* x, y: pixels from the top-left */
     UI_EV_LEFT,                   /* down */
     UI_EV_RIGHT,                  /* down */
-    UI_EV_WHEEL                   /* x: steps */
+    UI_EV_WHEEL,                  /* x: steps */
+    UI_EV_CTRL                    /* down: held (Ctrl+Z undo in the live window) */
 } ui_ev_kind_t;
 
 typedef struct {

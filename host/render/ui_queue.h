@@ -19,7 +19,8 @@ typedef enum {
     UI_CMD_STOP,                  /* end the session (window closed) */
     UI_CMD_ISO2,                  /* arg: 1 shows the second iso-surface at level value, 0 hides */
     UI_CMD_COLOUR,                /* arg: colour_map_t, the material shown on the clay */
-    UI_CMD_REFINE                 /* knot insertion in the B-spline model (peer_refine) */
+    UI_CMD_REFINE,                /* knot insertion in the B-spline model (peer_refine) */
+    UI_CMD_UNDO                   /* arg: 1 undo, 2 redo (host/app/session_undo.h) */
 } ui_cmd_kind_t;
 
 typedef struct {

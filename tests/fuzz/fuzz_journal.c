@@ -1,7 +1,8 @@
 /* libFuzzer target for the autosave-journal reader: any bytes either replay or stop with one line
  * naming the journal and the byte; scanning and replaying agree; replay never writes outside the
  * grid nor leaves a density outside [0, 1] or a painted material value grid_mat_valid refuses
- * (replayed onto a whole grid too, so type-2 records reach the channels). Every record carries a
+ * (replayed onto a whole grid too, so type-2 records reach the channels and type-3 records the
+ * colour). Every record carries a
  * CRC-32C, so the input is read
  * as it is, then once more with the header and record checksums recomputed, which lets mutated
  * records reach the decoder. */
@@ -64,7 +65,10 @@ static void check_one(const uint8_t *data, size_t size)
     const argil_err_t e3 = journal_replay_grid(data, size, name, &g, &grid_play, err3,
                                                sizeof(err3));
     if (e3 != e || grid_play.records != scan.records || grid_play.mat_samples != scan.mat_samples ||
-        strcmp(err, err3) != 0)
+        grid_play.rgb_samples != scan.rgb_samples || strcmp(err, err3) != 0)
+        abort();
+    /* Type-3 records paint the grid's colour: present exactly when a colour run was replayed. */
+    if ((g.rgb != NULL) != (grid_play.rgb_samples > 0))
         abort();
     for (int ch = 0; ch < GRID_MAT_N; ch++)
         for (size_t i = 0; g.mat[ch] != NULL && i < n; i++)

@@ -15,62 +15,22 @@
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
+#include "tests/unit/test_grids.h"
 
 #define N 48
 #define H 1.25e-3f
 #define R 0.020f
 #define DT 0.01f
 
-static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-}
-
-/* A 48³ grid at 1.25 mm centred on the origin holding a 20 mm sphere. */
-static grid_t *sphere_grid(void)
-{
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0, 0, 0), R);
-    return g;
-}
-
-static void free_grid(grid_t *g)
-{
-    grid_free(g);
-    free(g);
-}
-
-/* Where the density along +axis from the centre sample crosses 0.5 (m from the grid centre). */
-static float crossing_m(const grid_t *g, int axis)
-{
-    const int32_t c = N / 2;
-    int32_t at[3] = {c, c, c};
-    for (int32_t i = c; i + 1 < N; i++) {
-        at[axis] = i;
-        const float a = g->density[gidx(g, at[0], at[1], at[2])];
-        at[axis] = i + 1;
-        const float b = g->density[gidx(g, at[0], at[1], at[2])];
-        if (a >= 0.5f && b < 0.5f) {
-            const float pos = (float)i + (a - 0.5f) / (a - b);
-            return (pos - 0.5f * (float)(N - 1)) * H;
-        }
-    }
-    return -1.0f;
-}
-
 static void test_seed_makes_the_grid_the_models_view(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     const size_t n = (size_t)N * N * N;
     float *orig = malloc(n * sizeof(float));
     assert_non_null(orig);
     memcpy(orig, g->density, n * sizeof(float));
-    const float x0 = crossing_m(g, 0);
+    const float x0 = test_crossing_m(g, 0);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     float ramp_err = 0.0f, any_err = 0.0f;
@@ -84,23 +44,23 @@ static void test_seed_makes_the_grid_the_models_view(void **st)
         assert_true(g->rest[i] == g->density[i]);
     }
     print_message("# seed: ramp error %.2e, largest %.2e; +x surface %.4f mm (grid %.4f mm)\n",
-                  (double)ramp_err, (double)any_err, (double)crossing_m(g, 0) * 1e3,
+                  (double)ramp_err, (double)any_err, (double)test_crossing_m(g, 0) * 1e3,
                   (double)x0 * 1e3);
     /* The cubic B-spline reproduces the linear ramp: only its kinks at 0 and 1 round off. */
     assert_true(ramp_err < 5e-3f);  /* measured 3.7e-3 (the ramp bends round the sphere) */
     assert_true(any_err < 0.04f);   /* measured 0.027, at the kinks */
     assert_true(any_err > 1e-3f); /* it is the model's view, not the old grid */
-    assert_true(fabsf(crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
-    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f);
+    assert_true(fabsf(test_crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
+    assert_true(fabsf(test_crossing_m(g, 0) - R) < 0.1e-3f);
     gsolve_free(&gs);
     free(orig);
-    free_grid(g);
+    test_grid_free(g);
 }
 
 static void test_field_at_rest_stays_put(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
@@ -123,7 +83,7 @@ static void test_field_at_rest_stays_put(void **st)
     assert_int_equal(gs.stats.rest_skips, 29);
     free(before);
     gsolve_free(&gs);
-    free_grid(g);
+    test_grid_free(g);
 }
 
 /* Pushes the surface on +y with a force spread like the board's Gaussian filter (σ 1.5
@@ -132,7 +92,7 @@ static void test_field_at_rest_stays_put(void **st)
 static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *at_moved,
                           float *far_moved)
 {
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     gsolve_t gs;
     if (bspline)
         assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
@@ -143,7 +103,7 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
     /* the surface sample on +y nearest density 0.5 */
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (g->density[test_gidx(g, c, sy + 1, c)] >= 0.5f)
         sy++;
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     for (int k = 0; k < 30; k++) {
@@ -179,14 +139,14 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
     for (size_t i = 0; i < n; i++)
         sum += (double)g->density[i] - before[i];
     *sum_moved = (float)sum;
-    const size_t at = gidx(g, c, sy, c);
+    const size_t at = test_gidx(g, c, sy, c);
     *at_moved = g->density[at] - before[at];
-    const size_t far = gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
+    const size_t far = test_gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
     *far_moved = g->density[far] - before[far];
     free(before);
     if (bspline)
         gsolve_free(&gs);
-    free_grid(g);
+    test_grid_free(g);
 }
 
 static void test_impulse_moves_as_much_clay_as_the_springs(void **st)
@@ -214,7 +174,7 @@ static void test_impulse_moves_as_much_clay_as_the_springs(void **st)
  * with painted material in it or without. */
 static void moved_window_matches_a_fresh_one(bool painted)
 {
-    grid_t *g1 = sphere_grid(), *g2 = sphere_grid();
+    grid_t *g1 = test_sphere_grid(N, H, R), *g2 = test_sphere_grid(N, H, R);
     gsolve_t a, b;
     assert_int_equal(gsolve_init(&a, g1), ARGIL_OK);
     assert_int_equal(gsolve_init(&b, g2), ARGIL_OK);
@@ -251,8 +211,8 @@ static void moved_window_matches_a_fresh_one(bool painted)
     assert_true(largest > 1e-3f); /* the forces did move the clay */
     gsolve_free(&a);
     gsolve_free(&b);
-    free_grid(g1);
-    free_grid(g2);
+    test_grid_free(g1);
+    test_grid_free(g2);
 }
 
 static void test_moved_window_matches_a_fresh_one(void **st)
@@ -265,8 +225,8 @@ static void test_moved_window_matches_a_fresh_one(void **st)
 static void test_carve_goes_through_the_model(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid();
-    grid_t *ref = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *ref = test_sphere_grid(N, H, R);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
@@ -281,17 +241,17 @@ static void test_carve_goes_through_the_model(void **st)
     assert_true(hi[0] > lo[0]);
     assert_int_equal(gs.stats.carves, 1);
     /* the surface on +y moved in by the tool's radius, as the grid's own carve puts it */
-    const float y_b = crossing_m(g, 1), y_g = crossing_m(ref, 1);
+    const float y_b = test_crossing_m(g, 1), y_g = test_crossing_m(ref, 1);
     print_message("# carve: +y surface %.2f mm (grid carve %.2f mm, sphere %.1f)\n",
                   (double)y_b * 1e3, (double)y_g * 1e3, (double)R * 1e3);
     assert_true(y_b < R - 4e-3f);
     assert_true(fabsf(y_b - y_g) < 0.5e-3f);
-    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
+    assert_true(fabsf(test_crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
     /* every change lies in the box reported */
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = gidx(g, x, y, z);
+                const size_t i = test_gidx(g, x, y, z);
                 if (g->density[i] != before[i])
                     assert_true(x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] &&
                                 z >= lo[2] && z < hi[2]);
@@ -307,17 +267,17 @@ static void test_carve_goes_through_the_model(void **st)
                              ARGIL_OK);
     }
     assert_true(change < 1e-3f);
-    assert_true(crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
+    assert_true(test_crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
     free(before);
     gsolve_free(&gs);
-    free_grid(ref);
-    free_grid(g);
+    test_grid_free(ref);
+    test_grid_free(g);
 }
 
 static void test_painted_material(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     peer_cfg_t cfg;
     peer_cfg_default(&cfg);
     cfg.global_solve = PEER_SOLVE_SPRINGS;
@@ -351,24 +311,24 @@ static void test_painted_material(void **st)
     peer_free(springs);
     free(bs);
     free(springs);
-    free_grid(g);
+    test_grid_free(g);
 }
 
 /* Elastic clay pushed in: where the stiffness is painted 50x it springs back sooner. */
 static float springback_left(bool painted)
 {
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     g->material.plastic_rate_hz = 0.0f;
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (g->density[test_gidx(g, c, sy + 1, c)] >= 0.5f)
         sy++;
     const vec3_t at = vec3(0.5f * H, (float)(sy - c) * H + 0.5f * H, 0.5f * H);
     if (painted)
         assert_int_equal(gsolve_paint(&gs, GSOLVE_MAT_STIFFNESS, at, 8e-3f, 50.0f), ARGIL_OK);
-    const size_t i = gidx(g, c, sy, c);
+    const size_t i = test_gidx(g, c, sy, c);
     const float d0 = g->density[i];
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     float deepest = 0.0f;
@@ -386,7 +346,7 @@ static float springback_left(bool painted)
     assert_true(deepest > 5e-3f);
     const float left = (d0 - g->density[i]) / deepest;
     gsolve_free(&gs);
-    free_grid(g);
+    test_grid_free(g);
     return left;
 }
 

@@ -11,33 +11,11 @@
 #include <string.h>
 
 #include "host/model/grid.h"
+#include "tests/unit/test_grids.h"
 
 #define N 64
 #define H 1.25e-3f
 #define R 0.030f
-
-/* A 64³ grid at 1.25 mm, centred on the origin, holding a 30 mm sphere. */
-static grid_t *sphere_grid(void)
-{
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0.0f, 0.0f, 0.0f), R);
-    return g;
-}
-
-static void drop_grid(grid_t *g)
-{
-    grid_free(g);
-    free(g);
-}
-
-static size_t idx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-}
 
 static vec3_t sample_pos(const grid_t *g, int32_t x, int32_t y, int32_t z)
 {
@@ -85,7 +63,7 @@ static void test_init_defaults_and_errors(void **state)
 static void test_sphere_profile(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     assert_float_equal(grid_density_at(g, vec3(0, 0, 0)), 1.0f, 1e-6f);
     assert_float_equal(grid_profile(0.0f, 1.0f), 0.5f, 0.0f);
     for (int k = 0; k < 20; k++) {
@@ -105,13 +83,13 @@ static void test_sphere_profile(void **state)
     assert_float_equal(grid_density_at(g, vec3(1.0f, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(grid_density_at(g, vec3(NAN, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(vec3_norm(grid_gradient_at(g, vec3(0, -1.0f, 0))), 0.0f, 0.0f);
-    drop_grid(g);
+    test_grid_free(g);
 }
 
 static void test_gradient_matches_finite_differences(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     const float step = 1e-3f * H;
     for (int k = 0; k < 200; k++) {
         /* Points in the band, kept away from cell faces so the difference stays in one cell. */
@@ -135,13 +113,13 @@ static void test_gradient_matches_finite_differences(void **state)
         /* |grad| is 100 /m; float differences over 1.25 µm carry ~1 /m of rounding. */
         assert_true(vec3_norm(vec3_sub(grad, fd)) < 2.0f);
     }
-    drop_grid(g);
+    test_grid_free(g);
 }
 
 static void test_carve_sphere(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     float *rest_before = malloc(n * sizeof(float));
@@ -160,7 +138,7 @@ static void test_carve_sphere(void **state)
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = idx(g, x, y, z);
+                const size_t i = test_gidx(g, x, y, z);
                 const float dist = vec3_norm(vec3_sub(sample_pos(g, x, y, z), c));
                 if (dist < rc - g->band_m)
                     assert_true(g->density[i] == 0.0f && g->rest[i] == 0.0f);
@@ -201,13 +179,13 @@ static void test_carve_sphere(void **state)
         assert_true(lo[a] == 0 && hi[a] == 0);
     free(before);
     free(rest_before);
-    drop_grid(g);
+    test_grid_free(g);
 }
 
 static void test_window_corner_and_extract(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     const int32_t win[3] = {32, 5, 8};
     /* p at sample index (10.2, 20.0, 60.7). */
     const vec3_t p = vec3(g->origin_m.x + 10.2f * H, g->origin_m.y + 20.0f * H,
@@ -230,7 +208,8 @@ static void test_window_corner_and_extract(void **state)
                     assert_true(out[o] == 0.0f);
                     zeros_outside++;
                 } else {
-                    assert_memory_equal(&out[o], &g->density[idx(g, gx, gy, gz)], sizeof(float));
+                    assert_memory_equal(&out[o], &g->density[test_gidx(g, gx, gy, gz)],
+                                        sizeof(float));
                 }
             }
     assert_int_equal(zeros_outside, 32 * 5 * 8 - 27 * 5 * 7);
@@ -244,13 +223,13 @@ static void test_window_corner_and_extract(void **state)
 
     grid_window_corner(g, vec3(INFINITY, 0, 0), win, corner);
     assert_int_equal(corner[0], 0);
-    drop_grid(g);
+    test_grid_free(g);
 }
 
 static void test_add_force(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     assert_false(grid_add_force(g, -1, 0, 0, 1.0f));
     assert_false(grid_add_force(g, 0, N, 0, 1.0f));
     assert_false(grid_add_force(g, 0, 0, N + 5, 1.0f));
@@ -258,20 +237,20 @@ static void test_add_force(void **state)
     assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
     assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
     assert_true(grid_add_force(g, 1, 2, 3, 1.0f));
-    assert_float_equal(g->force[idx(g, 1, 2, 3)], 2.5f, 0.0f);
-    drop_grid(g);
+    assert_float_equal(g->force[test_gidx(g, 1, 2, 3)], 2.5f, 0.0f);
+    test_grid_free(g);
 }
 
 static void test_springs_push_lowers_density(void **state)
 {
     (void)state;
-    grid_t *g = sphere_grid();
+    grid_t *g = test_sphere_grid(N, H, R);
     /* The sample on the +x surface of the sphere: 30 mm = 24 spacings from the centre. */
     const int32_t x = 31 + 24, y = 31, z = 31;
-    const size_t i = idx(g, x, y, z);
+    const size_t i = test_gidx(g, x, y, z);
     const float d0 = g->density[i];
     assert_true(d0 > 0.2f && d0 < 0.8f);
-    const float far0 = g->density[idx(g, 5, 5, 5)];
+    const float far0 = g->density[test_gidx(g, 5, 5, 5)];
     assert_true(grid_add_force(g, x, y, z, -50.0f));
 
     spring_field_t f = grid_springs(g);
@@ -281,8 +260,8 @@ static void test_springs_push_lowers_density(void **state)
     /* a = F/m = -50 /s²; after one step of ~21 ms the density falls by a*dt² ≈ 0.02. */
     assert_true(g->density[i] < d0 - 0.01f);
     assert_float_equal(g->force[i], 0.0f, 0.0f); /* consumed */
-    assert_float_equal(g->density[idx(g, 5, 5, 5)], far0, 0.0f);
-    drop_grid(g);
+    assert_float_equal(g->density[test_gidx(g, 5, 5, 5)], far0, 0.0f);
+    test_grid_free(g);
 }
 
 

@@ -43,12 +43,15 @@ typedef enum { STAY, LEAVE, LEAVE_FROZEN, SHIFT, SHIFT_FROZEN, UNION } run_t;
 
 /* Pushes the top of the sphere for 4 steps with the window over it, then (LEAVE) moves the
  * window to the bottom of the sphere, far from the dent, or (SHIFT) 10 samples along x, so the
- * dent's edge is in both, or (UNION) grows it over both, for `after` steps. Returns the grid. */
-static grid_t *run(run_t how, bool elastic, int after, gsolve_stats_t *stats)
+ * dent's edge is in both, or (UNION) grows it over both, for `after` steps; with `ratio`
+ * samples per knot span, refined (knot insertion) before step `refine_at` (0: never). Returns
+ * the grid. */
+static grid_t *run_r(run_t how, bool elastic, int after, int32_t ratio, int refine_at,
+                     gsolve_stats_t *stats)
 {
     grid_t *g = sphere_grid(elastic);
     gsolve_t gs;
-    assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
+    assert_int_equal(gsolve_init_ratio(&gs, g, ratio), ARGIL_OK);
     gs.settle_enabled = how != LEAVE_FROZEN && how != SHIFT_FROZEN;
     const bool shift = how == SHIFT || how == SHIFT_FROZEN;
     const int32_t top_lo[3] = {C - 8, SY - 8, C - 8}, top_hi[3] = {C + 8, SY + 8, C + 8};
@@ -56,6 +59,15 @@ static grid_t *run(run_t how, bool elastic, int after, gsolve_stats_t *stats)
     for (int k = 0; k < 4 + after; k++) {
         int32_t dlo[3], dhi[3];
         float change;
+        if (k == refine_at && refine_at > 0) {
+            const bool settling = gs.settle.active;
+            float dd;
+            assert_int_equal(gsolve_refine(&gs, g, &dd, dlo, dhi), ARGIL_OK);
+            assert_true(dd < 1e-5f);
+            /* the region's physical window (coarse indices) is gone, the region is not */
+            assert_false(gs.settle.open);
+            assert_true(gs.settle.active == settling);
+        }
         if (k < 4)
             for (int32_t dx = -1; dx <= 1; dx++)
                 for (int32_t dz = -1; dz <= 1; dz++)
@@ -67,10 +79,19 @@ static grid_t *run(run_t how, bool elastic, int after, gsolve_stats_t *stats)
         const int32_t *lo = top || how == UNION ? top_lo : shift ? sh_lo : bot_lo;
         const int32_t *hi = top ? top_hi : how == UNION ? un_hi : shift ? sh_hi : bot_hi;
         assert_int_equal(gsolve_step(&gs, g, lo, hi, DT, dlo, dhi, &change), ARGIL_OK);
+        if (gs.settle.open) /* a settling region lies on the field's lattice now */
+            for (int a = 0; a < 3; a++)
+                assert_int_equal(gs.settle.win.slo[a],
+                                 (gs.settle.win.clo[a] - 2) * gsolve_ratio(&gs));
     }
     *stats = gs.stats;
     gsolve_free(&gs);
     return g;
+}
+
+static grid_t *run(run_t how, bool elastic, int after, gsolve_stats_t *stats)
+{
+    return run_r(how, elastic, after, 1, 0, stats);
 }
 
 static float dent_at(const grid_t *g)
@@ -143,9 +164,13 @@ static void test_shifted_window_and_settling_region_share_the_dent(void **st)
     const float moved = top_diff(pushed, both);
     const float diff_shift = top_diff(both, shift), diff_frozen = top_diff(both, frozen);
     print_message("# window moved 10 samples: largest difference to one window over both boxes "
-                  "%.2e (settling off %.2e; the clay moved up to %.2e); settling steps %u\n",
-                  (double)diff_shift, (double)diff_frozen, (double)moved, s_shift.settle_steps);
+                  "%.2e (settling off %.2e; the clay moved up to %.2e); settling steps %u, "
+                  "window reloads %u\n", (double)diff_shift, (double)diff_frozen, (double)moved,
+                  s_shift.settle_steps, s_shift.settle_reloads);
     assert_true(s_shift.settle_steps == 30);
+    /* the region moved the window's fixed part: re-read after each of its steps that moved */
+    assert_true(s_shift.settle_reloads > 0 && s_shift.settle_reloads <= s_shift.settle_steps);
+    assert_int_equal(s_frozen.settle_reloads, 0);
     assert_int_equal(s_union.settle_steps, 0); /* the grown window covers the old box */
     /* Measured: 9.7e-4 against 6.6e-3 frozen, for clay that moved up to 6.2e-3 (1.5e-3 when
      * the settling region held the window's coefficients still instead of on their path).
@@ -179,12 +204,54 @@ static void test_settling_region_rests(void **st)
     free(g);
 }
 
+/* At R = 2 (one coefficient every 2 samples: the window's sample box rounds out to whole knot
+ * spans) a dent left behind springs back as if the window stayed; and a knot insertion while
+ * the region settles closes its coarse physical window but not the region, which goes on
+ * on the fine lattice (refined 6 steps after the window left; compared 12 steps after it left,
+ * while the region still moves: at R = 2 it rests after ~19). */
+static void test_settling_at_r2_and_across_a_refinement(void **st)
+{
+    (void)st;
+    gsolve_stats_t s_stay, s_leave, s_frozen, s_pushed;
+    grid_t *pushed = run_r(STAY, true, 0, 2, 0, &s_pushed);
+    grid_t *rest = sphere_grid(true);
+    const float push = dent_at(rest) - dent_at(pushed);
+    float diff[2][2];
+    uint32_t steps[2];
+    for (int refine = 0; refine < 2; refine++) {
+        const int at = refine ? 10 : 0;
+        grid_t *stay = run_r(STAY, true, 12, 2, at, &s_stay);
+        grid_t *leave = run_r(LEAVE, true, 12, 2, at, &s_leave);
+        grid_t *frozen = run_r(LEAVE_FROZEN, true, 12, 2, at, &s_frozen);
+        diff[refine][0] = top_diff(stay, leave);
+        diff[refine][1] = top_diff(stay, frozen);
+        steps[refine] = s_leave.settle_steps;
+        assert_int_equal(s_leave.refines, (uint32_t)refine);
+        grid_free(stay); free(stay);
+        grid_free(leave); free(leave);
+        grid_free(frozen); free(frozen);
+    }
+    print_message("# R = 2: pushed %.2e; largest difference to the stayed window: left %.2e "
+                  "(frozen %.2e); refined while settling: left %.2e (frozen %.2e); settling "
+                  "steps %u / %u\n", (double)push, (double)diff[0][0], (double)diff[0][1],
+                  (double)diff[1][0], (double)diff[1][1], steps[0], steps[1]);
+    assert_true(push > 5e-3f);
+    for (int refine = 0; refine < 2; refine++) {
+        assert_int_equal(steps[refine], 12);
+        assert_true(diff[refine][1] > 0.2f * push);
+        assert_true(diff[refine][0] < 0.02f * push);
+    }
+    grid_free(pushed); free(pushed);
+    grid_free(rest); free(rest);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_left_dent_springs_back_as_if_the_window_stayed),
         cmocka_unit_test(test_shifted_window_and_settling_region_share_the_dent),
         cmocka_unit_test(test_settling_region_rests),
+        cmocka_unit_test(test_settling_at_r2_and_across_a_refinement),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

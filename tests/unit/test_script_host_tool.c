@@ -74,10 +74,20 @@ static void test_bad_lines_name_the_line_and_rule(void **st)
         const char *text, *expect;
     } cases[] = {
         {"wait 1\naction\n", "line 2: 'action' takes a name (carve, add, toothpaste, soft-erase, "
-                             "smooth, stamp, chisel, squirt, interior-carve) and optionally "
-                             "strength S"},
+                             "smooth, stamp, chisel, squirt, interior-carve, paint, soft-paint) "
+                             "and optionally strength S (paint and soft-paint: rgb R G B)"},
         {"action pinch\n", "line 1: unknown action 'pinch' (carve, add,"},
-        {"action paint\n", "line 1: 'action paint': painted colour would not show"},
+        {"action paint rgb 1 2\n", "line 1: 'rgb' takes three whole numbers 0 … 255 (R G B)"},
+        {"action paint rgb 1 2 256\n", "line 1: 'rgb' takes three whole numbers 0 … 255, got '256'"},
+        {"action paint rgb 1 -2 3\n", "line 1: 'rgb' takes three whole numbers 0 … 255, got '-2'"},
+        {"action paint rgb 1 2 3.5\n", "line 1: 'rgb' takes three whole numbers 0 … 255, got '3.5'"},
+        {"action paint rgb 1 2 3 rgb 4 5 6\n", "line 1: too many words"},
+        {"action soft-paint rgb 1 2 3 rgb 4\n", "line 1: 'rgb' given twice"},
+        {"action paint strength 3\n", "line 1: 'action paint' takes no strength"},
+        {"action paint colour 3\n", "line 1: 'action paint' takes NAME [rgb R G B], not 'colour'"},
+        {"action soft-paint rgb 1 2 3 strength 2 strength 3\n", "line 1: too many words"},
+        {"action soft-paint strength 2 strength 3\n", "line 1: 'strength' given twice"},
+        {"action smooth rgb 1 2 3\n", "line 1: 'action smooth' takes no colour"},
         {"action add strength 3\n", "line 1: 'action add' takes no strength"},
         {"action smooth strength\n", "line 1: 'action' takes a name"},
         {"action smooth power 3\n", "line 1: 'action' takes NAME [strength S], not 'power'"},
@@ -94,7 +104,8 @@ static void test_bad_lines_name_the_line_and_rule(void **st)
         {"mirror w\n", "line 1: unknown mirror 'w'"},
         {"mirror xyzx\n", "line 1: unknown mirror 'xyzx'"},
         {"actoin add\n", "line 1: unknown command 'actoin' (tool, shape, filter, axis, set, move, "
-                         "press, release, wait, paint, refine, action, action_shape, mirror)"},
+                         "press, release, wait, paint, refine, action, action_shape, mirror, undo, "
+                         "redo)"},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         script_t s;
@@ -106,6 +117,42 @@ static void test_bad_lines_name_the_line_and_rule(void **st)
         assert_null(strchr(err, '\n')); /* one line */
         script_free(&s);
     }
+}
+
+/* `action paint [rgb R G B]`, `action soft-paint [rgb R G B] [strength S]`: the colour and
+ * strength reach the player's host tool (terracotta 200 60 40 when no rgb is given). */
+static void test_paint_verbs(void **st)
+{
+    (void)st;
+    script_t s;
+    script_init(&s);
+    char err[256] = "";
+    assert_int_equal(parse(&s, "action paint\nwait 0.1\naction soft-paint strength 7 rgb 10 20 30\n"
+                               "wait 0.1\naction paint rgb 0 255 1\n", err),
+                     ARGIL_OK);
+    assert_int_equal(s.cmds[0].arg_int, HOST_ACT_PAINT);
+    assert_int_equal(s.cmds[2].arg_int, HOST_ACT_SOFT_PAINT);
+    script_player_t p;
+    script_player_init(&p, &s, vec3(0, 0, 0.06f));
+    const uint8_t terracotta[3] = {200, 60, 40}, c1[3] = {10, 20, 30}, c2[3] = {0, 255, 1};
+    (void)script_player_step(&p, 0.01f);
+    assert_int_equal(p.host_tool.action, HOST_ACT_PAINT);
+    assert_memory_equal(p.host_tool.rgb, terracotta, 3);
+    assert_true(host_action_paints(p.host_tool.action));
+    for (int k = 0; k < 11; k++)
+        (void)script_player_step(&p, 0.01f);
+    assert_int_equal(p.host_tool.action, HOST_ACT_SOFT_PAINT);
+    assert_float_equal(p.host_tool.strength, 7.0f, 0.0f);
+    assert_memory_equal(p.host_tool.rgb, c1, 3);
+    for (int k = 0; k < 11; k++)
+        (void)script_player_step(&p, 0.01f);
+    assert_int_equal(p.host_tool.action, HOST_ACT_PAINT);
+    assert_memory_equal(p.host_tool.rgb, c2, 3);
+    assert_true(host_tool_valid(&p.host_tool));
+    assert_false(host_action_paints(HOST_ACT_CARVE));
+    assert_float_equal(host_action_default_strength(HOST_ACT_SOFT_PAINT), 20.0f, 0.0f);
+    assert_false(host_action_has_strength(HOST_ACT_PAINT));
+    script_free(&s);
 }
 
 static void test_names_round_trip(void **st)
@@ -133,6 +180,7 @@ int main(void)
         cmocka_unit_test(test_verbs_parse_and_play),
         cmocka_unit_test(test_bad_lines_name_the_line_and_rule),
         cmocka_unit_test(test_names_round_trip),
+        cmocka_unit_test(test_paint_verbs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
