@@ -23,6 +23,21 @@ void haptics_reset_path(haptics_t *h)
     h->in_contact = false;
 }
 
+/* Where the field crosses iso inside the bracket [t_a, t_b] whose ends hold f_a = d - iso on one
+ * side and f_b on the other (or 0): the linear interpolant's zero, so the crossing moves
+ * continuously with the densities. The bisection midpoint alone jumps by half a bracket (1/128
+ * of a cell) when a density change of ~1e-6 flips one comparison, and the force with it; such
+ * steps made two runs differing only by round-off end up to 0.8 mm apart (docs/haptics.md). */
+static float bracket_crossing(float t_a, float f_a, float t_b, float f_b)
+{
+    const float df = f_a - f_b;
+    if (!(df != 0.0f))
+        return 0.5f * (t_a + t_b);
+    float w = f_a / df;                  /* 0 at t_a, 1 at t_b */
+    w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
+    return t_a + w * (t_b - t_a);
+}
+
 bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, float reach_m,
                               float *dist_m, vec3_t *normal)
 {
@@ -43,7 +58,7 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
     int steps = (int)ceilf(reach_m / step);
     if (steps > HAPTICS_MARCH_STEPS)
         steps = HAPTICS_MARCH_STEPS;
-    float t_in = 0.0f, t_out = -1.0f;
+    float t_in = 0.0f, t_out = -1.0f, f_in = f0, f_out = 0.0f;
     for (int k = 1; k <= steps; k++) {
         const float t = dir * step * (float)k;
         float dk;
@@ -51,9 +66,11 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
             break;
         if ((dk - iso) * f0 <= 0.0f) {
             t_out = t;
+            f_out = dk - iso;
             break;
         }
         t_in = t;
+        f_in = dk - iso;
     }
     *normal = n;
     if (t_out == -1.0f) {
@@ -66,12 +83,15 @@ bool haptics_surface_distance(const window_buf_t *win, vec3_t p_m, float iso, fl
         float dk;
         if (!window_density(win, vec3_add(p_m, vec3_scale(n, t)), &dk))
             break;
-        if ((dk - iso) * f0 > 0.0f)
+        if ((dk - iso) * f0 > 0.0f) {
             t_in = t;
-        else
+            f_in = dk - iso;
+        } else {
             t_out = t;
+            f_out = dk - iso;
+        }
     }
-    *dist_m = 0.5f * (t_in + t_out);
+    *dist_m = bracket_crossing(t_in, f_in, t_out, f_out);
     return isfinite(*dist_m);
 }
 
@@ -259,32 +279,37 @@ static bool apply_tool_paths(window_buf_t *win, const msg_tool_t *tool, vec3_t f
 
 /* How far along u from p the field first reaches iso (the tool's surface meets the clay), up
  * to reach; reach when it does not. */
-static float first_crossing(const window_buf_t *win, vec3_t p, vec3_t u, float iso, float reach)
+static float first_crossing(const window_buf_t *win, vec3_t p, vec3_t u, float iso, float reach,
+                            float f_start)
 {
     const float step = win->spacing_m;
     int steps = (int)ceilf(reach / step);
     if (steps > HAPTICS_MARCH_STEPS)
         steps = HAPTICS_MARCH_STEPS;
-    float t_out = 0.0f;
+    float t_out = 0.0f, f_out = f_start;
     for (int k = 1; k <= steps; k++) {
         const float t = k == steps ? reach : step * (float)k;
         float d;
         if (!window_density(win, vec3_add(p, vec3_scale(u, t)), &d))
             return reach;
         if (d >= iso) {
-            float t_in = t;
+            float t_in = t, f_in = d - iso;
             for (int b = 0; b < HAPTICS_BISECT_STEPS; b++) {
                 const float m = 0.5f * (t_in + t_out);
                 if (!window_density(win, vec3_add(p, vec3_scale(u, m)), &d))
                     break;
-                if (d >= iso)
+                if (d >= iso) {
                     t_in = m;
-                else
+                    f_in = d - iso;
+                } else {
                     t_out = m;
+                    f_out = d - iso;
+                }
             }
-            return 0.5f * (t_in + t_out);
+            return bracket_crossing(t_in, f_in, t_out, f_out);
         }
         t_out = t;
+        f_out = d - iso;
     }
     return reach;
 }
@@ -316,7 +341,7 @@ static bool sphere_penetration(const window_buf_t *win, vec3_t p, float r, float
     vec3_t dir = vec3(0, 0, 0);
     for (int k = 0; k < 14; k++) {
         const vec3_t u = vec3(DIRS[k][0], DIRS[k][1], DIRS[k][2]);
-        const float pen = r - first_crossing(win, p, u, iso, r);
+        const float pen = r - first_crossing(win, p, u, iso, r, d0 - iso);
         if (pen <= 0.0f)
             continue;
         dir = vec3_sub(dir, vec3_scale(u, pen));

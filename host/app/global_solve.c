@@ -113,11 +113,11 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     argil_err_t e = field_init(&gs->field, g->spacing_m * (float)ratio, ratio, g->origin_m);
     if (e != ARGIL_OK)
         return e;
-    /* Off by default: with it on, tests/sil/test_knot_refine.c's dents (pushed at R = 1, and at
-     * R = 2 refined to 1) end 0.85 mm apart (18.33 / 19.18 mm) against its bound of 0.5. Not a
-     * fault of the settling region: that scenario moves its dent by up to 0.84 mm with settling
-     * off too, on one ulp of one step's state (docs/model.md "Settling"). */
-    gs->settle_enabled = false;
+    /* On: clay the board's window left while still moving keeps settling (docs/model.md
+     * "Settling"). It was off while tests/sil/test_knot_refine.c's two dents ended 0.85 mm apart
+     * with it on; the cause was the board's bisected contact crossing, which turned one ulp of
+     * state into a 0.01 mm step of penetration (firmware/core/haptics.c bracket_crossing). */
+    gs->settle_enabled = true;
     gs->field.iso = g->iso;
     gs->field.band_m = g->band_m; /* the grid's density ramp, so tools cut the same profile */
     solver_cfg_default(&gs->cfg);

@@ -92,7 +92,8 @@ typedef struct {
     solver_cfg_t cfg;
     spring_material_t mat;            /* the grid material the field's material was made from */
     gsolve_settle_t settle;           /* the region the window left last, while it moves */
-    bool settle_enabled;              /* false (gsolve_init: see there): left regions freeze */
+    bool settle_enabled;              /* true (gsolve_init: see there); false: left regions
+                                       * freeze where the window left them */
     float *buf;                       /* window-sized scratch (samples) */
     size_t buf_n;
     gsolve_stats_t stats;
