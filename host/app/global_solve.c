@@ -34,13 +34,7 @@ static float *scratch(gsolve_t *gs, size_t n)
 static bool clip_to_grid(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
                          int32_t chi[3])
 {
-    for (int a = 0; a < 3; a++) {
-        clo[a] = lo[a] < 0 ? 0 : lo[a];
-        chi[a] = hi[a] > g->dims[a] ? g->dims[a] : hi[a];
-        if (chi[a] <= clo[a])
-            return false;
-    }
-    return true;
+    return grid_clip(g, lo, hi, clo, chi);
 }
 
 /* Copies the field's densities in sample box [lo, hi) (clipped to the grid) into the grid,
@@ -57,17 +51,17 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
     float change = 0.0f;
     for (int32_t z = a0[2]; z < a1[2]; z++)
         for (int32_t y = a0[1]; y < a1[1]; y++) {
-            const size_t row = (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
             const float *src = d + (size_t)n[0] * ((size_t)(y - lo[1]) +
                                                    (size_t)n[1] * (size_t)(z - lo[2])) -
                                lo[0];
             for (int32_t x = a0[0]; x < a1[0]; x++) {
                 const float v = clamp01(src[x]);
-                const float c = fabsf(v - g->density[row + (size_t)x]);
+                const float c = fabsf(v - grid_get(g, GRID_DENSITY, x, y, z));
                 if (c > GSOLVE_VIEW_EPS) {
                     if (c > change)
                         change = c;
-                    g->density[row + (size_t)x] = v;
+                    if (grid_set(g, GRID_DENSITY, x, y, z, v) != ARGIL_OK)
+                        return -1.0f;
                 }
             }
         }
@@ -123,8 +117,9 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     gs->cfg.acc_threshold = INFINITY; /* implicit: unconditionally stable, no step halving */
     gs->cfg.cg_tol = GSOLVE_CG_TOL;
     gsolve_set_material(gs, &g->material);
-    const int32_t lo[3] = {0, 0, 0};
-    e = gsolve_seed_from_grid(gs, g, lo, g->dims);
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    e = gsolve_seed_from_grid(gs, g, lo, hi);
     if (e != ARGIL_OK)
         gsolve_free(gs);
     return e;
@@ -289,19 +284,22 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
         return ARGIL_ERR_STATE;
     /* The field is current after every step (p, velocity, d, rest): only the window goes. */
     close_window(gs);
-    const int32_t zero[3] = {0, 0, 0};
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    int32_t zero[3], top[3], gd[3];
+    grid_bounds(g, zero, top);
+    for (int a = 0; a < 3; a++)
+        gd[a] = top[a] - zero[a];
+    const size_t n = grid_count(g);
     float *before = malloc(2 * n * sizeof(float));
     if (!before)
         return ARGIL_ERR_NOMEM;
     float *after = before + n;
-    sparse_read_box(&f->samp, FS_D, zero, g->dims, before);
+    sparse_read_box(&f->samp, FS_D, zero, gd, before);
     const uint32_t gen = f->lattice_gen;
     argil_err_t e = field_refine(f);
     if (e != ARGIL_OK && f->lattice_gen != gen) {
         /* Out of memory after the finer coefficients replaced the coarse ones: some d may still
          * hold the old values (field.h); recompute the grid's part once more. */
-        const argil_err_t e2 = field_refresh(f, zero, g->dims);
+        const argil_err_t e2 = field_refresh(f, zero, top);
         if (e2 == ARGIL_OK)
             e = ARGIL_OK;
     }
@@ -309,28 +307,36 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
         free(before);
         return e;
     }
-    sparse_read_box(&f->samp, FS_D, zero, g->dims, after);
+    sparse_read_box(&f->samp, FS_D, zero, gd, after);
     /* The grid follows only a density the refinement itself moved by > GSOLVE_VIEW_EPS (none
      * measured: ~5e-7): a sample the view left within GSOLVE_VIEW_EPS of the field stays as it
      * is, so the grid, the mesh and the board's window do not change at all. */
     float dd = 0.0f;
     bool changed = false;
-    for (size_t i = 0; i < n; i++) {
-        const float c = fabsf(after[i] - before[i]);
-        if (c > dd)
-            dd = c;
-        if (c > GSOLVE_VIEW_EPS) {
-            g->density[i] = clamp01(after[i]);
-            changed = true;
-        }
-    }
+    size_t i = 0;
+    for (int32_t z = zero[2]; z < top[2]; z++)
+        for (int32_t y = zero[1]; y < top[1]; y++)
+            for (int32_t x = zero[0]; x < top[0]; x++, i++) {
+                const float c = fabsf(after[i] - before[i]);
+                if (c > dd)
+                    dd = c;
+                if (c > GSOLVE_VIEW_EPS) {
+                    if (grid_set(g, GRID_DENSITY, x, y, z, clamp01(after[i])) != ARGIL_OK) {
+                        free(before);
+                        return ARGIL_ERR_NOMEM;
+                    }
+                    changed = true;
+                }
+            }
     free(before);
     gs->stats.refines++;
     if (max_dd)
         *max_dd = dd;
     if (changed)
-        for (int a = 0; a < 3; a++)
-            hi[a] = g->dims[a];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = zero[a];
+            hi[a] = top[a];
+        }
     return ARGIL_OK;
 }
 
@@ -372,9 +378,7 @@ static argil_err_t seed_fit(field_t *f, const grid_t *g, const int32_t lo[3], co
     for (int32_t z = 0, k = 0; z < ns[2]; z++)
         for (int32_t y = 0; y < ns[1]; y++)
             for (int32_t x = 0; x < ns[0]; x++, k++)
-                Rs[k] = g->density[(size_t)(a0[0] + x) + (size_t)g->dims[0] *
-                                   ((size_t)(a0[1] + y) + (size_t)g->dims[1] *
-                                    (size_t)(a0[2] + z))] - Rs[k];
+                Rs[k] = grid_get(g, GRID_DENSITY, a0[0] + x, a0[1] + y, a0[2] + z) - Rs[k];
     field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
     memcpy(Q, S, ncoef * sizeof(float));
     double gamma = dot(S, S, ncoef);
@@ -427,12 +431,7 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
             for (int32_t x = 0; x < nc[0]; x++, k++) {
                 const int32_t s[3] = {(clo[0] + x) * f->ratio, (clo[1] + y) * f->ratio,
                                       (clo[2] + z) * f->ratio};
-                bool in = true;
-                for (int a = 0; a < 3; a++)
-                    in = in && s[a] >= 0 && s[a] < g->dims[a];
-                p[k] = in ? g->density[(size_t)s[0] + (size_t)g->dims[0] *
-                                       ((size_t)s[1] + (size_t)g->dims[1] * (size_t)s[2])]
-                          : 0.0f;
+                p[k] = grid_get(g, GRID_DENSITY, s[0], s[1], s[2]);
             }
     argil_err_t e = sparse_write_box(&f->coef, FC_P, clo, nc, p);
     if (e == ARGIL_OK) {
@@ -459,10 +458,10 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         for (int32_t z = a0[2]; z < a1[2]; z++)
             for (int32_t y = a0[1]; y < a1[1]; y++)
                 for (int32_t x = a0[0]; x < a1[0]; x++) {
-                    const size_t i = (size_t)x + (size_t)g->dims[0] *
-                                     ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                    g->rest[i] = g->density[i];
-                    g->velocity[i] = 0.0f;
+                    if (grid_set(g, GRID_REST, x, y, z, grid_get(g, GRID_DENSITY, x, y, z)) !=
+                            ARGIL_OK ||
+                        grid_set(g, GRID_VELOCITY, x, y, z, 0.0f) != ARGIL_OK)
+                        return ARGIL_ERR_NOMEM;
                 }
     return ARGIL_OK;
 }
@@ -742,14 +741,15 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
         for (int32_t z = a0[2]; z < a1[2]; z++)
             for (int32_t y = a0[1]; y < a1[1]; y++)
                 for (int32_t x = a0[0]; x < a1[0]; x++) {
-                    const size_t gi = (size_t)x + (size_t)g->dims[0] *
-                                      ((size_t)y + (size_t)g->dims[1] * (size_t)z);
                     const size_t si = (size_t)(x - w->slo[0]) +
                                       (size_t)nx * ((size_t)(y - w->slo[1]) +
                                                     (size_t)ny * (size_t)(z - w->slo[2]));
-                    s->force_n[si] = g->force[gi];
-                    forced = forced || g->force[gi] != 0.0f;
-                    g->force[gi] = 0.0f;
+                    const float fo = grid_get(g, GRID_FORCE, x, y, z);
+                    s->force_n[si] = fo;
+                    if (fo != 0.0f) {
+                        forced = true;
+                        (void)grid_set(g, GRID_FORCE, x, y, z, 0.0f);
+                    }
                 }
     }
     /* At rest and left alone: nothing to step (and no round-off to integrate); the window is
@@ -862,29 +862,19 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
     const size_t vol = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
-    float *v = malloc(vol * sizeof(float));
+    float *v = malloc(2 * vol * sizeof(float));
     if (v == NULL)
         return ARGIL_ERR_NOMEM;
+    float *old = v + vol;
     bool changed = false;
     argil_err_t e = ARGIL_OK;
     for (int ch = 0; ch < GRID_MAT_N && e == ARGIL_OK; ch++) {
         sparse_read_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], a0, n, v);
-        size_t k = 0;
-        for (int32_t z = a0[2]; z < a1[2] && e == ARGIL_OK; z++)
-            for (int32_t y = a0[1]; y < a1[1] && e == ARGIL_OK; y++)
-                for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
-                    const size_t i = (size_t)x + (size_t)g->dims[0] *
-                                     ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                    const float old = grid_mat_value(g, (grid_mat_t)ch, i);
-                    if (memcmp(&old, &v[k], sizeof(float)) == 0)
-                        continue;
-                    if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
-                        e = ARGIL_ERR_NOMEM;
-                        break;
-                    }
-                    g->mat[ch][i] = v[k];
-                    changed = true;
-                }
+        grid_mat_read_box(g, (grid_mat_t)ch, a0, n, old);
+        if (memcmp(old, v, vol * sizeof(float)) == 0)
+            continue;
+        e = grid_mat_write_box(g, (grid_mat_t)ch, a0, n, v);
+        changed = changed || e == ARGIL_OK;
     }
     free(v);
     if (changed)
@@ -894,13 +884,16 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
 
 argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
 {
-    const int32_t lo[3] = {0, 0, 0};
+    int32_t lo[3], n[3];
     bool any = false;
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (g->mat[ch] == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
-        const argil_err_t e = sparse_write_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], lo,
-                                               g->dims, g->mat[ch]);
+        float *m = grid_dense_copy_mat(g, (grid_mat_t)ch, lo, n);
+        if (m == NULL)
+            return ARGIL_ERR_NOMEM;
+        const argil_err_t e = sparse_write_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], lo, n, m);
+        free(m);
         if (e != ARGIL_OK)
             return e;
         any = true;

@@ -18,6 +18,7 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/live_hand.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/render/backend_glfw.h"
 #include "host/render/camera.h"
@@ -362,7 +363,8 @@ static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo
     } else if (!empty) {
         mc_blocks_mark(&L->mcb2, lo, hi);
     }
-    if (mc_blocks_update(&L->mcb2, g->density, NULL) == ARGIL_OK && L->mcb2.blocks_meshed > 0)
+    if (mc_blocks_update_read(&L->mcb2, grid_mesh_read, g) == ARGIL_OK &&
+        L->mcb2.blocks_meshed > 0)
         L->serial2++;
 }
 
@@ -383,7 +385,8 @@ static void publish(live_t *L, session_frame_t *f)
     if (L->mcb_ready) {
         if (!empty)
             mc_blocks_mark(&L->mcb, p->dirty_lo, p->dirty_hi);
-        if (mc_blocks_update(&L->mcb, g->density, NULL) == ARGIL_OK && L->mcb.blocks_meshed > 0)
+        if (mc_blocks_update_read(&L->mcb, grid_mesh_read, g) == ARGIL_OK &&
+            L->mcb.blocks_meshed > 0)
             L->serial++;
     }
     update_iso2(L, g, empty, p->dirty_lo, p->dirty_hi);

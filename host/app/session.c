@@ -20,6 +20,7 @@
 #include "host/io/ply.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/model/grid.h"
 #include "sim/sim_device.h"
 
@@ -124,7 +125,7 @@ static argil_err_t mesh_field(const grid_t *g, mesh_t *m, double *volume_m3)
 {
     mesh_free(m);
     mesh_init(m);
-    const argil_err_t e = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, m);
+    const argil_err_t e = grid_mesh_extract(g, g->iso, m);
     if (e == ARGIL_OK)
         *volume_m3 = mesh_volume_m3(m);
     return e;

@@ -149,6 +149,51 @@ static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], si
 
 /* ---- the model as a journal holds it ---- */
 
+/* True when g can be journalled by j: the box [0, j->dims) holds all of g's samples. */
+static bool journal_fits(const journal_t *j, const grid_t *g)
+{
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        if (lo[a] != 0 || hi[a] != j->dims[a])
+            return false;
+    return true;
+}
+
+static void dense_all_free(float **dens, float *mat[GRID_MAT_N])
+{
+    free(*dens);
+    *dens = NULL;
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        free(mat[ch]);
+        mat[ch] = NULL;
+    }
+}
+
+/* Dense copies over [0, dims) of g's densities and of each painted channel (NULL = unpainted). */
+static argil_err_t grid_dense_all(const grid_t *g, const int32_t dims[3], float **dens,
+                                  float *mat[GRID_MAT_N])
+{
+    const int32_t zero[3] = {0, 0, 0};
+    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    *dens = malloc(n * sizeof(float));
+    if (*dens == NULL)
+        return ARGIL_ERR_NOMEM;
+    grid_read_box(g, GRID_DENSITY, zero, dims, *dens);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        mat[ch] = NULL;
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
+            continue;
+        mat[ch] = malloc(n * sizeof(float));
+        if (mat[ch] == NULL) {
+            dense_all_free(dens, mat);
+            return ARGIL_ERR_NOMEM;
+        }
+        grid_mat_read_box(g, (grid_mat_t)ch, zero, dims, mat[ch]);
+    }
+    return ARGIL_OK;
+}
+
 argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
                               float *const mat[GRID_MAT_N], argil_doc_t *doc)
 {
@@ -156,17 +201,20 @@ argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
     argil_err_t e = grid_init(&doc->grid, info->dims, info->spacing_m, info->origin_m);
     if (e != ARGIL_OK)
         return e;
-    const size_t n = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
-    memcpy(doc->grid.density, density, n * sizeof(float));
+    const int32_t zero[3] = {0, 0, 0};
+    e = grid_write_box(&doc->grid, GRID_DENSITY, zero, info->dims, density);
+    if (e != ARGIL_OK)
+        return e;
     for (int ch = 0; mat != NULL && ch < GRID_MAT_N; ch++) {
         if (mat[ch] == NULL)
             continue;
-        float *m = grid_mat_alloc(&doc->grid, (grid_mat_t)ch);
-        if (m == NULL)
-            return ARGIL_ERR_NOMEM;
-        memcpy(m, mat[ch], n * sizeof(float));
+        e = grid_mat_write_box(&doc->grid, (grid_mat_t)ch, zero, info->dims, mat[ch]);
+        if (e != ARGIL_OK)
+            return e;
     }
-    memcpy(doc->grid.rest, density, n * sizeof(float));
+    e = grid_write_box(&doc->grid, GRID_REST, zero, info->dims, density);
+    if (e != ARGIL_OK)
+        return e;
     doc->grid.iso = info->iso;
     doc->grid.band_m = info->band_m;
     doc->grid.material = info->material;
@@ -191,17 +239,20 @@ static void writer_info(const journal_t *j, uint32_t edits, journal_info_t *info
 argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
                                 const char *path, char *err, size_t err_len)
 {
-    if ((g == NULL && j->shadow == NULL) ||
-        (g != NULL && (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] ||
-                       g->dims[2] != j->dims[2] || g->density == NULL))) {
+    if ((g == NULL && j->shadow == NULL) || (g != NULL && !journal_fits(j, g))) {
         io_err(err, err_len, "%s: the journal holds no model (or not this grid's)", path);
         return ARGIL_ERR_STATE;
     }
     journal_info_t info;
     writer_info(j, edits, &info);
     argil_doc_t doc;
-    argil_err_t e = g != NULL ? journal_model_doc(&info, g->density, g->mat, &doc)
-                              : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
+    argil_doc_init(&doc);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    argil_err_t e = g != NULL ? grid_dense_all(g, j->dims, &dens, mat) : ARGIL_OK;
+    if (e == ARGIL_OK)
+        e = g != NULL ? journal_model_doc(&info, dens, mat, &doc)
+                      : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
+    dense_all_free(&dens, mat);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", path);
         argil_doc_free(&doc);
@@ -304,29 +355,33 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
     memset(j, 0, sizeof(*j));
     j->fd = -1;
     if (!(cfg->autosave_s > 0.0f) || !(cfg->checkpoint_s > 0.0f) || cfg->checkpoint_bytes == 0 ||
-        g->density == NULL) {
+        grid_count(g) == 0) {
         io_err(err, err_len, "journal: autosave and checkpoint intervals must be > 0");
         return ARGIL_ERR_ARG;
     }
     j->cfg = *cfg;
+    int32_t glo[3], ghi[3];
+    grid_bounds(g, glo, ghi);
     for (int a = 0; a < 3; a++)
-        j->dims[a] = g->dims[a];
+        j->dims[a] = ghi[a] - glo[a];
     j->spacing_m = g->spacing_m;
     j->origin_m = g->origin_m;
     j->iso = g->iso;
     j->band_m = g->band_m;
     j->material = g->material;
-    j->n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    j->n = (size_t)j->dims[0] * (size_t)j->dims[1] * (size_t)j->dims[2];
     j->dir = strdup(dir);
     j->shadow = malloc(j->n * sizeof(float));
-    if (j->dir == NULL || j->shadow == NULL) {
+    j->cur = malloc(j->n * sizeof(float));
+    if (j->dir == NULL || j->shadow == NULL || j->cur == NULL || !journal_fits(j, g)) {
         io_err(err, err_len, "%s: out of memory for the journal", dir);
         journal_close(j);
         return ARGIL_ERR_NOMEM;
     }
-    memcpy(j->shadow, g->density, j->n * sizeof(float));
+    const int32_t zero[3] = {0, 0, 0};
+    grid_read_box(g, GRID_DENSITY, zero, j->dims, j->shadow);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (g->mat[ch] == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
         j->mat_shadow[ch] = malloc(j->n * sizeof(float));
         if (j->mat_shadow[ch] == NULL) {
@@ -334,7 +389,7 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
             journal_close(j);
             return ARGIL_ERR_NOMEM;
         }
-        memcpy(j->mat_shadow[ch], g->mat[ch], j->n * sizeof(float));
+        grid_mat_read_box(g, (grid_mat_t)ch, zero, j->dims, j->mat_shadow[ch]);
     }
     j->mat_writes = g->mat_writes;
     if (journal_exists(dir)) {
@@ -478,7 +533,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         io_err(err, err_len, "journal: not open (or stopped by an earlier failure)");
         return ARGIL_ERR_STATE;
     }
-    if (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] || g->dims[2] != j->dims[2]) {
+    if (!journal_fits(j, g)) {
         io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
         return ARGIL_ERR_ARG;
     }
@@ -492,6 +547,19 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         }
     }
     const size_t x0 = (size_t)lo[0], x1 = (size_t)hi[0];
+    /* The grid's densities on the box's whole rows: a run bridges at most JOURNAL_RUN_GAP
+     * samples, so beyond a changed sample it reaches only into the next row of the box (or, for
+     * rows this short, the next plane: then whole planes). */
+    if (x1 > x0 && hi[1] > lo[1] && hi[2] > lo[2]) {
+        const bool planes = j->dims[0] <= (int32_t)JOURNAL_RUN_GAP;
+        const int32_t y0 = planes ? 0 : lo[1], ny = planes ? j->dims[1] : hi[1] - lo[1];
+        for (int32_t z = lo[2]; z < hi[2]; z++) {
+            const int32_t slo[3] = {0, y0, z}, sn[3] = {j->dims[0], ny, 1};
+            const size_t at = (size_t)j->dims[0] * ((size_t)y0 + (size_t)j->dims[1] * (size_t)z);
+            grid_read_box(g, GRID_DENSITY, slo, sn, j->cur + at);
+        }
+    }
+    const float *gd = j->cur;
     const size_t rec_at = j->buf_len;
     if (!reserve(j, 4 + JOURNAL_RECORD_HEAD_BYTES))
         goto nomem;
@@ -502,7 +570,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
     for (int32_t z = lo[2]; z < hi[2] && x1 > x0; z++) {
         for (int32_t y = lo[1]; y < hi[1]; y++) {
             const size_t r0 = ((size_t)y + (size_t)j->dims[1] * (size_t)z) * (size_t)j->dims[0];
-            const float *d = g->density + r0, *s = j->shadow + r0;
+            const float *d = gd + r0, *s = j->shadow + r0;
             if (same_bits(d + x0, s + x0, (x1 - x0) * sizeof(float)))
                 continue;
             for (size_t x = x0; x < x1; x++) {
@@ -514,7 +582,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
                     continue;
                 }
                 if (open_run) {
-                    if (!put_run(j, g->density, run_start, run_end))
+                    if (!put_run(j, gd, run_start, run_end))
                         goto nomem;
                     runs++;
                 }
@@ -525,7 +593,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         }
     }
     if (open_run) {
-        if (!put_run(j, g->density, run_start, run_end))
+        if (!put_run(j, gd, run_start, run_end))
             goto nomem;
         runs++;
     }
@@ -536,9 +604,14 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         if (!reserve(j, 4))
             goto nomem;
         j->buf_len += 4;
-        for (int ch = 0; ch < GRID_MAT_N; ch++)
-            if (!put_mat_block(j, (grid_mat_t)ch, g->mat[ch], &blocks))
+        const int32_t zero[3] = {0, 0, 0};
+        for (int ch = 0; ch < GRID_MAT_N; ch++) {
+            const bool painted = grid_mat_painted(g, (grid_mat_t)ch);
+            if (painted) /* the density runs are written: cur is free again */
+                grid_mat_read_box(g, (grid_mat_t)ch, zero, j->dims, j->cur);
+            if (!put_mat_block(j, (grid_mat_t)ch, painted ? j->cur : NULL, &blocks))
                 goto nomem;
+        }
         if (blocks == 0)
             j->buf_len = blocks_at;
         else
@@ -656,6 +729,8 @@ void journal_close(journal_t *j)
     j->fd = -1;
     free(j->dir);
     free(j->shadow);
+    free(j->cur);
+    j->cur = NULL;
     free(j->buf);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
         free(j->mat_shadow[ch]);
@@ -859,18 +934,25 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
     return ARGIL_OK;
 }
 
-/* Applies the checked material blocks at payload offset off to g's channels. */
-static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, const char *name,
-                                    char *err, size_t err_len)
+/* Applies the checked material blocks at payload offset off to the n-sample channels mat (an
+ * absent one is made, every sample the default, before it is written). */
+static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, float *mat[GRID_MAT_N],
+                                    size_t n, const char *name, char *err, size_t err_len)
 {
     const uint32_t blocks = io_get_u32le(p + off);
     size_t o = off + 4;
     /* Every channel the record touches exists before anything is written. */
     for (uint32_t k = 0; k < blocks; k++) {
         const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
-        if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
-            io_err(err, err_len, "%s: out of memory for a painted material channel", name);
-            return ARGIL_ERR_NOMEM;
+        if (mat[ch] == NULL) {
+            mat[ch] = malloc(n * sizeof(float));
+            if (mat[ch] == NULL) {
+                io_err(err, err_len, "%s: out of memory for a painted material channel", name);
+                return ARGIL_ERR_NOMEM;
+            }
+            const float def = grid_mat_default((grid_mat_t)ch);
+            for (size_t i = 0; i < n; i++)
+                mat[ch][i] = def;
         }
         o += 8;
         for (uint32_t r = 0; r < runs; r++)
@@ -879,7 +961,7 @@ static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, con
     o = off + 4;
     for (uint32_t k = 0; k < blocks; k++) {
         const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
-        float *m = g->mat[ch];
+        float *m = mat[ch];
         o += 8;
         for (uint32_t r = 0; r < runs; r++) {
             const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
@@ -888,13 +970,12 @@ static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, con
             o += 8 + 4 * count;
         }
     }
-    g->mat_writes++;
     return ARGIL_OK;
 }
 
 /* Checks one record's payload (CRC already good) and, with density (and g), applies it. */
 static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, const char *name,
-                                float *density, grid_t *g, size_t n, journal_info_t *info,
+                                float *density, float **mat, size_t n, journal_info_t *info,
                                 char *err, size_t err_len)
 {
     char why[160];
@@ -959,8 +1040,8 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
         return fail(err, err_len, name, at + 4 + off, why);
     }
-    if (type == 2u && g != NULL) {
-        const argil_err_t e = apply_mat_blocks(p, mat_off, g, name, err, err_len);
+    if (type == 2u && mat != NULL) {
+        const argil_err_t e = apply_mat_blocks(p, mat_off, mat, n, name, err, err_len);
         if (e != ARGIL_OK)
             return e;
     }
@@ -984,9 +1065,9 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     return ARGIL_OK;
 }
 
-/* journal_replay with an optional grid for the painted channels (density = g's then). */
+/* journal_replay with optional painted channels (mat[GRID_MAT_N], n samples each). */
 static argil_err_t replay(const uint8_t *data, size_t len, const char *name, float *density,
-                          size_t n, grid_t *g, journal_info_t *info, char *err, size_t err_len)
+                          size_t n, float **mat, journal_info_t *info, char *err, size_t err_len)
 {
     argil_err_t e = journal_header_decode(data, len, name, info, err, err_len);
     if (e != ARGIL_OK)
@@ -1020,7 +1101,7 @@ static argil_err_t replay(const uint8_t *data, size_t len, const char *name, flo
                      info->records + 1u);
             return fail(err, err_len, name, at, why);
         }
-        e = apply_record(data + at + 4, (size_t)payload, at, name, density, g, want, info, err,
+        e = apply_record(data + at + 4, (size_t)payload, at, name, density, mat, want, info, err,
                          err_len);
         if (e != ARGIL_OK)
             return e;
@@ -1039,8 +1120,34 @@ argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, fl
 argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
                                 journal_info_t *info, char *err, size_t err_len)
 {
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
-    return replay(data, len, name, g->density, n, g, info, err, err_len);
+    int32_t lo[3], hi[3], dims[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        dims[a] = hi[a] - lo[a];
+    const size_t n = grid_count(g);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    argil_err_t e = grid_dense_all(g, dims, &dens, mat);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return e;
+    }
+    e = replay(data, len, name, dens, n, mat, info, err, err_len);
+    /* Even after a bad record (PARSE) the grid takes the model as of the record before it. */
+    argil_err_t we = grid_write_box(g, GRID_DENSITY, lo, dims, dens);
+    bool painted = false;
+    for (int ch = 0; ch < GRID_MAT_N && we == ARGIL_OK; ch++)
+        if (mat[ch] != NULL) {
+            we = grid_mat_write_box(g, (grid_mat_t)ch, lo, dims, mat[ch]);
+            painted = true;
+        }
+    if (painted)
+        g->mat_writes++;
+    dense_all_free(&dens, mat);
+    if (we != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return we;
+    }
+    return e;
 }
 
 static argil_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
@@ -1082,6 +1189,7 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     char *path = NULL, *base_path = NULL;
     argil_doc_t b;
     argil_doc_init(&b);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
     argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
     if (e != ARGIL_OK)
         goto out;
@@ -1098,10 +1206,19 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     if (e != ARGIL_OK)
         goto out;
     const grid_t *g = &b.grid;
-    const size_t bn = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    int32_t glo[3], ghi[3], gdims[3];
+    grid_bounds(g, glo, ghi);
+    for (int a = 0; a < 3; a++)
+        gdims[a] = ghi[a] - glo[a];
+    const size_t bn = grid_count(g);
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    const uint32_t crc = model_crc(g->density, g->mat, bn);
+    e = grid_dense_all(g, gdims, &dens, mat);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", base_path);
+        goto out;
+    }
+    const uint32_t crc = model_crc(dens, mat, bn);
     if (blen != info->base_len || crc != info->base_crc ||
         !same_bits(&g->material, &info->material, sizeof(g->material)) ||
         b.state.edits != info->edits) {
@@ -1114,8 +1231,9 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
-    if (g->dims[0] != info->dims[0] || g->dims[1] != info->dims[1] ||
-        g->dims[2] != info->dims[2] || !same_f32(g->spacing_m, info->spacing_m) ||
+    if (glo[0] != 0 || glo[1] != 0 || glo[2] != 0 || gdims[0] != info->dims[0] ||
+        gdims[1] != info->dims[1] || gdims[2] != info->dims[2] ||
+        !same_f32(g->spacing_m, info->spacing_m) ||
         !same_f32(g->origin_m.x, info->origin_m.x) || !same_f32(g->origin_m.y, info->origin_m.y) ||
         !same_f32(g->origin_m.z, info->origin_m.z) || !same_f32(g->iso, info->iso) ||
         !same_f32(g->band_m, info->band_m)) {
@@ -1123,11 +1241,11 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
-    e = journal_replay_grid(data, len, path, &b.grid, info, err, err_len);
+    e = replay(data, len, path, dens, bn, mat, info, err, err_len);
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         goto out;
-    /* After a bad record (PARSE) the grid holds the model as of the record before it. */
-    const argil_err_t me = journal_model_doc(info, b.grid.density, b.grid.mat, doc);
+    /* After a bad record (PARSE) the arrays hold the model as of the record before it. */
+    const argil_err_t me = journal_model_doc(info, dens, mat, doc);
     if (me != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the recovered model", path);
         e = me;
@@ -1135,8 +1253,9 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
 out:
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         argil_doc_free(doc);
-    else if (e == ARGIL_ERR_PARSE && doc->grid.density == NULL)
+    else if (e == ARGIL_ERR_PARSE && grid_count(&doc->grid) == 0)
         argil_doc_free(doc);
+    dense_all_free(&dens, mat);
     argil_doc_free(&b);
     free(data);
     free(path);

@@ -49,6 +49,7 @@ typedef struct {
     vec3_t origin_m;
     size_t n;                 /* samples */
     float *shadow;            /* density as of the last record */
+    float *cur;               /* scratch: the grid's samples read for a record (n floats) */
     float *mat_shadow[GRID_MAT_N]; /* painted channels as of the last record (NULL: never
                                * painted, all grid_mat_default) */
     uint32_t mat_writes;      /* the grid's mat_writes when its channels were last compared */

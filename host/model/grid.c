@@ -84,7 +84,7 @@ void grid_free(grid_t *g)
     g->dims[0] = g->dims[1] = g->dims[2] = 0;
 }
 
-static size_t grid_count(const grid_t *g)
+size_t grid_count(const grid_t *g)
 {
     return (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
 }
@@ -103,12 +103,19 @@ bool grid_mat_valid(grid_mat_t ch, float v)
     return ch == GRID_MAT_RESTLEN || v >= 0.0f;
 }
 
-float grid_mat_value(const grid_t *g, grid_mat_t ch, size_t i)
+/* Channel ch's storage (NULL for an unpainted mat channel). */
+static float *grid_channel(const grid_t *g, grid_ch_t ch)
 {
-    return g->mat[ch] != NULL ? g->mat[ch][i] : grid_mat_default(ch);
+    switch (ch) {
+    case GRID_DENSITY: return g->density;
+    case GRID_REST: return g->rest;
+    case GRID_VELOCITY: return g->velocity;
+    case GRID_FORCE: return g->force;
+    default: return NULL;
+    }
 }
 
-float *grid_mat_alloc(grid_t *g, grid_mat_t ch)
+static float *grid_mat_alloc(grid_t *g, grid_mat_t ch)
 {
     if ((unsigned)ch >= GRID_MAT_N || g->density == NULL)
         return NULL;
@@ -123,6 +130,204 @@ float *grid_mat_alloc(grid_t *g, grid_mat_t ch)
         m[i] = def;
     g->mat[ch] = m;
     return m;
+}
+
+void grid_bounds(const grid_t *g, int32_t lo[3], int32_t hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = 0;
+        hi[a] = g->dims[a];
+    }
+}
+
+bool grid_holds(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return x >= 0 && y >= 0 && z >= 0 && x < g->dims[0] && y < g->dims[1] && z < g->dims[2];
+}
+
+float grid_get(const grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z)
+{
+    const float *c = grid_channel(g, ch);
+    if (c == NULL || !grid_holds(g, x, y, z))
+        return 0.0f;
+    return c[grid_index(g, x, y, z)];
+}
+
+argil_err_t grid_set(grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z, float v)
+{
+    float *c = grid_channel(g, ch);
+    if (c == NULL || !grid_holds(g, x, y, z))
+        return ARGIL_ERR_ARG;
+    c[grid_index(g, x, y, z)] = v;
+    return ARGIL_OK;
+}
+
+bool grid_clip(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
+               int32_t chi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        clo[a] = lo[a] < 0 ? 0 : lo[a];
+        chi[a] = hi[a] > g->dims[a] ? g->dims[a] : hi[a];
+        if (chi[a] <= clo[a])
+            return false;
+    }
+    return true;
+}
+
+/* The part of box [lo, lo+n) inside the grid: [a0, a1); false when empty. */
+static bool grid_clip_n(const grid_t *g, const int32_t lo[3], const int32_t n[3], int32_t a0[3],
+                      int32_t a1[3])
+{
+    for (int a = 0; a < 3; a++) {
+        if (n[a] <= 0)
+            return false;
+        const int64_t l = lo[a] < 0 ? 0 : lo[a];
+        const int64_t h = (int64_t)lo[a] + n[a] > g->dims[a] ? g->dims[a] : (int64_t)lo[a] + n[a];
+        if (h <= l)
+            return false;
+        a0[a] = (int32_t)l;
+        a1[a] = (int32_t)h;
+    }
+    return true;
+}
+
+/* Copies the grid's part of box [lo, lo+n) between array c and buf (x fastest over the box):
+ * into buf when to_buf, else into c. */
+static void grid_copy_box(const grid_t *g, float *c, const int32_t lo[3], const int32_t n[3],
+                          float *buf, bool to_buf)
+{
+    int32_t a0[3], a1[3];
+    if (!grid_clip_n(g, lo, n, a0, a1))
+        return;
+    const size_t w = (size_t)(a1[0] - a0[0]);
+    for (int32_t z = a0[2]; z < a1[2]; z++)
+        for (int32_t y = a0[1]; y < a1[1]; y++) {
+            float *gp = c + grid_index(g, a0[0], y, z);
+            float *bp = buf + (size_t)(a0[0] - lo[0]) +
+                        (size_t)n[0] * ((size_t)(y - lo[1]) + (size_t)n[1] * (size_t)(z - lo[2]));
+            if (to_buf)
+                memcpy(bp, gp, w * sizeof(float));
+            else
+                memcpy(gp, bp, w * sizeof(float));
+        }
+}
+
+static void fill(float *out, size_t n, float v)
+{
+    for (size_t i = 0; i < n; i++)
+        out[i] = v;
+}
+
+static size_t box_count(const int32_t n[3])
+{
+    if (n[0] <= 0 || n[1] <= 0 || n[2] <= 0)
+        return 0;
+    return (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+}
+
+void grid_read_box(const grid_t *g, grid_ch_t ch, const int32_t lo[3], const int32_t n[3],
+                   float *out)
+{
+    fill(out, box_count(n), 0.0f);
+    float *c = grid_channel(g, ch);
+    if (c != NULL)
+        grid_copy_box(g, c, lo, n, out, true);
+}
+
+argil_err_t grid_write_box(grid_t *g, grid_ch_t ch, const int32_t lo[3], const int32_t n[3],
+                           const float *in)
+{
+    float *c = grid_channel(g, ch);
+    if (c == NULL)
+        return ARGIL_ERR_ARG;
+    grid_copy_box(g, c, lo, n, (float *)in, false);
+    return ARGIL_OK;
+}
+
+float grid_mat_get(const grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t z)
+{
+    if ((unsigned)ch >= GRID_MAT_N)
+        return 0.0f;
+    if (g->mat[ch] == NULL || !grid_holds(g, x, y, z))
+        return grid_mat_default(ch);
+    return g->mat[ch][grid_index(g, x, y, z)];
+}
+
+argil_err_t grid_mat_set(grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t z, float v)
+{
+    if ((unsigned)ch >= GRID_MAT_N || !grid_holds(g, x, y, z))
+        return ARGIL_ERR_ARG;
+    float *m = grid_mat_alloc(g, ch);
+    if (m == NULL)
+        return ARGIL_ERR_NOMEM;
+    m[grid_index(g, x, y, z)] = v;
+    return ARGIL_OK;
+}
+
+void grid_mat_read_box(const grid_t *g, grid_mat_t ch, const int32_t lo[3], const int32_t n[3],
+                       float *out)
+{
+    if ((unsigned)ch >= GRID_MAT_N)
+        return;
+    fill(out, box_count(n), grid_mat_default(ch));
+    if (g->mat[ch] != NULL)
+        grid_copy_box(g, g->mat[ch], lo, n, out, true);
+}
+
+argil_err_t grid_mat_write_box(grid_t *g, grid_mat_t ch, const int32_t lo[3], const int32_t n[3],
+                               const float *in)
+{
+    if ((unsigned)ch >= GRID_MAT_N)
+        return ARGIL_ERR_ARG;
+    float *m = grid_mat_alloc(g, ch);
+    if (m == NULL)
+        return ARGIL_ERR_NOMEM;
+    grid_copy_box(g, m, lo, n, (float *)in, false);
+    return ARGIL_OK;
+}
+
+bool grid_mat_painted(const grid_t *g, grid_mat_t ch)
+{
+    return (unsigned)ch < GRID_MAT_N && g->mat[ch] != NULL;
+}
+
+float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3])
+{
+    int32_t hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        n[a] = hi[a] - lo[a];
+    float *out = malloc(box_count(n) * sizeof(float));
+    if (out != NULL)
+        grid_read_box(g, ch, lo, n, out);
+    return out;
+}
+
+float *grid_dense_copy_mat(const grid_t *g, grid_mat_t ch, int32_t lo[3], int32_t n[3])
+{
+    int32_t hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        n[a] = hi[a] - lo[a];
+    float *out = malloc(box_count(n) * sizeof(float));
+    if (out != NULL)
+        grid_mat_read_box(g, ch, lo, n, out);
+    return out;
+}
+
+vec3_t grid_box_origin(const grid_t *g, const int32_t lo[3])
+{
+    if (lo[0] == 0 && lo[1] == 0 && lo[2] == 0)
+        return g->origin_m;
+    return grid_sample_pos(g, lo[0], lo[1], lo[2]);
+}
+
+size_t grid_bytes(const grid_t *g)
+{
+    size_t chans = 4;
+    for (int c = 0; c < GRID_MAT_N; c++)
+        chans += g->mat[c] != NULL;
+    return chans * grid_count(g) * sizeof(float);
 }
 
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)
@@ -142,7 +347,7 @@ bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)
     return true;
 }
 
-spring_field_t grid_springs(grid_t *g)
+float grid_springs_step(grid_t *g, const int32_t lo[3], const int32_t hi[3], float dt_s)
 {
     spring_field_t f;
     for (int a = 0; a < 3; a++)
@@ -152,7 +357,7 @@ spring_field_t grid_springs(grid_t *g)
     f.velocity = g->velocity;
     f.force = g->force;
     f.stiffness = NULL; /* uniform: g->material.stiffness */
-    return f;
+    return springs_step(&f, &g->material, lo, hi, dt_s);
 }
 
 float grid_profile(float signed_dist_m, float band_m)

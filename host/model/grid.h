@@ -54,19 +54,85 @@ float grid_mat_default(grid_mat_t ch);
  * scales >= 0 (what host/model/material.c keeps them to). */
 bool grid_mat_valid(grid_mat_t ch, float v);
 
-/* Channel ch of sample i (the default when ch is not painted). */
-float grid_mat_value(const grid_t *g, grid_mat_t ch, size_t i);
-
-/* Makes channel ch present (every sample the default when newly allocated) and returns it;
- * NULL when out of memory or ch is out of range. */
-float *grid_mat_alloc(grid_t *g, grid_mat_t ch);
-
 /* True when the two grids' samples hold the same bits in channel ch (an absent channel reads
  * as the default everywhere); false when their sample counts differ. */
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch);
 
-/* A spring_field_t view onto the grid's own arrays (no copy). */
-spring_field_t grid_springs(grid_t *g);
+/* One explicit density-spring step (shared/density_springs.h) over the sample box [lo, hi)
+ * with the grid's material; returns what springs_step returns (the largest |acceleration|). */
+float grid_springs_step(grid_t *g, const int32_t lo[3], const int32_t hi[3], float dt_s);
+
+/* ---- Sample access: every consumer reads and writes the grid through these ---- */
+
+/* The per-sample channels besides the painted ones. */
+typedef enum {
+    GRID_DENSITY = 0,
+    GRID_REST = 1,
+    GRID_VELOCITY = 2,
+    GRID_FORCE = 3,
+    GRID_CH_N = 4
+} grid_ch_t;
+
+/* The sample box [lo, hi) outside which every sample reads as empty clay (density, rest,
+ * velocity and force 0, material the default); hi > lo on every axis. */
+void grid_bounds(const grid_t *g, int32_t lo[3], int32_t hi[3]);
+
+/* Number of samples in grid_bounds' box. */
+size_t grid_count(const grid_t *g);
+
+/* The part [clo, chi) of the sample box [lo, hi) the grid can hold; false when empty. */
+bool grid_clip(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
+               int32_t chi[3]);
+
+/* True when sample (x,y,z) can hold a value (inside the grid). */
+bool grid_holds(const grid_t *g, int32_t x, int32_t y, int32_t z);
+
+/* Channel ch of sample (x,y,z); 0 where the grid holds nothing. */
+float grid_get(const grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z);
+
+/* Stores v in channel ch of sample (x,y,z). ARGIL_ERR_ARG where the grid cannot hold it. */
+argil_err_t grid_set(grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z, float v);
+
+/* Copies channel ch over the box [lo, lo+n) into out (x fastest); outside reads 0. */
+void grid_read_box(const grid_t *g, grid_ch_t ch, const int32_t lo[3], const int32_t n[3],
+                   float *out);
+
+/* Stores the box [lo, lo+n) of channel ch from in (x fastest); samples the grid cannot hold are
+ * skipped. ARGIL_ERR_NOMEM when storage could not be made. */
+argil_err_t grid_write_box(grid_t *g, grid_ch_t ch, const int32_t lo[3], const int32_t n[3],
+                           const float *in);
+
+/* Painted channel ch of sample (x,y,z) (the default where unpainted or not held). */
+float grid_mat_get(const grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t z);
+
+/* Stores v in painted channel ch at (x,y,z) (making the channel present); bumps mat_writes only
+ * when the caller does. ARGIL_ERR_ARG outside the grid or ch out of range, NOMEM. */
+argil_err_t grid_mat_set(grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t z, float v);
+
+/* Copies painted channel ch over [lo, lo+n) into out; the default where unpainted. */
+void grid_mat_read_box(const grid_t *g, grid_mat_t ch, const int32_t lo[3], const int32_t n[3],
+                       float *out);
+
+/* Stores painted channel ch over [lo, lo+n) from in (making the channel present). ARGIL_ERR_ARG
+ * for ch out of range, NOMEM. */
+argil_err_t grid_mat_write_box(grid_t *g, grid_mat_t ch, const int32_t lo[3], const int32_t n[3],
+                               const float *in);
+
+/* True when channel ch has been painted (stored) anywhere. */
+bool grid_mat_painted(const grid_t *g, grid_mat_t ch);
+
+/* A newly allocated copy of channel ch over grid_bounds' box (x fastest), its box written to
+ * lo / n; NULL when out of memory. The caller frees it. */
+float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3]);
+
+/* The same for painted channel ch (the default where unpainted). */
+float *grid_dense_copy_mat(const grid_t *g, grid_mat_t ch, int32_t lo[3], int32_t n[3]);
+
+/* Model-space position of sample lo (origin_m itself, bit for bit, when lo is 0). */
+vec3_t grid_box_origin(const grid_t *g, const int32_t lo[3]);
+
+/* Bytes the grid holds for its samples. */
+size_t grid_bytes(const grid_t *g);
 
 /* The density profile used everywhere: clamp(0.5 + 0.5*sd/band, 0, 1), sd positive inside. */
 float grid_profile(float signed_dist_m, float band_m);

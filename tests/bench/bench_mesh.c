@@ -12,6 +12,7 @@
 #include "host/mesh/mc.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 static double now_s(void)
 {
@@ -47,11 +48,11 @@ int main(void)
     size_t tris = 0;
     for (int r = 0; r < RUNS; r++) {
         double t0 = now_s();
-        mc_extract_region(g.density, NULL, g.dims, h, g.origin_m, 0.5f, NULL, NULL, &m);
+        mc_extract_region(gv_dense(&g), NULL, g.dims, h, g.origin_m, 0.5f, NULL, NULL, &m);
         t[r] = now_s() - t0;
         tris = m.n_tri;
         t0 = now_s();
-        mc_extract(g.density, g.dims, h, g.origin_m, 0.5f, &m);
+        mc_extract(gv_dense(&g), g.dims, h, g.origin_m, 0.5f, &m);
         t2[r] = now_s() - t0;
     }
     const double cells = (double)(N + 1) * (N + 1) * (N + 1);

@@ -14,6 +14,7 @@
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
+#include "tests/unit/grid_view.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -58,7 +59,7 @@ static void check_one(const uint8_t *data, size_t size)
     if (grid_init(&g, scan.dims, 0.001f, vec3(0, 0, 0)) != ARGIL_OK)
         return;
     for (size_t i = 0; i < n; i++)
-        g.density[i] = 0.5f;
+        gv_set(&g, GRID_DENSITY, i, 0.5f);
     journal_info_t grid_play;
     char err3[512] = "";
     const argil_err_t e3 = journal_replay_grid(data, size, name, &g, &grid_play, err3,
@@ -67,8 +68,8 @@ static void check_one(const uint8_t *data, size_t size)
         strcmp(err, err3) != 0)
         abort();
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        for (size_t i = 0; g.mat[ch] != NULL && i < n; i++)
-            if (!grid_mat_valid((grid_mat_t)ch, g.mat[ch][i]))
+        for (size_t i = 0; grid_mat_painted(&g, (grid_mat_t)ch) && i < n; i++)
+            if (!grid_mat_valid((grid_mat_t)ch, gv_mat(&g, ch, i)))
                 abort();
     grid_free(&g);
 }

@@ -15,6 +15,7 @@
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
@@ -51,9 +52,9 @@ static float crossing_m(const grid_t *g, int axis)
     int32_t at[3] = {c, c, c};
     for (int32_t i = c; i + 1 < N; i++) {
         at[axis] = i;
-        const float a = g->density[gidx(g, at[0], at[1], at[2])];
+        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         at[axis] = i + 1;
-        const float b = g->density[gidx(g, at[0], at[1], at[2])];
+        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         if (a >= 0.5f && b < 0.5f) {
             const float pos = (float)i + (a - 0.5f) / (a - b);
             return (pos - 0.5f * (float)(N - 1)) * H;
@@ -69,19 +70,19 @@ static void test_seed_makes_the_grid_the_models_view(void **st)
     const size_t n = (size_t)N * N * N;
     float *orig = malloc(n * sizeof(float));
     assert_non_null(orig);
-    memcpy(orig, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, orig);
     const float x0 = crossing_m(g, 0);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     float ramp_err = 0.0f, any_err = 0.0f;
     for (size_t i = 0; i < n; i++) {
-        const float e = fabsf(g->density[i] - orig[i]);
+        const float e = fabsf(gv_get(g, GRID_DENSITY, i) - orig[i]);
         if (orig[i] > 0.15f && orig[i] < 0.85f && e > ramp_err)
             ramp_err = e;
         if (e > any_err)
             any_err = e;
-        assert_true(g->density[i] >= 0.0f && g->density[i] <= 1.0f);
-        assert_true(g->rest[i] == g->density[i]);
+        assert_true(gv_get(g, GRID_DENSITY, i) >= 0.0f && gv_get(g, GRID_DENSITY, i) <= 1.0f);
+        assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
     }
     print_message("# seed: ramp error %.2e, largest %.2e; +x surface %.4f mm (grid %.4f mm)\n",
                   (double)ramp_err, (double)any_err, (double)crossing_m(g, 0) * 1e3,
@@ -106,7 +107,7 @@ static void test_field_at_rest_stays_put(void **st)
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const int32_t lo[3] = {10, 28, 10}, hi[3] = {34, 48, 34};
     for (int k = 0; k < 30; k++) {
         int32_t dlo[3], dhi[3];
@@ -117,7 +118,7 @@ static void test_field_at_rest_stays_put(void **st)
         assert_true(change == 0.0f);
         assert_int_equal(dhi[0] - dlo[0], 0);
     }
-    assert_memory_equal(before, g->density, n * sizeof(float));
+    assert_true(gv_equal(g, GRID_DENSITY, before));
     assert_int_equal(gs.stats.windows_opened, 1);
     assert_int_equal(gs.stats.steps, 1);       /* then at rest: not stepped */
     assert_int_equal(gs.stats.rest_skips, 29);
@@ -139,11 +140,11 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     /* the surface sample on +y nearest density 0.5 */
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
         sy++;
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     for (int k = 0; k < 30; k++) {
@@ -171,18 +172,17 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
                     assert_true(dlo[a] <= lo[a] && dhi[a] >= (hi[a] < N ? hi[a] : N));
             }
         } else {
-            spring_field_t f = grid_springs(g);
-            springs_step(&f, &g->material, lo, hi, DT);
+            grid_springs_step(g, lo, hi, DT);
         }
     }
     double sum = 0.0;
     for (size_t i = 0; i < n; i++)
-        sum += (double)g->density[i] - before[i];
+        sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
     const size_t at = gidx(g, c, sy, c);
-    *at_moved = g->density[at] - before[at];
+    *at_moved = gv_get(g, GRID_DENSITY, at) - before[at];
     const size_t far = gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
-    *far_moved = g->density[far] - before[far];
+    *far_moved = gv_get(g, GRID_DENSITY, far) - before[far];
     free(before);
     if (bspline)
         gsolve_free(&gs);
@@ -247,7 +247,7 @@ static void moved_window_matches_a_fresh_one(bool painted)
     assert_int_equal(a.stats.windows_opened, 1);
     assert_int_equal(a.stats.windows_moved, 3);
     assert_int_equal(b.stats.windows_opened, 4);
-    assert_memory_equal(g1->density, g2->density, sizeof(float) * N * N * N);
+    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
     assert_true(largest > 1e-3f); /* the forces did move the clay */
     gsolve_free(&a);
     gsolve_free(&b);
@@ -272,7 +272,7 @@ static void test_carve_goes_through_the_model(void **st)
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const vec3_t at = vec3(0, R, 0);
     const float radius = 5e-3f;
     int32_t lo[3], hi[3], rlo[3], rhi[3];
@@ -292,7 +292,7 @@ static void test_carve_goes_through_the_model(void **st)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
                 const size_t i = gidx(g, x, y, z);
-                if (g->density[i] != before[i])
+                if (gv_get(g, GRID_DENSITY, i) != before[i])
                     assert_true(x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] &&
                                 z >= lo[2] && z < hi[2]);
             }
@@ -363,13 +363,13 @@ static float springback_left(bool painted)
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
         sy++;
     const vec3_t at = vec3(0.5f * H, (float)(sy - c) * H + 0.5f * H, 0.5f * H);
     if (painted)
         assert_int_equal(gsolve_paint(&gs, GSOLVE_MAT_STIFFNESS, at, 8e-3f, 50.0f), ARGIL_OK);
     const size_t i = gidx(g, c, sy, c);
-    const float d0 = g->density[i];
+    const float d0 = gv_get(g, GRID_DENSITY, i);
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     float deepest = 0.0f;
     for (int k = 0; k < 60; k++) {
@@ -378,13 +378,13 @@ static float springback_left(bool painted)
         int32_t dlo[3], dhi[3];
         float change;
         assert_int_equal(gsolve_step(&gs, g, lo, hi, DT, dlo, dhi, &change), ARGIL_OK);
-        if (d0 - g->density[i] > deepest)
-            deepest = d0 - g->density[i];
+        if (d0 - gv_get(g, GRID_DENSITY, i) > deepest)
+            deepest = d0 - gv_get(g, GRID_DENSITY, i);
     }
     print_message("# elastic push: %.4f deepest, %.4f at the end\n", (double)deepest,
-                  (double)(d0 - g->density[i]));
+                  (double)(d0 - gv_get(g, GRID_DENSITY, i)));
     assert_true(deepest > 5e-3f);
-    const float left = (d0 - g->density[i]) / deepest;
+    const float left = (d0 - gv_get(g, GRID_DENSITY, i)) / deepest;
     gsolve_free(&gs);
     free_grid(g);
     return left;

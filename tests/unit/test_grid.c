@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 64
 #define H 1.25e-3f
@@ -62,13 +63,14 @@ static void test_init_defaults_and_errors(void **state)
     assert_float_equal(g.band_m, 0.008f, 1e-9f);
     assert_true(spring_material_valid(&g.material));
     for (size_t i = 0; i < 120; i++)
-        assert_true(g.density[i] == 0.0f && g.rest[i] == 0.0f && g.velocity[i] == 0.0f &&
-                    g.force[i] == 0.0f);
-    spring_field_t f = grid_springs(&g);
-    assert_int_equal(f.dims[0], 4);
-    assert_int_equal(f.dims[2], 6);
-    assert_ptr_equal(f.density, g.density);
-    assert_ptr_equal(f.force, g.force);
+        assert_true(gv_get(&g, GRID_DENSITY, i) == 0.0f && gv_get(&g, GRID_REST, i) == 0.0f &&
+                    gv_get(&g, GRID_VELOCITY, i) == 0.0f && gv_get(&g, GRID_FORCE, i) == 0.0f);
+    int32_t lo[3], hi[3];
+    grid_bounds(&g, lo, hi);
+    assert_int_equal(lo[0], 0);
+    assert_int_equal(hi[0], 4);
+    assert_int_equal(hi[2], 6);
+    assert_int_equal(grid_count(&g), 120);
     grid_free(&g);
     grid_free(&g); /* twice is harmless */
 
@@ -147,8 +149,8 @@ static void test_carve_sphere(void **state)
     float *rest_before = malloc(n * sizeof(float));
     assert_non_null(before);
     assert_non_null(rest_before);
-    memcpy(before, g->density, n * sizeof(float));
-    memcpy(rest_before, g->rest, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
+    gv_copy(g, GRID_REST, rest_before);
 
     const vec3_t c = vec3(R, 0.0f, 0.0f);
     const float rc = 0.008f;
@@ -163,15 +165,17 @@ static void test_carve_sphere(void **state)
                 const size_t i = idx(g, x, y, z);
                 const float dist = vec3_norm(vec3_sub(sample_pos(g, x, y, z), c));
                 if (dist < rc - g->band_m)
-                    assert_true(g->density[i] == 0.0f && g->rest[i] == 0.0f);
+                    assert_true(gv_get(g, GRID_DENSITY, i) == 0.0f &&
+                                gv_get(g, GRID_REST, i) == 0.0f);
                 if (dist < rc)
-                    assert_true(g->density[i] < 0.5f);
+                    assert_true(gv_get(g, GRID_DENSITY, i) < 0.5f);
                 if (dist > rc + g->band_m + H) {
-                    assert_memory_equal(&g->density[i], &before[i], sizeof(float));
-                    assert_memory_equal(&g->rest[i], &rest_before[i], sizeof(float));
+                    assert_true(gv_bits(gv_get(g, GRID_DENSITY, i), before[i]));
+                    assert_true(gv_bits(gv_get(g, GRID_REST, i), rest_before[i]));
                 }
-                assert_true(g->density[i] <= before[i]);
-                if (g->density[i] != before[i] || g->rest[i] != rest_before[i]) {
+                assert_true(gv_get(g, GRID_DENSITY, i) <= before[i]);
+                if (gv_get(g, GRID_DENSITY, i) != before[i] ||
+                    gv_get(g, GRID_REST, i) != rest_before[i]) {
                     changed++;
                     const int32_t s[3] = {x, y, z};
                     for (int a = 0; a < 3; a++) {
@@ -230,7 +234,7 @@ static void test_window_corner_and_extract(void **state)
                     assert_true(out[o] == 0.0f);
                     zeros_outside++;
                 } else {
-                    assert_memory_equal(&out[o], &g->density[idx(g, gx, gy, gz)], sizeof(float));
+                    assert_true(gv_bits(out[o], gv_get(g, GRID_DENSITY, idx(g, gx, gy, gz))));
                 }
             }
     assert_int_equal(zeros_outside, 32 * 5 * 8 - 27 * 5 * 7);
@@ -258,7 +262,7 @@ static void test_add_force(void **state)
     assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
     assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
     assert_true(grid_add_force(g, 1, 2, 3, 1.0f));
-    assert_float_equal(g->force[idx(g, 1, 2, 3)], 2.5f, 0.0f);
+    assert_float_equal(gv_get(g, GRID_FORCE, idx(g, 1, 2, 3)), 2.5f, 0.0f);
     drop_grid(g);
 }
 
@@ -269,19 +273,18 @@ static void test_springs_push_lowers_density(void **state)
     /* The sample on the +x surface of the sphere: 30 mm = 24 spacings from the centre. */
     const int32_t x = 31 + 24, y = 31, z = 31;
     const size_t i = idx(g, x, y, z);
-    const float d0 = g->density[i];
+    const float d0 = gv_get(g, GRID_DENSITY, i);
     assert_true(d0 > 0.2f && d0 < 0.8f);
-    const float far0 = g->density[idx(g, 5, 5, 5)];
+    const float far0 = gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5));
     assert_true(grid_add_force(g, x, y, z, -50.0f));
 
-    spring_field_t f = grid_springs(g);
     const int32_t lo[3] = {0, 0, 0}, hi[3] = {N, N, N};
     const float dt = springs_stable_dt_s(&g->material);
-    springs_step(&f, &g->material, lo, hi, dt);
+    grid_springs_step(g, lo, hi, dt);
     /* a = F/m = -50 /s²; after one step of ~21 ms the density falls by a*dt² ≈ 0.02. */
-    assert_true(g->density[i] < d0 - 0.01f);
-    assert_float_equal(g->force[i], 0.0f, 0.0f); /* consumed */
-    assert_float_equal(g->density[idx(g, 5, 5, 5)], far0, 0.0f);
+    assert_true(gv_get(g, GRID_DENSITY, i) < d0 - 0.01f);
+    assert_float_equal(gv_get(g, GRID_FORCE, i), 0.0f, 0.0f); /* consumed */
+    assert_float_equal(gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5)), far0, 0.0f);
     drop_grid(g);
 }
 
@@ -296,9 +299,9 @@ static void test_painted_channels(void **state)
     assert_int_equal(grid_init(&a, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
     assert_int_equal(grid_init(&b, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        assert_null(a.mat[ch]);
-    assert_float_equal(grid_mat_value(&a, GRID_MAT_STIFFNESS, 5), 1.0f, 0);
-    assert_float_equal(grid_mat_value(&a, GRID_MAT_RESTLEN, 5), 0.0f, 0);
+        assert_false(grid_mat_painted(&a, ch));
+    assert_float_equal(gv_mat(&a, GRID_MAT_STIFFNESS, 5), 1.0f, 0);
+    assert_float_equal(gv_mat(&a, GRID_MAT_RESTLEN, 5), 0.0f, 0);
     assert_true(grid_mat_valid(GRID_MAT_MASS, 1e-6f));
     assert_false(grid_mat_valid(GRID_MAT_MASS, 0.0f));
     assert_true(grid_mat_valid(GRID_MAT_STIFFNESS, 0.0f));
@@ -306,23 +309,22 @@ static void test_painted_channels(void **state)
     assert_true(grid_mat_valid(GRID_MAT_RESTLEN, -0.5f));
     assert_false(grid_mat_valid(GRID_MAT_STIFFNESS, INFINITY));
     assert_false(grid_mat_valid(GRID_MAT_N, 1.0f));
-    float *m = grid_mat_alloc(&a, GRID_MAT_MASS);
-    assert_non_null(m);
-    assert_ptr_equal(grid_mat_alloc(&a, GRID_MAT_MASS), m); /* allocated once */
-    assert_null(grid_mat_alloc(&a, GRID_MAT_N));
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, 0, 0, 0, 1.0f), ARGIL_OK);
+    assert_true(grid_mat_painted(&a, GRID_MAT_MASS));
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_N, 0, 0, 0, 1.0f), ARGIL_ERR_ARG);
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, 3, 0, 0, 1.0f), ARGIL_ERR_ARG); /* outside */
     for (int i = 0; i < 12; i++)
-        assert_float_equal(m[i], 1.0f, 0);
+        assert_float_equal(gv_mat(&a, GRID_MAT_MASS, (size_t)i), 1.0f, 0);
     assert_true(grid_mat_equal(&a, &b, GRID_MAT_MASS)); /* all default = absent */
-    m[7] = 0.5f;
+    gv_mat_set(&a, GRID_MAT_MASS, 7, 0.5f);
     assert_false(grid_mat_equal(&a, &b, GRID_MAT_MASS));
     assert_false(grid_mat_equal(&b, &a, GRID_MAT_MASS));
-    float *r = grid_mat_alloc(&b, GRID_MAT_RESTLEN);
-    r[0] = -0.0f; /* == 0, other bits */
+    gv_mat_set(&b, GRID_MAT_RESTLEN, 0, -0.0f); /* == 0, other bits */
     assert_false(grid_mat_equal(&a, &b, GRID_MAT_RESTLEN));
     grid_free(&a);
     grid_free(&b);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        assert_null(a.mat[ch]);
+        assert_false(grid_mat_painted(&a, ch));
 }
 
 int main(void)

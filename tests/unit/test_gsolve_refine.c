@@ -18,6 +18,7 @@
 #include "host/app/script.h"
 #include "host/mesh/mc.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
@@ -54,9 +55,9 @@ static float crossing_m(const grid_t *g, int axis)
     int32_t at[3] = {c, c, c};
     for (int32_t i = c; i + 1 < N; i++) {
         at[axis] = i;
-        const float a = g->density[gidx(g, at[0], at[1], at[2])];
+        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         at[axis] = i + 1;
-        const float b = g->density[gidx(g, at[0], at[1], at[2])];
+        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         if (a >= 0.5f && b < 0.5f) {
             const float pos = (float)i + (a - 0.5f) / (a - b);
             return (pos - 0.5f * (float)(N - 1)) * H;
@@ -69,8 +70,10 @@ static size_t mesh_vertices(const grid_t *g)
 {
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &m),
-                     ARGIL_OK);
+    float *d = gv_dup(g, GRID_DENSITY);
+    assert_non_null(d);
+    assert_int_equal(mc_extract(d, g->dims, g->spacing_m, g->origin_m, g->iso, &m), ARGIL_OK);
+    free(d);
     const size_t n = m.n_vert;
     mesh_free(&m);
     return n;
@@ -96,7 +99,7 @@ static void push_at(grid_t *g, int32_t x, int32_t y, int32_t z, float force_n)
 static int32_t surface_y(const grid_t *g)
 {
     int32_t sy = N / 2;
-    while (g->density[gidx(g, N / 2, sy + 1, N / 2)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, N / 2, sy + 1, N / 2)) >= 0.5f)
         sy++;
     return sy;
 }
@@ -113,19 +116,19 @@ static void test_seed_at_coarser_ratios(void **st)
         const size_t n = (size_t)N * N * N;
         float *orig = malloc(n * sizeof(float));
         assert_non_null(orig);
-        memcpy(orig, g->density, n * sizeof(float));
+        gv_copy(g, GRID_DENSITY, orig);
         const float x0 = crossing_m(g, 0);
         gsolve_t gs;
         assert_int_equal(gsolve_init_ratio(&gs, g, ratios[k]), ARGIL_OK);
         assert_int_equal(gsolve_ratio(&gs), ratios[k]);
         float ramp_err = 0.0f, any_err = 0.0f;
         for (size_t i = 0; i < n; i++) {
-            const float e = fabsf(g->density[i] - orig[i]);
+            const float e = fabsf(gv_get(g, GRID_DENSITY, i) - orig[i]);
             if (orig[i] > 0.15f && orig[i] < 0.85f && e > ramp_err)
                 ramp_err = e;
             if (e > any_err)
                 any_err = e;
-            assert_true(g->rest[i] == g->density[i]);
+            assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
         }
         const float dx = crossing_m(g, 0) - x0;
         print_message("# seed R=%d: ramp error %.2e, largest %.2e; +x surface moved %.4f mm\n",
@@ -173,7 +176,7 @@ static void refine_keeps_the_shape(int32_t r0)
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
     for (int32_t r = r0; r > 1; r /= 2) {
-        memcpy(before, g->density, n * sizeof(float));
+        gv_copy(g, GRID_DENSITY, before);
         const size_t verts = mesh_vertices(g);
         const size_t coef_blocks = gs.field.coef.count;
         float dd = -1.0f;
@@ -190,7 +193,7 @@ static void refine_keeps_the_shape(int32_t r0)
         /* nothing crossed the view's threshold: the grid, so the mesh and the board's window,
          * stayed as they were */
         assert_int_equal(hi[0] - lo[0], 0);
-        assert_memory_equal(before, g->density, n * sizeof(float));
+        assert_true(gv_equal(g, GRID_DENSITY, before));
         assert_int_equal(mesh_vertices(g), verts);
         assert_false(gs.win_open); /* reopened on the new lattice by the next step */
         push_and_flow(&gs, g, 0.0f, 1);
@@ -198,7 +201,7 @@ static void refine_keeps_the_shape(int32_t r0)
     }
     assert_int_equal(gs.stats.refines, r0 == 4 ? 2 : 1);
     /* R = 1: refused, nothing changes */
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const uint32_t gen = gs.field.lattice_gen;
     float dd = -1.0f;
     int32_t lo[3], hi[3];
@@ -206,7 +209,7 @@ static void refine_keeps_the_shape(int32_t r0)
     assert_int_equal(gsolve_ratio(&gs), 1);
     assert_int_equal(gs.field.lattice_gen, gen);
     assert_true(dd == 0.0f);
-    assert_memory_equal(before, g->density, n * sizeof(float));
+    assert_true(gv_equal(g, GRID_DENSITY, before));
     free(before);
     gsolve_free(&gs);
     free_grid(g);
@@ -235,14 +238,14 @@ static void dent(int32_t r0, int refines, float *sum_moved, float *at_moved)
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const int32_t c = N / 2, sy = surface_y(g);
     push_and_flow(&gs, g, -40.0f, 30);
     double sum = 0.0;
     for (size_t i = 0; i < n; i++)
-        sum += (double)g->density[i] - before[i];
+        sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
-    *at_moved = g->density[gidx(g, c, sy, c)] - before[gidx(g, c, sy, c)];
+    *at_moved = gv_get(g, GRID_DENSITY, gidx(g, c, sy, c)) - before[gidx(g, c, sy, c)];
     free(before);
     gsolve_free(&gs);
     free_grid(g);
@@ -308,7 +311,7 @@ static void test_window_shift_at_ratio_2(void **st)
     assert_int_equal(a.stats.windows_opened, 1);
     assert_int_equal(a.stats.windows_moved, 3);
     assert_int_equal(b.stats.windows_opened, 4);
-    assert_memory_equal(g1->density, g2->density, sizeof(float) * N * N * N);
+    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
     assert_true(largest > 1e-4f); /* the forces did move the clay */
     /* one sample to the side (samples 26..46 → 27..47): the same coefficients 13..23 */
     const int32_t lo[3] = {c + 3, sy - 8, c - 8}, hi[3] = {c + 24, sy + 8, c + 8};

@@ -13,9 +13,11 @@
 #include <string.h>
 
 #include "host/mesh/mc.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 static void make_grid(grid_t *g, int32_t n, float spacing_m, float radius_m)
 {
@@ -68,8 +70,8 @@ static void test_matches_whole_grid_mesher(void **state)
     mesh_t whole, blk;
     mesh_init(&whole);
     mesh_init(&blk);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, 0.5f, &whole), ARGIL_OK);
-    assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, 0.5f,
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, 0.5f, &whole), ARGIL_OK);
+    assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, 0.5f,
                                        NULL, NULL, &blk),
                      ARGIL_OK);
     assert_true(blk.n_tri > 10000);
@@ -124,7 +126,7 @@ static void test_incremental_equals_full(void **state)
     /* and the whole-grid mesher sees the same surface */
     mesh_t w;
     mesh_init(&w);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, 0.5f, &w), ARGIL_OK);
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, 0.5f, &w), ARGIL_OK);
     assert_int_equal(w.n_tri, a.n_tri);
     assert_float_equal(mesh_volume_m3(&w), mesh_volume_m3(&a), 1e-12);
     mesh_free(&w);
@@ -213,7 +215,7 @@ static void test_painted_colours(void **state)
     }
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract_region(g.density, rgb, g.dims, g.spacing_m, g.origin_m, 0.5f, NULL,
+    assert_int_equal(mc_extract_region(gv_dense(&g), rgb, g.dims, g.spacing_m, g.origin_m, 0.5f, NULL,
                                        NULL, &m),
                      ARGIL_OK);
     assert_true(m.has_rgb);
@@ -245,7 +247,7 @@ static void test_region_and_iso(void **state)
     mesh_init(&m);
     /* The x < 24 half of the sphere: closed at the cut, about half the volume. */
     const int32_t lo[3] = {0, 0, 0}, hi[3] = {24, 48, 48};
-    assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, 0.5f, lo,
+    assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, 0.5f, lo,
                                        hi, &m),
                      ARGIL_OK);
     assert_closed(&m);
@@ -258,7 +260,7 @@ static void test_region_and_iso(void **state)
     double vol[3];
     const float iso[3] = {0.25f, 0.5f, 0.75f};
     for (int k = 0; k < 3; k++) {
-        assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, iso[k],
+        assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, iso[k],
                                            NULL, NULL, &m),
                          ARGIL_OK);
         assert_closed(&m);
