@@ -48,23 +48,34 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
         hi[a] = lo[a] + n[a];
     if (!clip_to_grid(g, lo, hi, a0, a1))
         return 0.0f;
+    /* The grid's box, changed where the field moved it, stored back when anything changed. */
+    int32_t an[3];
+    for (int a = 0; a < 3; a++)
+        an[a] = a1[a] - a0[a];
+    float *cur = malloc((size_t)an[0] * (size_t)an[1] * (size_t)an[2] * sizeof(float));
+    if (cur == NULL)
+        return -1.0f;
+    grid_read_box(g, GRID_DENSITY, a0, an, cur);
     float change = 0.0f;
+    size_t k = 0;
     for (int32_t z = a0[2]; z < a1[2]; z++)
         for (int32_t y = a0[1]; y < a1[1]; y++) {
             const float *src = d + (size_t)n[0] * ((size_t)(y - lo[1]) +
                                                    (size_t)n[1] * (size_t)(z - lo[2])) -
                                lo[0];
-            for (int32_t x = a0[0]; x < a1[0]; x++) {
+            for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
                 const float v = clamp01(src[x]);
-                const float c = fabsf(v - grid_get(g, GRID_DENSITY, x, y, z));
+                const float c = fabsf(v - cur[k]);
                 if (c > GSOLVE_VIEW_EPS) {
                     if (c > change)
                         change = c;
-                    if (grid_set(g, GRID_DENSITY, x, y, z, v) != ARGIL_OK)
-                        return -1.0f;
+                    cur[k] = v;
                 }
             }
         }
+    if (change > 0.0f && grid_write_box(g, GRID_DENSITY, a0, an, cur) != ARGIL_OK)
+        change = -1.0f;
+    free(cur);
     return change;
 }
 
@@ -737,20 +748,20 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     bool forced = false;
     int32_t a0[3], a1[3];
     if (clip_to_grid(g, w->slo, w->shi, a0, a1)) {
-        const int32_t nx = w->shi[0] - w->slo[0], ny = w->shi[1] - w->slo[1];
-        for (int32_t z = a0[2]; z < a1[2]; z++)
-            for (int32_t y = a0[1]; y < a1[1]; y++)
-                for (int32_t x = a0[0]; x < a1[0]; x++) {
-                    const size_t si = (size_t)(x - w->slo[0]) +
-                                      (size_t)nx * ((size_t)(y - w->slo[1]) +
-                                                    (size_t)ny * (size_t)(z - w->slo[2]));
-                    const float fo = grid_get(g, GRID_FORCE, x, y, z);
-                    s->force_n[si] = fo;
-                    if (fo != 0.0f) {
-                        forced = true;
-                        (void)grid_set(g, GRID_FORCE, x, y, z, 0.0f);
-                    }
-                }
+        /* The grid holds every index the window can have: its box is the window's. */
+        const int32_t ns[3] = {w->shi[0] - w->slo[0], w->shi[1] - w->slo[1],
+                               w->shi[2] - w->slo[2]};
+        grid_read_box(g, GRID_FORCE, w->slo, ns, s->force_n);
+        for (size_t i = 0; i < s->nsamp && !forced; i++)
+            forced = s->force_n[i] != 0.0f;
+        if (forced) {
+            float *zero = calloc(s->nsamp, sizeof(float));
+            if (zero == NULL || grid_write_box(g, GRID_FORCE, w->slo, ns, zero) != ARGIL_OK) {
+                free(zero);
+                return ARGIL_ERR_NOMEM;
+            }
+            free(zero);
+        }
     }
     /* At rest and left alone: nothing to step (and no round-off to integrate); the window is
      * not stepped again until a force, a tool, the material or a new window moves it. */

@@ -149,13 +149,13 @@ static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], si
 
 /* ---- the model as a journal holds it ---- */
 
-/* True when g can be journalled by j: the box [0, j->dims) holds all of g's samples. */
+/* True when g can be journalled by j: its bounds are the journal's box [lo, lo + dims). */
 static bool journal_fits(const journal_t *j, const grid_t *g)
 {
     int32_t lo[3], hi[3];
     grid_bounds(g, lo, hi);
     for (int a = 0; a < 3; a++)
-        if (lo[a] != 0 || hi[a] != j->dims[a])
+        if (lo[a] != j->lo[a] || hi[a] != j->lo[a] + j->dims[a])
             return false;
     return true;
 }
@@ -170,11 +170,11 @@ static void dense_all_free(float **dens, float *mat[GRID_MAT_N])
     }
 }
 
-/* Dense copies over [0, dims) of g's densities and of each painted channel (NULL = unpainted). */
-static argil_err_t grid_dense_all(const grid_t *g, const int32_t dims[3], float **dens,
-                                  float *mat[GRID_MAT_N])
+/* Dense copies over [zero, zero + dims) of g's densities and of each painted channel (NULL =
+ * unpainted). */
+static argil_err_t grid_dense_all(const grid_t *g, const int32_t zero[3], const int32_t dims[3],
+                                  float **dens, float *mat[GRID_MAT_N])
 {
-    const int32_t zero[3] = {0, 0, 0};
     const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
     *dens = malloc(n * sizeof(float));
     if (*dens == NULL)
@@ -248,7 +248,7 @@ argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t ed
     argil_doc_t doc;
     argil_doc_init(&doc);
     float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
-    argil_err_t e = g != NULL ? grid_dense_all(g, j->dims, &dens, mat) : ARGIL_OK;
+    argil_err_t e = g != NULL ? grid_dense_all(g, j->lo, j->dims, &dens, mat) : ARGIL_OK;
     if (e == ARGIL_OK)
         e = g != NULL ? journal_model_doc(&info, dens, mat, &doc)
                       : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
@@ -362,10 +362,12 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
     j->cfg = *cfg;
     int32_t glo[3], ghi[3];
     grid_bounds(g, glo, ghi);
-    for (int a = 0; a < 3; a++)
+    for (int a = 0; a < 3; a++) {
+        j->lo[a] = glo[a];
         j->dims[a] = ghi[a] - glo[a];
+    }
     j->spacing_m = g->spacing_m;
-    j->origin_m = g->origin_m;
+    j->origin_m = grid_box_origin(g, glo);
     j->iso = g->iso;
     j->band_m = g->band_m;
     j->material = g->material;
@@ -378,8 +380,7 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
         journal_close(j);
         return ARGIL_ERR_NOMEM;
     }
-    const int32_t zero[3] = {0, 0, 0};
-    grid_read_box(g, GRID_DENSITY, zero, j->dims, j->shadow);
+    grid_read_box(g, GRID_DENSITY, j->lo, j->dims, j->shadow);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
         if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
@@ -389,7 +390,7 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
             journal_close(j);
             return ARGIL_ERR_NOMEM;
         }
-        grid_mat_read_box(g, (grid_mat_t)ch, zero, j->dims, j->mat_shadow[ch]);
+        grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->mat_shadow[ch]);
     }
     j->mat_writes = g->mat_writes;
     if (journal_exists(dir)) {
@@ -524,6 +525,77 @@ static bool put_mat_block(journal_t *j, grid_mat_t ch, const float *gm, uint32_t
     return true;
 }
 
+/* Fetches into cur the grid's current values of the samples [from, to) (journal indices) that
+ * lie outside the box [lo, hi) read for a record (a run bridges them). */
+static void bridge_outside(journal_t *j, const grid_t *g, const int32_t lo[3], const int32_t hi[3],
+                           size_t from, size_t to)
+{
+    const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
+    for (size_t i = from; i < to; i++) {
+        const int32_t s[3] = {(int32_t)(i % nx), (int32_t)(i / nx % ny), (int32_t)(i / (nx * ny))};
+        bool in = true;
+        for (int a = 0; a < 3; a++)
+            in = in && s[a] >= lo[a] && s[a] < hi[a];
+        if (!in)
+            j->cur[i] =
+                grid_get(g, GRID_DENSITY, j->lo[0] + s[0], j->lo[1] + s[1], j->lo[2] + s[2]);
+    }
+}
+
+/* The clay grew past the journal's box: everything buffered is written, the shadows take the
+ * whole grid over its new bounds and a checkpoint makes that the new base (header and base file
+ * with the new box). */
+static argil_err_t journal_rebase(journal_t *j, const grid_t *g, uint32_t edits, double sim_s,
+                                  char *err, size_t err_len)
+{
+    argil_err_t e = journal_sync(j, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    int32_t glo[3], ghi[3], dims[3];
+    grid_bounds(g, glo, ghi);
+    for (int a = 0; a < 3; a++)
+        dims[a] = ghi[a] - glo[a];
+    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    float *sh = malloc(n * sizeof(float)), *cur = malloc(n * sizeof(float));
+    float *msh[GRID_MAT_N] = {NULL};
+    bool ok = sh != NULL && cur != NULL;
+    for (int ch = 0; ok && ch < GRID_MAT_N; ch++)
+        if (grid_mat_painted(g, (grid_mat_t)ch)) {
+            msh[ch] = malloc(n * sizeof(float));
+            ok = msh[ch] != NULL;
+        }
+    if (!ok) {
+        free(sh);
+        free(cur);
+        for (int ch = 0; ch < GRID_MAT_N; ch++)
+            free(msh[ch]);
+        io_err(err, err_len, "%s: out of memory for the journal of the grown clay", j->dir);
+        return ARGIL_ERR_NOMEM;
+    }
+    grid_read_box(g, GRID_DENSITY, glo, dims, sh);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        if (msh[ch] != NULL)
+            grid_mat_read_box(g, (grid_mat_t)ch, glo, dims, msh[ch]);
+        free(j->mat_shadow[ch]);
+        j->mat_shadow[ch] = msh[ch];
+    }
+    free(j->shadow);
+    free(j->cur);
+    j->shadow = sh;
+    j->cur = cur;
+    for (int a = 0; a < 3; a++) {
+        j->lo[a] = glo[a];
+        j->dims[a] = dims[a];
+    }
+    j->n = n;
+    j->origin_m = grid_box_origin(g, glo);
+    j->material = g->material;
+    j->mat_writes = g->mat_writes;
+    j->edits = edits;
+    j->stats.rebases++;
+    return journal_checkpoint(j, sim_s, err, err_len);
+}
+
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len)
@@ -534,30 +606,42 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         return ARGIL_ERR_STATE;
     }
     if (!journal_fits(j, g)) {
-        io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
-        return ARGIL_ERR_ARG;
+        if (g->spacing_m != j->spacing_m) {
+            io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
+            return ARGIL_ERR_ARG;
+        }
+        const argil_err_t re = journal_rebase(j, g, edits, sim_s, err, err_len);
+        *appended = re == ARGIL_OK;
+        return re;
     }
     const bool material_changed = !same_bits(&g->material, &j->material, sizeof(j->material));
     /* The box to compare, clipped to the grid. */
     int32_t lo[3] = {0, 0, 0}, hi[3] = {j->dims[0], j->dims[1], j->dims[2]};
     if (box != NULL) {
-        for (int a = 0; a < 3; a++) {
-            lo[a] = box->lo[a] < 0 ? 0 : (box->lo[a] > j->dims[a] ? j->dims[a] : box->lo[a]);
-            hi[a] = box->hi[a] < lo[a] ? lo[a] : (box->hi[a] > j->dims[a] ? j->dims[a] : box->hi[a]);
+        for (int a = 0; a < 3; a++) { /* into the journal's own indices */
+            const int64_t bl = (int64_t)box->lo[a] - j->lo[a], bh = (int64_t)box->hi[a] - j->lo[a];
+            lo[a] = bl < 0 ? 0 : (bl > j->dims[a] ? j->dims[a] : (int32_t)bl);
+            hi[a] = bh < lo[a] ? lo[a] : (bh > j->dims[a] ? j->dims[a] : (int32_t)bh);
         }
     }
     const size_t x0 = (size_t)lo[0], x1 = (size_t)hi[0];
-    /* The grid's densities on the box's whole rows: a run bridges at most JOURNAL_RUN_GAP
-     * samples, so beyond a changed sample it reaches only into the next row of the box (or, for
-     * rows this short, the next plane: then whole planes). */
+    /* The grid's densities in the box, read in one go and laid into cur row by row (the
+     * samples a run bridges outside the box are fetched when bridged: bridge_outside). */
     if (x1 > x0 && hi[1] > lo[1] && hi[2] > lo[2]) {
-        const bool planes = j->dims[0] <= (int32_t)JOURNAL_RUN_GAP;
-        const int32_t y0 = planes ? 0 : lo[1], ny = planes ? j->dims[1] : hi[1] - lo[1];
-        for (int32_t z = lo[2]; z < hi[2]; z++) {
-            const int32_t slo[3] = {0, y0, z}, sn[3] = {j->dims[0], ny, 1};
-            const size_t at = (size_t)j->dims[0] * ((size_t)y0 + (size_t)j->dims[1] * (size_t)z);
-            grid_read_box(g, GRID_DENSITY, slo, sn, j->cur + at);
+        const int32_t blo[3] = {j->lo[0] + lo[0], j->lo[1] + lo[1], j->lo[2] + lo[2]};
+        const int32_t bn[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+        float *box_d = malloc((size_t)bn[0] * (size_t)bn[1] * (size_t)bn[2] * sizeof(float));
+        if (box_d == NULL) {
+            io_err(err, err_len, "%s: out of memory for journal records", j->dir);
+            return ARGIL_ERR_NOMEM; /* nothing written yet: the journal goes on */
         }
+        grid_read_box(g, GRID_DENSITY, blo, bn, box_d);
+        const float *src = box_d;
+        for (int32_t z = lo[2]; z < hi[2]; z++)
+            for (int32_t y = lo[1]; y < hi[1]; y++, src += bn[0])
+                memcpy(j->cur + (size_t)j->dims[0] * ((size_t)y + (size_t)j->dims[1] * (size_t)z) + x0,
+                       src, (size_t)bn[0] * sizeof(float));
+        free(box_d);
     }
     const float *gd = j->cur;
     const size_t rec_at = j->buf_len;
@@ -578,7 +662,9 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
                     continue;
                 const size_t i = r0 + x;
                 if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
-                    run_end = i + 1; /* bridged samples are written with their current values */
+                    /* bridged samples are written with their current values */
+                    bridge_outside(j, g, lo, hi, run_end, i);
+                    run_end = i + 1;
                     continue;
                 }
                 if (open_run) {
@@ -604,11 +690,10 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         if (!reserve(j, 4))
             goto nomem;
         j->buf_len += 4;
-        const int32_t zero[3] = {0, 0, 0};
         for (int ch = 0; ch < GRID_MAT_N; ch++) {
             const bool painted = grid_mat_painted(g, (grid_mat_t)ch);
             if (painted) /* the density runs are written: cur is free again */
-                grid_mat_read_box(g, (grid_mat_t)ch, zero, j->dims, j->cur);
+                grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->cur);
             if (!put_mat_block(j, (grid_mat_t)ch, painted ? j->cur : NULL, &blocks))
                 goto nomem;
         }
@@ -1126,7 +1211,7 @@ argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *nam
         dims[a] = hi[a] - lo[a];
     const size_t n = grid_count(g);
     float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
-    argil_err_t e = grid_dense_all(g, dims, &dens, mat);
+    argil_err_t e = grid_dense_all(g, lo, dims, &dens, mat);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", name);
         return e;
@@ -1213,7 +1298,7 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     const size_t bn = grid_count(g);
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    e = grid_dense_all(g, gdims, &dens, mat);
+    e = grid_dense_all(g, glo, gdims, &dens, mat);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", base_path);
         goto out;

@@ -35,6 +35,7 @@ typedef struct {
     uint64_t bytes;           /* record bytes appended */
     uint32_t syncs;           /* write + fdatasync rounds */
     uint32_t checkpoints;     /* rotations onto a new base */
+    uint32_t rebases;         /* of them, because the clay grew past the journal's box */
     uint64_t samples;         /* sample values journaled */
     uint64_t mat_samples;     /* painted material values journaled */
 } journal_stats_t;
@@ -45,8 +46,9 @@ typedef struct {
     char *dir;
     int fd;
     int32_t dims[3];
+    int32_t lo[3];            /* grid sample index of the journal's sample 0 (its box's corner) */
     float spacing_m, iso, band_m;
-    vec3_t origin_m;
+    vec3_t origin_m;          /* model-space position of sample lo */
     size_t n;                 /* samples */
     float *shadow;            /* density as of the last record */
     float *cur;               /* scratch: the grid's samples read for a record (n floats) */
@@ -105,7 +107,9 @@ typedef struct {
  * last record (buffered; *appended says whether one was made). Only densities inside box are
  * compared when box is not NULL: the caller promises nothing changed outside it; the painted
  * channels are compared whole when box is NULL or the grid's mat_writes moved. edits counts the
- * session's edit steps. */
+ * session's edit steps. When the grid's bounds have grown past the journal's box (the clay grew)
+ * the journal rotates onto a new base snapshot of the whole grid over its new bounds (a
+ * checkpoint) instead, and *appended is true. */
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len);

@@ -1,5 +1,8 @@
-/* The host's dense density grid: the sampled field the tools edit, the springs move, the
- * mesher reads and the board's local window is cut from (sparse blocks come later). */
+/* The host's density grid: the sampled field the tools edit, the springs move, the mesher reads
+ * and the board's local window is cut from. Sparse (Ferley et al. §3.1): samples live in
+ * GRID_B³ blocks held in a hash by block index of any sign, so the clay can grow in every
+ * direction; a block wholly at rest at one density (empty space, solid interior) holds no
+ * sample memory, and a block never written holds nothing at all. */
 #ifndef ARGIL_GRID_H
 #define ARGIL_GRID_H
 
@@ -11,8 +14,12 @@
 #include "shared/density_springs.h"
 #include "shared/vec3.h"
 
-/* Largest number of samples a grid may hold (indices stay within int32). */
+/* Largest number of samples a grid may be created with (its nominal dims box). */
 #define GRID_SAMPLES_MAX ((int64_t)1 << 30)
+
+#define GRID_B 8                              /* samples per block edge */
+#define GRID_BN (GRID_B * GRID_B * GRID_B)
+#define GRID_INDEX_MAX ((int32_t)1 << 30)     /* samples live at indices in [-max, max) */
 
 /* Painted material channels (Hua & Qin §6.3), the sampled view of the B-spline model's
  * FS_STIFF, FS_MASS, FS_DAMP and FS_RESTLEN: scales of the base material (1 = unpainted) and
@@ -26,16 +33,27 @@ typedef enum {
     GRID_MAT_N = 4
 } grid_mat_t;
 
+/* One block of the hash (internal to grid.c). */
 typedef struct {
-    int32_t dims[3];            /* samples per axis; index = x + dims0*(y + dims1*z) */
+    int32_t key[3];             /* block index: sample index / GRID_B, rounded down */
+    bool used;                  /* slot taken */
+    float uniform;              /* data NULL: density = rest = uniform, velocity = force = 0 */
+    float *data;                /* GRID_CH_N * GRID_BN floats, channel-major, x fastest */
+    float *mat;                 /* GRID_MAT_N * GRID_BN floats; NULL = every channel default */
+} grid_block_t;
+
+typedef struct {
+    int32_t dims[3];            /* the nominal box [0, dims) it was made with (always held) */
     float spacing_m;            /* distance between neighbouring samples */
     vec3_t origin_m;            /* model-space position of sample (0,0,0) */
     float iso;                  /* surface level, 0.5 */
     float band_m;               /* half-width of the density ramp across the surface */
     spring_material_t material;
-    float *density, *rest, *velocity, *force;
-    float *mat[GRID_MAT_N];     /* painted channels, one value per sample; NULL until first
-                                 * painted (every sample then holds grid_mat_default) */
+    grid_block_t *slots;        /* open-addressing hash of blocks; NULL = not initialised */
+    size_t cap, count;          /* slots, slots used */
+    size_t data_blocks, mat_blocks; /* blocks holding sample / painted arrays */
+    int32_t blo[3], bhi[3];     /* sample box of the blocks that hold anything (lo > hi: none) */
+    bool painted[GRID_MAT_N];   /* channel written since init (absent: default everywhere) */
     uint32_t mat_writes;        /* +1 whenever a mat channel changes (the journal then looks) */
 } grid_t;
 
@@ -84,7 +102,7 @@ size_t grid_count(const grid_t *g);
 bool grid_clip(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
                int32_t chi[3]);
 
-/* True when sample (x,y,z) can hold a value (inside the grid). */
+/* True when sample (x,y,z) can hold a value (every index in [-GRID_INDEX_MAX, GRID_INDEX_MAX)). */
 bool grid_holds(const grid_t *g, int32_t x, int32_t y, int32_t z);
 
 /* Channel ch of sample (x,y,z); 0 where the grid holds nothing. */
@@ -131,8 +149,12 @@ float *grid_dense_copy_mat(const grid_t *g, grid_mat_t ch, int32_t lo[3], int32_
 /* Model-space position of sample lo (origin_m itself, bit for bit, when lo is 0). */
 vec3_t grid_box_origin(const grid_t *g, const int32_t lo[3]);
 
-/* Bytes the grid holds for its samples. */
+/* Bytes the grid holds: block arrays and the hash table. */
 size_t grid_bytes(const grid_t *g);
+
+/* Frees the arrays of blocks that became uniform (one density and rest, no velocity, force or
+ * paint) and shrinks the bounds to what still holds anything. */
+void grid_compact(grid_t *g);
 
 /* The density profile used everywhere: clamp(0.5 + 0.5*sd/band, 0, 1), sd positive inside. */
 float grid_profile(float signed_dist_m, float band_m);

@@ -10,6 +10,7 @@
 #include "host/fit/octree_fit.h"
 #include "host/fit/rbf.h"
 #include "host/mesh/mc.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
@@ -61,8 +62,9 @@ int main(void)
            "whole-grid slab mesher %.3f s; goal <= 0.15 s\n", tb, cells / tb / 1e6, tris, ts);
 
     mc_blocks_t b;
-    mc_blocks_init(&b, g.dims, h, g.origin_m, 0.5f);
-    mc_blocks_update(&b, g.density, NULL);
+    grid_mesh_view_t view;
+    grid_mesh_blocks_init(&b, &view, &g, 0.5f);
+    mc_blocks_update_read(&b, grid_mesh_read, &view);
     double inc[21];
     size_t blocks = 0;
     for (int r = 0; r < 21; r++) {
@@ -71,8 +73,8 @@ int main(void)
         const float a = 0.3f * (float)r;
         grid_carve_sphere(&g, vec3(0.1f * cosf(a), 0.1f * sinf(a), 0.0f), 0.0195f, lo, hi);
         const double t0 = now_s();
-        mc_blocks_mark(&b, lo, hi);
-        mc_blocks_update(&b, g.density, NULL);
+        grid_mesh_mark(&b, &view, lo, hi);
+        mc_blocks_update_read(&b, grid_mesh_read, &view);
         inc[r] = now_s() - t0;
         blocks = b.blocks_meshed;
     }

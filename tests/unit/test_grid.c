@@ -255,9 +255,11 @@ static void test_add_force(void **state)
 {
     (void)state;
     grid_t *g = sphere_grid();
-    assert_false(grid_add_force(g, -1, 0, 0, 1.0f));
-    assert_false(grid_add_force(g, 0, N, 0, 1.0f));
-    assert_false(grid_add_force(g, 0, 0, N + 5, 1.0f));
+    /* Beyond the nominal box the sparse grid still holds samples; only the index limit refuses. */
+    assert_true(grid_add_force(g, -1, 0, 0, 1.0f));
+    assert_float_equal(grid_get(g, GRID_FORCE, -1, 0, 0), 1.0f, 0.0f);
+    assert_false(grid_add_force(g, -GRID_INDEX_MAX - 1, 0, 0, 1.0f));
+    assert_false(grid_add_force(g, 0, GRID_INDEX_MAX, 0, 1.0f));
     assert_false(grid_add_force(g, 1, 1, 1, NAN));
     assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
     assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
@@ -312,7 +314,7 @@ static void test_painted_channels(void **state)
     assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, 0, 0, 0, 1.0f), ARGIL_OK);
     assert_true(grid_mat_painted(&a, GRID_MAT_MASS));
     assert_int_equal(grid_mat_set(&a, GRID_MAT_N, 0, 0, 0, 1.0f), ARGIL_ERR_ARG);
-    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, 3, 0, 0, 1.0f), ARGIL_ERR_ARG); /* outside */
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, GRID_INDEX_MAX, 0, 0, 1.0f), ARGIL_ERR_ARG);
     for (int i = 0; i < 12; i++)
         assert_float_equal(gv_mat(&a, GRID_MAT_MASS, (size_t)i), 1.0f, 0);
     assert_true(grid_mat_equal(&a, &b, GRID_MAT_MASS)); /* all default = absent */
@@ -327,6 +329,76 @@ static void test_painted_channels(void **state)
         assert_false(grid_mat_painted(&a, ch));
 }
 
+/* Sparse storage: blocks wholly outside (0) or inside (1) the sphere hold no sample arrays, so
+ * memory follows the surface: a sphere of twice the radius takes ~4x, not 8x (a dense grid:
+ * 16 bytes per sample of the box whatever the clay). */
+static size_t sphere_bytes(int32_t n, float radius_m)
+{
+    grid_t g;
+    const int32_t dims[3] = {n, n, n};
+    const float o = -0.5f * (float)(n - 1) * H;
+    assert_int_equal(grid_init(&g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(&g, vec3(0, 0, 0), radius_m);
+    const size_t bytes = grid_bytes(&g);
+    /* Every block holding arrays lies on the surface's band. */
+    assert_true(g.data_blocks > 0);
+    grid_free(&g);
+    return bytes;
+}
+
+static void test_memory_follows_the_surface(void **state)
+{
+    (void)state;
+    const size_t small = sphere_bytes(64, 0.025f), big = sphere_bytes(128, 0.050f);
+    const double dense_small = 64.0 * 64 * 64 * 4 * sizeof(float);
+    print_message("# sphere r 25 mm in 64^3: %zu bytes (dense %.0f); r 50 mm in 128^3: %zu bytes "
+                  "(dense %.0f), ratio %.2f\n", small, dense_small, big, 8.0 * dense_small,
+                  (double)big / (double)small);
+    assert_true((double)small < 0.5 * dense_small);
+    const double ratio = (double)big / (double)small;
+    assert_true(ratio > 3.0 && ratio < 5.0); /* the surface's 4x, not the volume's 8x */
+}
+
+/* The clay can be written anywhere (negative indices too); bounds grow to hold it, reading
+ * beyond them is empty clay, compaction gives back blocks that came to rest uniform. */
+static void test_grows_in_every_direction(void **state)
+{
+    (void)state;
+    grid_t g;
+    const int32_t dims[3] = {16, 16, 16};
+    assert_int_equal(grid_init(&g, dims, H, vec3(0, 0, 0)), ARGIL_OK);
+    int32_t lo[3], hi[3];
+    grid_bounds(&g, lo, hi);
+    assert_true(lo[0] == 0 && hi[0] == 16 && grid_bytes(&g) < 4096); /* no sample arrays */
+    assert_int_equal(grid_set(&g, GRID_DENSITY, -20, 3, 40, 0.75f), ARGIL_OK);
+    grid_bounds(&g, lo, hi);
+    assert_int_equal(lo[0], -20);
+    assert_int_equal(hi[2], 41);
+    assert_int_equal(lo[1], 0);
+    assert_float_equal(grid_get(&g, GRID_DENSITY, -20, 3, 40), 0.75f, 0.0f);
+    assert_float_equal(grid_density_at(&g, vec3(-20 * H, 3 * H, 40 * H)), 0.75f, 1e-5f);
+    /* A box across old and new ground reads back what was written, 0 elsewhere. */
+    float box[27];
+    const int32_t b0[3] = {-21, 2, 39}, bn[3] = {3, 3, 3};
+    grid_read_box(&g, GRID_DENSITY, b0, bn, box);
+    for (int i = 0; i < 27; i++)
+        assert_float_equal(box[i], i == 13 ? 0.75f : 0.0f, 0.0f);
+    assert_int_equal(g.data_blocks, 1);
+    /* Writing empty clay over empty space allocates nothing. */
+    for (int i = 0; i < 27; i++)
+        box[i] = 0.0f;
+    const int32_t far[3] = {100, 100, 100};
+    assert_int_equal(grid_write_box(&g, GRID_DENSITY, far, bn, box), ARGIL_OK);
+    assert_int_equal(g.data_blocks, 1);
+    /* Back to empty: compaction frees the block and the bounds shrink to the nominal box. */
+    assert_int_equal(grid_set(&g, GRID_DENSITY, -20, 3, 40, 0.0f), ARGIL_OK);
+    grid_compact(&g);
+    assert_int_equal(g.data_blocks, 0);
+    grid_bounds(&g, lo, hi);
+    assert_true(lo[0] == 0 && hi[0] == 16 && lo[2] == 0 && hi[2] == 16);
+    grid_free(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -338,6 +410,8 @@ int main(void)
         cmocka_unit_test(test_add_force),
         cmocka_unit_test(test_springs_push_lowers_density),
         cmocka_unit_test(test_painted_channels),
+        cmocka_unit_test(test_memory_follows_the_surface),
+        cmocka_unit_test(test_grows_in_every_direction),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

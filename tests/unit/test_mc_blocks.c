@@ -96,8 +96,9 @@ static void test_incremental_equals_full(void **state)
     grid_t g;
     make_grid(&g, 96, 1e-3f, 0.035f);
     mc_blocks_t inc;
-    assert_int_equal(mc_blocks_init(&inc, g.dims, g.spacing_m, g.origin_m, 0.5f), ARGIL_OK);
-    assert_int_equal(mc_blocks_update(&inc, g.density, NULL), ARGIL_OK);
+    grid_mesh_view_t view;
+    assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
     const size_t all_blocks = inc.blocks_meshed;
     assert_int_equal(all_blocks, inc.n_blocks);
     mesh_t a, b;
@@ -110,8 +111,8 @@ static void test_incremental_equals_full(void **state)
         grid_carve_sphere(&g, vec3(0.035f * cosf(ang), 0.035f * sinf(ang), 0.01f * (float)(k - 2)),
                           0.008f, lo, hi);
         assert_true(hi[0] > lo[0]);
-        mc_blocks_mark(&inc, lo, hi);
-        assert_int_equal(mc_blocks_update(&inc, g.density, NULL), ARGIL_OK);
+        grid_mesh_mark(&inc, &view, lo, hi);
+        assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
         /* A 16 mm carve touches at most 3 blocks per axis (plus the normal halo: 4). */
         assert_true(inc.blocks_meshed <= 64);
         assert_true(inc.blocks_meshed * 8 < all_blocks);
@@ -119,7 +120,7 @@ static void test_incremental_equals_full(void **state)
     assert_int_equal(mc_blocks_assemble(&inc, &a), ARGIL_OK);
     mc_blocks_t full;
     assert_int_equal(mc_blocks_init(&full, g.dims, g.spacing_m, g.origin_m, 0.5f), ARGIL_OK);
-    assert_int_equal(mc_blocks_update(&full, g.density, NULL), ARGIL_OK);
+    assert_int_equal(mc_blocks_update(&full, gv_dense(&g), NULL), ARGIL_OK);
     assert_int_equal(mc_blocks_assemble(&full, &b), ARGIL_OK);
     assert_same_mesh(&a, &b);
     assert_closed(&a);
