@@ -27,6 +27,7 @@
 #define SESSION_CLAY_RADIUS_M 0.030f
 #define SESSION_GRID_EDGE 88
 #define SESSION_SPACING_M 0.00125f
+#define SESSION_COMPACT_SOLVES 100u /* grid_compact every this many solves (1 s) */
 #define SESSION_TAIL_S 0.3f            /* simulated time after the script, to let the clay settle */
 #define SESSION_START_Z_M 0.060f       /* the workspace centre sits 60 mm in front of the clay */
 #define COMPUTE_HIST_BINS 2001u        /* 0 … 2000 µs; the last bin holds everything slower */
@@ -69,6 +70,7 @@ typedef struct {
     journal_t journal;                 /* autosave journal (when journaling) */
     bool journaling;
     uint32_t journal_solves;           /* peer solves already looked at by the journal */
+    uint32_t compact_solves;           /* peer solves at the last grid_compact */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -317,6 +319,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         goto done;
     }
     grid_fill_sphere(&s->grid, vec3(0, 0, 0), SESSION_CLAY_RADIUS_M);
+    sum->grid_bytes_start = grid_bytes(&s->grid);
 
     peer_cfg_t pcfg;
     peer_cfg_default(&pcfg);
@@ -490,6 +493,12 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
         peer_tick(&s->peer, dt_us);
+        if (s->peer.stats.solves != s->compact_solves &&
+            s->peer.stats.solves % SESSION_COMPACT_SOLVES == 0) {
+            /* Blocks that came to rest uniform (carved empty, filled solid) give memory back. */
+            s->compact_solves = s->peer.stats.solves;
+            grid_compact(&s->grid);
+        }
         if (s->journaling) {
             bool stop_now = false;
             rc = journal_step(s, opts, (double)(tick + 1u) * dt_s, sum, &stop_now, err, err_len);
@@ -540,6 +549,10 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         rc = ARGIL_ERR_STATE;
     }
 
+    grid_compact(&s->grid);
+    sum->grid_bytes_end = grid_bytes(&s->grid);
+    grid_bounds(&s->grid, sum->grid_lo, sum->grid_hi);
+    sum->grid_dense_bytes_end = grid_count(&s->grid) * GRID_CH_N * sizeof(float);
     {
         const argil_err_t me = mesh_field(&s->grid, &mesh, &sum->volume_after_m3);
         if (me != ARGIL_OK && rc == ARGIL_OK) {

@@ -92,6 +92,10 @@ typedef struct {
     int knot_ratio_end;           /* samples per knot span at the end (0: springs solve) */
     float refine_max_dd;          /* the largest |density change| a refinement made (grid) */
     double real_seconds;          /* wall time of the lockstep loop */
+    size_t grid_bytes_start;      /* the sparse grid's memory after the sphere fill */
+    size_t grid_bytes_end;        /* ... at the end (after grid_compact) */
+    size_t grid_dense_bytes_end;  /* a dense grid of the end bounds (4 channels of floats) */
+    int32_t grid_lo[3], grid_hi[3]; /* the grid's bounds at the end (samples; nominal 0..88) */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);

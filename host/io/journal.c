@@ -149,13 +149,13 @@ static uint32_t model_crc(const float *density, float *const mat[GRID_MAT_N], si
 
 /* ---- the model as a journal holds it ---- */
 
-/* True when g can be journalled by j: its bounds are the journal's box [lo, lo + dims). */
+/* True when g can be journalled by j: its bounds lie within the journal's box [lo, lo + dims). */
 static bool journal_fits(const journal_t *j, const grid_t *g)
 {
     int32_t lo[3], hi[3];
     grid_bounds(g, lo, hi);
     for (int a = 0; a < 3; a++)
-        if (lo[a] != j->lo[a] || hi[a] != j->lo[a] + j->dims[a])
+        if (lo[a] < j->lo[a] || hi[a] > j->lo[a] + j->dims[a])
             return false;
     return true;
 }
@@ -551,10 +551,16 @@ static argil_err_t journal_rebase(journal_t *j, const grid_t *g, uint32_t edits,
     argil_err_t e = journal_sync(j, err, err_len);
     if (e != ARGIL_OK)
         return e;
+    /* The new box: the old one and the bounds, with room to grow on every side that grew (so a
+     * growing stroke rebases every JOURNAL_GROW_SAMPLES, not every sample). */
     int32_t glo[3], ghi[3], dims[3];
     grid_bounds(g, glo, ghi);
-    for (int a = 0; a < 3; a++)
+    for (int a = 0; a < 3; a++) {
+        const int32_t olo = j->lo[a], ohi = j->lo[a] + j->dims[a];
+        glo[a] = glo[a] < olo ? glo[a] - JOURNAL_GROW_SAMPLES : olo;
+        ghi[a] = ghi[a] > ohi ? ghi[a] + JOURNAL_GROW_SAMPLES : ohi;
         dims[a] = ghi[a] - glo[a];
+    }
     const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
     float *sh = malloc(n * sizeof(float)), *cur = malloc(n * sizeof(float));
     float *msh[GRID_MAT_N] = {NULL};

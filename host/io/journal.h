@@ -22,6 +22,7 @@
 #define JOURNAL_BASE_NAME_MAX 60u          /* bytes for the base file's name in the header */
 #define JOURNAL_FILE "journal.log"         /* inside the session's output directory */
 #define JOURNAL_BASE_PREFIX "journal-base-" /* + checkpoint number + ".argil" */
+#define JOURNAL_GROW_SAMPLES 16   /* room added on a side the clay grew past (journal_rebase) */
 #define JOURNAL_RUN_GAP 2u                 /* unchanged samples bridged inside one run */
 
 typedef struct {

@@ -716,6 +716,61 @@ static void test_painted_material(void **state)
     sess_free(s);
 }
 
+/* The clay grows past the journal's box (the sparse grid holds any index): the journal rebases
+ * onto a new checkpoint over a box that holds it, and recovery rebuilds the grown model bit for
+ * bit, in the new box's indices. */
+static void test_growth_rebases(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    grid_t *g = &s->grid;
+    char err[512] = "";
+    bool appended = false;
+    assert_int_equal(grid_set(g, GRID_DENSITY, EDGE_X + 5, 2, 3, 0.625f), ARGIL_OK);
+    assert_int_equal(grid_set(g, GRID_DENSITY, 1, -3, 2, 1e-40f), ARGIL_OK);
+    const journal_box_t box = {{0, -3, 2}, {EDGE_X + 6, 3, 4}};
+    assert_int_equal(journal_record(&s->j, g, &box, 1, 0.01, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.rebases, 1);
+    assert_int_equal(s->j.stats.checkpoints, 1);
+    /* The new box: the old one, grown by JOURNAL_GROW_SAMPLES past each side the clay crossed. */
+    assert_int_equal(s->j.lo[0], 0);
+    assert_int_equal(s->j.lo[1], -3 - JOURNAL_GROW_SAMPLES);
+    assert_int_equal(s->j.dims[0], EDGE_X + 6 + JOURNAL_GROW_SAMPLES);
+    /* A change inside the new box is an ordinary record again. */
+    assert_int_equal(grid_set(g, GRID_DENSITY, EDGE_X + 2, 0, 0, 0.25f), ARGIL_OK);
+    const journal_box_t box2 = {{EDGE_X + 2, 0, 0}, {EDGE_X + 3, 1, 1}};
+    assert_int_equal(journal_record(&s->j, g, &box2, 2, 0.02, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.rebases, 1);
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+    argil_doc_t doc;
+    journal_info_t info;
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 1);
+    assert_int_equal(doc.grid.dims[0], s->j.dims[0]);
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    size_t differ = 0, n = 0;
+    for (int32_t z = lo[2]; z < hi[2]; z++)
+        for (int32_t y = lo[1]; y < hi[1]; y++)
+            for (int32_t x = lo[0]; x < hi[0]; x++, n++)
+                differ += !gv_bits(grid_get(&doc.grid, GRID_DENSITY, x - s->j.lo[0],
+                                            y - s->j.lo[1], z - s->j.lo[2]),
+                                   grid_get(g, GRID_DENSITY, x, y, z));
+    assert_int_equal(differ, 0);
+    assert_true(n > N_SAMPLES);
+    assert_float_equal(grid_get(&doc.grid, GRID_DENSITY, EDGE_X + 5, 2 + 3 + JOURNAL_GROW_SAMPLES,
+                                3),
+                       0.625f, 0.0f);
+    argil_doc_free(&doc);
+    sess_free(s);
+}
+
 static void test_discard_and_bad_config(void **state)
 {
     (void)state;
@@ -765,6 +820,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_painted_material, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_growth_rebases, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, test_dir_teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
