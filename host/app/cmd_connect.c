@@ -25,6 +25,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/ply.h"
 #include "host/link/link.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
@@ -275,7 +276,7 @@ static argil_err_t write_model(const grid_t *g, const char *dir, uint32_t edits,
     char path[4096];
     mesh_t m;
     mesh_init(&m);
-    argil_err_t rc = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &m);
+    argil_err_t rc = grid_mesh_extract(g, g->iso, &m);
     if (rc != ARGIL_OK) {
         snprintf(err, err_len, "meshing the clay failed");
     } else {

@@ -156,8 +156,20 @@ static int fit_mesh_sdf(const char *in, const char *out, const mesh_t *m, const 
         fprintf(stderr, "argil fit: out of memory for the grid\n");
     } else {
         grid_t *g = &d.grid;
-        const argil_err_t e = mesh_sdf(m, g->dims, g->spacing_m, g->origin_m, g->band_m,
-                                       g->density, &rep);
+        const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+        float *sd = malloc(n * sizeof(float));
+        argil_err_t e = sd == NULL ? ARGIL_ERR_NOMEM
+                                   : mesh_sdf(m, g->dims, g->spacing_m, g->origin_m, g->band_m,
+                                              sd, &rep);
+        if (e == ARGIL_OK) {
+            const int32_t zero[3] = {0, 0, 0};
+            for (size_t i = 0; i < n; i++)
+                sd[i] = grid_profile(sd[i], g->band_m);
+            e = grid_write_box(g, GRID_DENSITY, zero, g->dims, sd);
+            if (e == ARGIL_OK)
+                e = grid_write_box(g, GRID_REST, zero, g->dims, sd);
+        }
+        free(sd);
         if (e == ARGIL_ERR_STATE) {
             fprintf(stderr, "argil fit: %s: the mesh is not closed (%zu boundary, %zu non-manifold "
                             "edges), so it has no inside; fit its vertices with --method octree\n",
@@ -166,9 +178,6 @@ static int fit_mesh_sdf(const char *in, const char *out, const mesh_t *m, const 
             fprintf(stderr, "argil fit: %s: %s\n", in,
                     e == ARGIL_ERR_NOMEM ? "out of memory" : "the mesh has no usable triangles");
         } else {
-            const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
-            for (size_t i = 0; i < n; i++)
-                g->density[i] = g->rest[i] = grid_profile(g->density[i], g->band_m);
             if (argil_file_write(out, &d, err, sizeof(err)) != ARGIL_OK) {
                 fprintf(stderr, "argil fit: %s\n", err);
             } else {
@@ -188,12 +197,11 @@ static int fit_mesh_sdf(const char *in, const char *out, const mesh_t *m, const 
 static bool sample_fit(argil_doc_t *d, progress_t *pr, int quiet)
 {
     grid_t *g = &d->grid;
-    size_t i = 0;
     for (int32_t z = 0; z < g->dims[2]; z++) {
         if (g_fit_stop)
             return false;
         for (int32_t y = 0; y < g->dims[1]; y++)
-            for (int32_t x = 0; x < g->dims[0]; x++, i++) {
+            for (int32_t x = 0; x < g->dims[0]; x++) {
                 const vec3_t p = vec3(g->origin_m.x + g->spacing_m * (float)x,
                                       g->origin_m.y + g->spacing_m * (float)y,
                                       g->origin_m.z + g->spacing_m * (float)z);
@@ -204,7 +212,9 @@ static bool sample_fit(argil_doc_t *d, progress_t *pr, int quiet)
                     v = grid_profile(octfit_eval(&d->octree, p), g->band_m);
                 else
                     v = grid_profile(rbf_eval(&d->rbf, p), g->band_m);
-                g->density[i] = g->rest[i] = v;
+                if (grid_set(g, GRID_DENSITY, x, y, z, v) != ARGIL_OK ||
+                    grid_set(g, GRID_REST, x, y, z, v) != ARGIL_OK)
+                    return false;
             }
         if (!quiet)
             progress_cb(pr, (double)(z + 1) / (double)g->dims[2]);
@@ -479,9 +489,19 @@ static int fit_volume(const char *in, const char *out, fit_method_t method, doub
         fprintf(stderr, "argil fit: out of memory\n");
     } else {
         d.grid.iso = iso_norm;
-        for (size_t i = 0; i < n; i++)
-            d.grid.density[i] = d.grid.rest[i] = (v.value[i] - lo) / (hi - lo);
-        if (argil_file_write(out, &d, err, sizeof(err)) != ARGIL_OK) {
+        const int32_t zero[3] = {0, 0, 0};
+        float *dn = malloc(n * sizeof(float));
+        argil_err_t we = dn == NULL ? ARGIL_ERR_NOMEM : ARGIL_OK;
+        for (size_t i = 0; dn != NULL && i < n; i++)
+            dn[i] = (v.value[i] - lo) / (hi - lo);
+        if (we == ARGIL_OK)
+            we = grid_write_box(&d.grid, GRID_DENSITY, zero, v.dims, dn);
+        if (we == ARGIL_OK)
+            we = grid_write_box(&d.grid, GRID_REST, zero, v.dims, dn);
+        free(dn);
+        if (we != ARGIL_OK) {
+            fprintf(stderr, "argil fit: out of memory\n");
+        } else if (argil_file_write(out, &d, err, sizeof(err)) != ARGIL_OK) {
             fprintf(stderr, "argil fit: %s\n", err);
         } else {
             rc = 0;

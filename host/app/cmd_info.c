@@ -1,6 +1,7 @@
 /* argil info: what a file holds (model, mesh, point cloud or volume), or why it cannot be read. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
@@ -31,12 +32,17 @@ static int has_ext(const char *p, const char *e)
 static void print_painted(const grid_t *g)
 {
     static const char *const names[GRID_MAT_N] = {"stiffness", "mass", "damping", "rest length"};
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    const size_t n = grid_count(g);
     bool any = false;
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        const float *m = g->mat[ch];
-        if (m == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
+        int32_t o[3], nd[3];
+        float *m = grid_dense_copy_mat(g, (grid_mat_t)ch, o, nd);
+        if (m == NULL) {
+            printf("  painted   %s: out of memory to read it\n", names[ch]);
+            continue;
+        }
         const float def = grid_mat_default((grid_mat_t)ch);
         size_t count = 0;
         float lo = INFINITY, hi = -INFINITY;
@@ -47,14 +53,15 @@ static void print_painted(const grid_t *g)
             count++;
             lo = fminf(lo, m[i]);
             hi = fmaxf(hi, m[i]);
-            const int32_t s[3] = {(int32_t)(i % (size_t)g->dims[0]),
-                                  (int32_t)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
-                                  (int32_t)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]))};
+            const int32_t s[3] = {o[0] + (int32_t)(i % (size_t)nd[0]),
+                                  o[1] + (int32_t)(i / (size_t)nd[0] % (size_t)nd[1]),
+                                  o[2] + (int32_t)(i / ((size_t)nd[0] * (size_t)nd[1]))};
             for (int a = 0; a < 3; a++) {
                 b0[a] = s[a] < b0[a] ? s[a] : b0[a];
                 b1[a] = s[a] > b1[a] ? s[a] : b1[a];
             }
         }
+        free(m);
         if (count == 0)
             continue;
         any = true;

@@ -162,15 +162,18 @@ int cmd_mesh(int argc, char **argv)
         fprintf(stderr, "argil mesh: %s\n", err);
         return 1;
     }
-    float *dens = d.grid.density, spacing = d.grid.spacing_m;
+    /* A loaded model's samples fill the file's box: bounds start at 0 and rgb matches them. */
+    int32_t blo[3], dims[3];
+    float *own_d = grid_dense_copy(&d.grid, GRID_DENSITY, blo, dims), *dens = own_d;
+    float spacing = d.grid.spacing_m;
     uint8_t *rgb = d.rgb;
-    int32_t dims[3] = {d.grid.dims[0], d.grid.dims[1], d.grid.dims[2]};
-    vec3_t origin = d.grid.origin_m;
-    float *own_d = NULL;
+    vec3_t origin = grid_box_origin(&d.grid, blo);
     uint8_t *own_c = NULL;
     int rc = 1;
-    argil_err_t e = ARGIL_OK;
-    if (res > 0) {
+    argil_err_t e = own_d != NULL ? ARGIL_OK : ARGIL_ERR_NOMEM;
+    if (e == ARGIL_OK && res > 0) {
+        free(own_d);
+        own_d = NULL;
         e = resample(&d, (int)res, &own_d, &own_c, dims, &spacing, &origin);
         dens = own_d;
         rgb = own_c;

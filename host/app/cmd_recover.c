@@ -11,6 +11,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/journal.h"
 #include "host/io/ply.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh.h"
 
@@ -150,7 +151,7 @@ int cmd_recover(int argc, char **argv)
     journal_info_t info;
     const argil_err_t e = journal_recover(dir, &doc, &info, err, sizeof(err));
     int status = 0;
-    if (doc.grid.density == NULL) {
+    if (grid_count(&doc.grid) == 0) {
         fprintf(stderr, "argil recover: %s\n", err);
         status = 1;
         goto out;
@@ -163,7 +164,7 @@ int cmd_recover(int argc, char **argv)
     mesh_t mesh;
     mesh_init(&mesh);
     const grid_t *g = &doc.grid;
-    argil_err_t me = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &mesh);
+    argil_err_t me = grid_mesh_extract(g, g->iso, &mesh);
     if (me == ARGIL_OK && mesh.n_tri > 0)
         me = ply_write(ply_path, &mesh, werr, sizeof(werr));
     const size_t tris = mesh.n_tri;
@@ -184,8 +185,10 @@ int cmd_recover(int argc, char **argv)
            info.first_seq, info.last_seq, (unsigned long long)info.samples);
     printf("  painted material    %llu values replayed; %s\n",
            (unsigned long long)info.mat_samples,
-           doc.grid.mat[GRID_MAT_STIFFNESS] || doc.grid.mat[GRID_MAT_MASS] ||
-                   doc.grid.mat[GRID_MAT_DAMPING] || doc.grid.mat[GRID_MAT_RESTLEN]
+           grid_mat_painted(&doc.grid, GRID_MAT_STIFFNESS) ||
+                   grid_mat_painted(&doc.grid, GRID_MAT_MASS) ||
+                   grid_mat_painted(&doc.grid, GRID_MAT_DAMPING) ||
+                   grid_mat_painted(&doc.grid, GRID_MAT_RESTLEN)
                ? "the model holds painted channels"
                : "the model holds none");
     printf("  painted colour      %llu samples replayed; %s\n",

@@ -9,6 +9,7 @@
 #include "host/app/commands.h"
 #include "host/io/argil_file.h"
 #include "host/io/mesh_import.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/render/camera.h"
 #include "host/render/offscreen.h"
@@ -154,11 +155,9 @@ static argil_err_t load_model(const char *path, float iso2, mesh_t *m, mesh_t *w
     if (rc != ARGIL_OK)
         return rc;
     const grid_t *g = &d.grid;
-    rc = mc_extract_region(g->density, d.rgb, g->dims, g->spacing_m, g->origin_m, g->iso, NULL,
-                           NULL, m);
+    rc = grid_mesh_region(g, d.rgb, g->iso, m);
     if (rc == ARGIL_OK && iso2 > 0.0f)
-        rc = mc_extract_region(g->density, NULL, g->dims, g->spacing_m, g->origin_m, iso2, NULL,
-                               NULL, wire);
+        rc = grid_mesh_region(g, NULL, iso2, wire);
     if (rc != ARGIL_OK)
         snprintf(err, err_len, "%s: cannot mesh the model (%s)", path,
                  rc == ARGIL_ERR_NOMEM ? "out of memory" : "bad field");

@@ -34,13 +34,7 @@ static float *scratch(gsolve_t *gs, size_t n)
 static bool clip_to_grid(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
                          int32_t chi[3])
 {
-    for (int a = 0; a < 3; a++) {
-        clo[a] = lo[a] < 0 ? 0 : lo[a];
-        chi[a] = hi[a] > g->dims[a] ? g->dims[a] : hi[a];
-        if (chi[a] <= clo[a])
-            return false;
-    }
-    return true;
+    return grid_clip(g, lo, hi, clo, chi);
 }
 
 /* Copies the field's densities in sample box [lo, hi) (clipped to the grid) into the grid,
@@ -54,23 +48,34 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
         hi[a] = lo[a] + n[a];
     if (!clip_to_grid(g, lo, hi, a0, a1))
         return 0.0f;
+    /* The grid's box, changed where the field moved it, stored back when anything changed. */
+    int32_t an[3];
+    for (int a = 0; a < 3; a++)
+        an[a] = a1[a] - a0[a];
+    float *cur = malloc((size_t)an[0] * (size_t)an[1] * (size_t)an[2] * sizeof(float));
+    if (cur == NULL)
+        return -1.0f;
+    grid_read_box(g, GRID_DENSITY, a0, an, cur);
     float change = 0.0f;
+    size_t k = 0;
     for (int32_t z = a0[2]; z < a1[2]; z++)
         for (int32_t y = a0[1]; y < a1[1]; y++) {
-            const size_t row = (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
             const float *src = d + (size_t)n[0] * ((size_t)(y - lo[1]) +
                                                    (size_t)n[1] * (size_t)(z - lo[2])) -
                                lo[0];
-            for (int32_t x = a0[0]; x < a1[0]; x++) {
+            for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
                 const float v = clamp01(src[x]);
-                const float c = fabsf(v - g->density[row + (size_t)x]);
+                const float c = fabsf(v - cur[k]);
                 if (c > GSOLVE_VIEW_EPS) {
                     if (c > change)
                         change = c;
-                    g->density[row + (size_t)x] = v;
+                    cur[k] = v;
                 }
             }
         }
+    if (change > 0.0f && grid_write_box(g, GRID_DENSITY, a0, an, cur) != ARGIL_OK)
+        change = -1.0f;
+    free(cur);
     return change;
 }
 
@@ -124,8 +129,9 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     gs->cfg.acc_threshold = INFINITY; /* implicit: unconditionally stable, no step halving */
     gs->cfg.cg_tol = GSOLVE_CG_TOL;
     gsolve_set_material(gs, &g->material);
-    const int32_t lo[3] = {0, 0, 0};
-    e = gsolve_seed_from_grid(gs, g, lo, g->dims);
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    e = gsolve_seed_from_grid(gs, g, lo, hi);
     if (e != ARGIL_OK)
         gsolve_free(gs);
     return e;
@@ -295,19 +301,22 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
     const bool settling = gs->settle.active;
     close_window(gs);
     gs->settle.active = settling;
-    const int32_t zero[3] = {0, 0, 0};
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    int32_t zero[3], top[3], gd[3];
+    grid_bounds(g, zero, top);
+    for (int a = 0; a < 3; a++)
+        gd[a] = top[a] - zero[a];
+    const size_t n = grid_count(g);
     float *before = malloc(2 * n * sizeof(float));
     if (!before)
         return ARGIL_ERR_NOMEM;
     float *after = before + n;
-    sparse_read_box(&f->samp, FS_D, zero, g->dims, before);
+    sparse_read_box(&f->samp, FS_D, zero, gd, before);
     const uint32_t gen = f->lattice_gen;
     argil_err_t e = field_refine(f);
     if (e != ARGIL_OK && f->lattice_gen != gen) {
         /* Out of memory after the finer coefficients replaced the coarse ones: some d may still
          * hold the old values (field.h); recompute the grid's part once more. */
-        const argil_err_t e2 = field_refresh(f, zero, g->dims);
+        const argil_err_t e2 = field_refresh(f, zero, top);
         if (e2 == ARGIL_OK)
             e = ARGIL_OK;
     }
@@ -315,28 +324,36 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
         free(before);
         return e;
     }
-    sparse_read_box(&f->samp, FS_D, zero, g->dims, after);
+    sparse_read_box(&f->samp, FS_D, zero, gd, after);
     /* The grid follows only a density the refinement itself moved by > GSOLVE_VIEW_EPS (none
      * measured: ~5e-7): a sample the view left within GSOLVE_VIEW_EPS of the field stays as it
      * is, so the grid, the mesh and the board's window do not change at all. */
     float dd = 0.0f;
     bool changed = false;
-    for (size_t i = 0; i < n; i++) {
-        const float c = fabsf(after[i] - before[i]);
-        if (c > dd)
-            dd = c;
-        if (c > GSOLVE_VIEW_EPS) {
-            g->density[i] = clamp01(after[i]);
-            changed = true;
-        }
-    }
+    size_t i = 0;
+    for (int32_t z = zero[2]; z < top[2]; z++)
+        for (int32_t y = zero[1]; y < top[1]; y++)
+            for (int32_t x = zero[0]; x < top[0]; x++, i++) {
+                const float c = fabsf(after[i] - before[i]);
+                if (c > dd)
+                    dd = c;
+                if (c > GSOLVE_VIEW_EPS) {
+                    if (grid_set(g, GRID_DENSITY, x, y, z, clamp01(after[i])) != ARGIL_OK) {
+                        free(before);
+                        return ARGIL_ERR_NOMEM;
+                    }
+                    changed = true;
+                }
+            }
     free(before);
     gs->stats.refines++;
     if (max_dd)
         *max_dd = dd;
     if (changed)
-        for (int a = 0; a < 3; a++)
-            hi[a] = g->dims[a];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = zero[a];
+            hi[a] = top[a];
+        }
     return ARGIL_OK;
 }
 
@@ -378,9 +395,7 @@ static argil_err_t seed_fit(field_t *f, const grid_t *g, const int32_t lo[3], co
     for (int32_t z = 0, k = 0; z < ns[2]; z++)
         for (int32_t y = 0; y < ns[1]; y++)
             for (int32_t x = 0; x < ns[0]; x++, k++)
-                Rs[k] = g->density[(size_t)(a0[0] + x) + (size_t)g->dims[0] *
-                                   ((size_t)(a0[1] + y) + (size_t)g->dims[1] *
-                                    (size_t)(a0[2] + z))] - Rs[k];
+                Rs[k] = grid_get(g, GRID_DENSITY, a0[0] + x, a0[1] + y, a0[2] + z) - Rs[k];
     field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
     memcpy(Q, S, ncoef * sizeof(float));
     double gamma = dot(S, S, ncoef);
@@ -433,12 +448,7 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
             for (int32_t x = 0; x < nc[0]; x++, k++) {
                 const int32_t s[3] = {(clo[0] + x) * f->ratio, (clo[1] + y) * f->ratio,
                                       (clo[2] + z) * f->ratio};
-                bool in = true;
-                for (int a = 0; a < 3; a++)
-                    in = in && s[a] >= 0 && s[a] < g->dims[a];
-                p[k] = in ? g->density[(size_t)s[0] + (size_t)g->dims[0] *
-                                       ((size_t)s[1] + (size_t)g->dims[1] * (size_t)s[2])]
-                          : 0.0f;
+                p[k] = grid_get(g, GRID_DENSITY, s[0], s[1], s[2]);
             }
     argil_err_t e = sparse_write_box(&f->coef, FC_P, clo, nc, p);
     if (e == ARGIL_OK) {
@@ -465,10 +475,10 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         for (int32_t z = a0[2]; z < a1[2]; z++)
             for (int32_t y = a0[1]; y < a1[1]; y++)
                 for (int32_t x = a0[0]; x < a1[0]; x++) {
-                    const size_t i = (size_t)x + (size_t)g->dims[0] *
-                                     ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                    g->rest[i] = g->density[i];
-                    g->velocity[i] = 0.0f;
+                    if (grid_set(g, GRID_REST, x, y, z, grid_get(g, GRID_DENSITY, x, y, z)) !=
+                            ARGIL_OK ||
+                        grid_set(g, GRID_VELOCITY, x, y, z, 0.0f) != ARGIL_OK)
+                        return ARGIL_ERR_NOMEM;
                 }
     return ARGIL_OK;
 }
@@ -745,19 +755,20 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     bool forced = false;
     int32_t a0[3], a1[3];
     if (clip_to_grid(g, w->slo, w->shi, a0, a1)) {
-        const int32_t nx = w->shi[0] - w->slo[0], ny = w->shi[1] - w->slo[1];
-        for (int32_t z = a0[2]; z < a1[2]; z++)
-            for (int32_t y = a0[1]; y < a1[1]; y++)
-                for (int32_t x = a0[0]; x < a1[0]; x++) {
-                    const size_t gi = (size_t)x + (size_t)g->dims[0] *
-                                      ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                    const size_t si = (size_t)(x - w->slo[0]) +
-                                      (size_t)nx * ((size_t)(y - w->slo[1]) +
-                                                    (size_t)ny * (size_t)(z - w->slo[2]));
-                    s->force_n[si] = g->force[gi];
-                    forced = forced || g->force[gi] != 0.0f;
-                    g->force[gi] = 0.0f;
-                }
+        /* The grid holds every index the window can have: its box is the window's. */
+        const int32_t ns[3] = {w->shi[0] - w->slo[0], w->shi[1] - w->slo[1],
+                               w->shi[2] - w->slo[2]};
+        grid_read_box(g, GRID_FORCE, w->slo, ns, s->force_n);
+        for (size_t i = 0; i < s->nsamp && !forced; i++)
+            forced = s->force_n[i] != 0.0f;
+        if (forced) {
+            float *zero = calloc(s->nsamp, sizeof(float));
+            if (zero == NULL || grid_write_box(g, GRID_FORCE, w->slo, ns, zero) != ARGIL_OK) {
+                free(zero);
+                return ARGIL_ERR_NOMEM;
+            }
+            free(zero);
+        }
     }
     /* At rest and left alone: nothing to step (and no round-off to integrate); the window is
      * not stepped again until a force, a tool, the material or a new window moves it. */
@@ -869,29 +880,19 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
     const size_t vol = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
-    float *v = malloc(vol * sizeof(float));
+    float *v = malloc(2 * vol * sizeof(float));
     if (v == NULL)
         return ARGIL_ERR_NOMEM;
+    float *old = v + vol;
     bool changed = false;
     argil_err_t e = ARGIL_OK;
     for (int ch = 0; ch < GRID_MAT_N && e == ARGIL_OK; ch++) {
         sparse_read_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], a0, n, v);
-        size_t k = 0;
-        for (int32_t z = a0[2]; z < a1[2] && e == ARGIL_OK; z++)
-            for (int32_t y = a0[1]; y < a1[1] && e == ARGIL_OK; y++)
-                for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
-                    const size_t i = (size_t)x + (size_t)g->dims[0] *
-                                     ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                    const float old = grid_mat_value(g, (grid_mat_t)ch, i);
-                    if (memcmp(&old, &v[k], sizeof(float)) == 0)
-                        continue;
-                    if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
-                        e = ARGIL_ERR_NOMEM;
-                        break;
-                    }
-                    g->mat[ch][i] = v[k];
-                    changed = true;
-                }
+        grid_mat_read_box(g, (grid_mat_t)ch, a0, n, old);
+        if (memcmp(old, v, vol * sizeof(float)) == 0)
+            continue;
+        e = grid_mat_write_box(g, (grid_mat_t)ch, a0, n, v);
+        changed = changed || e == ARGIL_OK;
     }
     free(v);
     if (changed)
@@ -901,13 +902,16 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
 
 argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
 {
-    const int32_t lo[3] = {0, 0, 0};
+    int32_t lo[3], n[3];
     bool any = false;
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (g->mat[ch] == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
-        const argil_err_t e = sparse_write_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], lo,
-                                               g->dims, g->mat[ch]);
+        float *m = grid_dense_copy_mat(g, (grid_mat_t)ch, lo, n);
+        if (m == NULL)
+            return ARGIL_ERR_NOMEM;
+        const argil_err_t e = sparse_write_box(&gs->field.samp, GSOLVE_GRID_MAT_FS[ch], lo, n, m);
+        free(m);
         if (e != ARGIL_OK)
             return e;
         any = true;
@@ -1071,9 +1075,9 @@ static uint8_t colour_byte(float v)
     return (uint8_t)lrintf(isfinite(c) ? c : 0.0f);
 }
 
-/* Copies the model's FS_R/G/B in sample box [lo, hi) (clipped to the grid) into g->rgb as bytes,
- * allocating it once a sample differs from GRID_RGB_DEFAULT; bumps g->rgb_writes when anything
- * changed. Returns 1 when something changed, 0 when nothing did, -1 when out of memory. */
+/* Copies the model's FS_R/G/B in sample box [lo, hi) (clipped to the grid) into the grid's colour
+ * as bytes (a block holds a colour array only once one of its samples differs from
+ * GRID_RGB_DEFAULT); bumps g->rgb_writes when anything changed. Returns 1 when something changed, 0 when nothing did, -1 when out of memory. */
 static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
@@ -1087,26 +1091,23 @@ static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         return -1.0f;
     for (int c = 0; c < 3; c++)
         sparse_read_box(&gs->field.samp, FS_R + c, a0, n, v + (size_t)c * vol);
-    bool changed = false, nomem = false;
-    size_t k = 0;
-    for (int32_t z = a0[2]; z < a1[2] && !nomem; z++)
-        for (int32_t y = a0[1]; y < a1[1] && !nomem; y++)
-            for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
-                const size_t i = (size_t)x + (size_t)g->dims[0] *
-                                 ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-                const uint8_t b[3] = {colour_byte(v[k]), colour_byte(v[vol + k]),
-                                      colour_byte(v[2 * vol + k])};
-                const uint8_t def[3] = {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT};
-                const uint8_t *old = g->rgb != NULL ? g->rgb + 3 * i : def;
-                if (memcmp(old, b, 3) == 0)
-                    continue;
-                if (grid_rgb_alloc(g) == NULL) {
-                    nomem = true;
-                    break;
-                }
-                memcpy(g->rgb + 3 * i, b, 3);
-                changed = true;
-            }
+    uint8_t *cur = malloc(3 * vol), *want = malloc(3 * vol);
+    if (cur == NULL || want == NULL) {
+        free(cur);
+        free(want);
+        free(v);
+        return -1.0f;
+    }
+    grid_rgb_read_box(g, a0, n, cur);
+    for (size_t k = 0; k < vol; k++) {
+        want[3 * k] = colour_byte(v[k]);
+        want[3 * k + 1] = colour_byte(v[vol + k]);
+        want[3 * k + 2] = colour_byte(v[2 * vol + k]);
+    }
+    const bool changed = memcmp(cur, want, 3 * vol) != 0;
+    const bool nomem = changed && grid_rgb_write_box(g, a0, n, want) != ARGIL_OK;
+    free(cur);
+    free(want);
     free(v);
     if (changed)
         g->rgb_writes++;
@@ -1121,20 +1122,24 @@ argil_err_t gsolve_colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t l
 
 argil_err_t gsolve_colour_from_grid(gsolve_t *gs, const grid_t *g)
 {
-    if (g->rgb == NULL)
+    if (!grid_rgb_any(g))
         return ARGIL_OK;
-    const int32_t lo[3] = {0, 0, 0};
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
-    float *v = malloc(n * sizeof(float));
-    if (v == NULL)
+    int32_t lo[3], n[3];
+    uint8_t *rgb = grid_dense_copy_rgb(g, lo, n);
+    const size_t cnt = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    float *v = rgb != NULL ? malloc(cnt * sizeof(float)) : NULL;
+    if (v == NULL) {
+        free(rgb);
         return ARGIL_ERR_NOMEM;
+    }
     argil_err_t e = ARGIL_OK;
     for (int c = 0; c < 3 && e == ARGIL_OK; c++) {
-        for (size_t i = 0; i < n; i++)
-            v[i] = (float)g->rgb[3 * i + (size_t)c] / 255.0f;
-        e = sparse_write_box(&gs->field.samp, FS_R + c, lo, g->dims, v);
+        for (size_t i = 0; i < cnt; i++)
+            v[i] = (float)rgb[3 * i + (size_t)c] / 255.0f;
+        e = sparse_write_box(&gs->field.samp, FS_R + c, lo, n, v);
     }
     free(v);
+    free(rgb);
     return e;
 }
 
@@ -1152,12 +1157,16 @@ argil_err_t gsolve_restored(gsolve_t *gs, grid_t *g, const int32_t lo[3], const 
         return ARGIL_OK;
     if (view_to_grid(gs, g, a0, a1) < 0.0f)
         return ARGIL_ERR_NOMEM;
-    for (int32_t z = a0[2]; z < a1[2]; z++)
-        for (int32_t y = a0[1]; y < a1[1]; y++) {
-            const size_t row = (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-            memset(&g->velocity[row + (size_t)a0[0]], 0, (size_t)(a1[0] - a0[0]) * sizeof(float));
-        }
-    argil_err_t e = gsolve_material_to_grid(gs, g, a0, a1);
+    int32_t an[3];
+    for (int a = 0; a < 3; a++)
+        an[a] = a1[a] - a0[a];
+    float *zero = calloc((size_t)an[0] * (size_t)an[1] * (size_t)an[2], sizeof(float));
+    if (zero == NULL)
+        return ARGIL_ERR_NOMEM;
+    argil_err_t e = grid_write_box(g, GRID_VELOCITY, a0, an, zero);
+    free(zero);
+    if (e == ARGIL_OK)
+        e = gsolve_material_to_grid(gs, g, a0, a1);
     if (e == ARGIL_OK)
         e = gsolve_colour_to_grid(gs, g, a0, a1);
     if (e != ARGIL_OK)

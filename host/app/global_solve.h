@@ -198,7 +198,7 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
 /* ---- painted colour (helper "colour"; docs/model.md "In the session") ---- */
 
 /* Mirrors the model's colour (FS_R, FS_G, FS_B, 0..1) in sample box [lo, hi) (clipped to the
- * grid) into the grid's rgb as bytes (round(255 v)), allocating g->rgb only once a sample
+ * grid) into the grid's rgb as bytes (round(255 v)), a block holding colour only once a sample
  * differs from GRID_RGB_DEFAULT; bumps g->rgb_writes when anything changed (the journal then
  * records it). gsolve_apply_tool calls it after a paint; call it after anything else that
  * changes the model's colour (an undo) with the box it changed. ARGIL_ERR_NOMEM. */

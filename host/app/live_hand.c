@@ -33,10 +33,13 @@ bool live_hand_raycast(const grid_t *g, vec3_t origin_m, vec3_t dir, vec3_t *hit
         return false;
     /* Slab test against the grid's box. */
     const float o[3] = {origin_m.x, origin_m.y, origin_m.z}, d[3] = {dir.x, dir.y, dir.z};
-    const float lo[3] = {g->origin_m.x, g->origin_m.y, g->origin_m.z};
+    int32_t b0[3], b1[3];
+    grid_bounds(g, b0, b1);
+    const vec3_t org = grid_box_origin(g, b0);
+    const float lo[3] = {org.x, org.y, org.z};
     float t0 = 0.0f, t1 = INFINITY;
     for (int a = 0; a < 3; a++) {
-        const float hi = lo[a] + (float)(g->dims[a] - 1) * g->spacing_m;
+        const float hi = lo[a] + (float)(b1[a] - b0[a] - 1) * g->spacing_m;
         if (fabsf(d[a]) < 1e-12f) {
             if (o[a] < lo[a] || o[a] > hi)
                 return false;

@@ -371,6 +371,11 @@ int cmd_sculpt(int argc, char **argv)
             printf("  files               %s/final.ply, %s/telemetry.csv (%u rows)%s%s%s\n",
                    o.out_dir, o.out_dir, s.telemetry_rows, wo.mouse ? "" : ", ",
                    wo.mouse ? "" : o.out_dir, wo.mouse ? "" : "/session.scn");
+        printf("  grid memory         %.1f KiB sparse at the start, %.1f KiB at the end (a dense "
+               "grid of its %dx%dx%d bounds: %.1f KiB)\n", (double)s.grid_bytes_start / 1024.0,
+               (double)s.grid_bytes_end / 1024.0, s.grid_hi[0] - s.grid_lo[0],
+               s.grid_hi[1] - s.grid_lo[1], s.grid_hi[2] - s.grid_lo[2],
+               (double)s.grid_dense_bytes_end / 1024.0);
         if (s.journal_records > 0)
             printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u checkpoints, "
                    "%.1f ms of work; removed at this clean end\n",

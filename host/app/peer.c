@@ -336,16 +336,15 @@ static void solve_springs(peer_t *p)
     p->have_box = true;
     /* Impulses received so far act in this step: from now on windows include them. */
     p->impulse_seq_applied = p->impulse_seq_received;
-    spring_field_t f = grid_springs(g);
     const float dt_s = (float)p->cfg.solve_period_us * 1e-6f;
-    const float acc = springs_step(&f, &g->material, box.lo, box.hi, dt_s);
+    const float acc = grid_springs_step(g, box.lo, box.hi, dt_s);
     if (acc > 0.0f) {
         mark_dirty(p, box.lo, box.hi);
         p->field_dirty = true;
     }
     for (uint32_t k = 0; k < p->settling_count;) {
         const peer_box_t *s = &p->settling[k];
-        const float a = springs_step(&f, &g->material, s->lo, s->hi, dt_s);
+        const float a = grid_springs_step(g, s->lo, s->hi, dt_s);
         if (a > 0.0f)
             mark_dirty(p, s->lo, s->hi);
         if (a < PEER_REST_ACCEL) {
@@ -364,11 +363,10 @@ static void clear_forces(peer_t *p)
     if (p->force_lo[0] > p->force_hi[0])
         return;
     for (int32_t z = p->force_lo[2]; z < p->force_hi[2]; z++)
-        for (int32_t y = p->force_lo[1]; y < p->force_hi[1]; y++) {
-            const size_t row = (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-            memset(&g->force[row + (size_t)p->force_lo[0]], 0,
-                   (size_t)(p->force_hi[0] - p->force_lo[0]) * sizeof(float));
-        }
+        for (int32_t y = p->force_lo[1]; y < p->force_hi[1]; y++)
+            for (int32_t x = p->force_lo[0]; x < p->force_hi[0]; x++)
+                if (grid_get(g, GRID_FORCE, x, y, z) != 0.0f)
+                    (void)grid_set(g, GRID_FORCE, x, y, z, 0.0f);
     for (int a = 0; a < 3; a++) {
         p->force_lo[a] = 1;
         p->force_hi[a] = 0;
@@ -591,14 +589,16 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
         /* The densities did not change, but the surface there must be re-meshed to show the
          * new material (colour maps): the painted ball's sample box becomes dirty. */
         const grid_t *g = p->grid;
-        int32_t lo[3], hi[3];
+        int32_t lo[3], hi[3], b0[3], b1[3];
+        grid_bounds(g, b0, b1);
         const float c[3] = {centre_m.x - g->origin_m.x, centre_m.y - g->origin_m.y,
                             centre_m.z - g->origin_m.z};
         for (int a = 0; a < 3; a++) {
             const float l = floorf((c[a] - radius_m) / g->spacing_m);
             const float h = ceilf((c[a] + radius_m) / g->spacing_m) + 1.0f;
-            lo[a] = l < 0.0f ? 0 : l > (float)g->dims[a] ? g->dims[a] : (int32_t)l;
-            hi[a] = h < 0.0f ? 0 : h > (float)g->dims[a] ? g->dims[a] : (int32_t)h;
+            const float fl = (float)b0[a], fh = (float)b1[a];
+            lo[a] = l < fl ? b0[a] : l > fh ? b1[a] : (int32_t)l;
+            hi[a] = h < fl ? b0[a] : h > fh ? b1[a] : (int32_t)h;
         }
         if (lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2]) {
             /* The grid's painted channels follow (what .argil files and the journal keep). */

@@ -18,6 +18,7 @@
 
 #include "firmware/core/safety.h"
 #include "host/app/live_hand.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/render/backend_glfw.h"
 #include "host/render/camera.h"
@@ -178,10 +179,12 @@ typedef struct {
     const sculpt_window_opts_t *wo;
     volatile sig_atomic_t *stop;
     mc_blocks_t mcb;
+    grid_mesh_view_t mcb_view;    /* the grid's bounds mcb was set up over */
     bool mcb_ready, mcb_failed;
     uint64_t serial;
     uint64_t news_serial, news_serial2; /* the serials the last snapshot published */
     mc_blocks_t mcb2;             /* the second iso-surface's mesher (only while shown) */
+    grid_mesh_view_t mcb2_view;
     bool mcb2_ready, iso2_on;
     float iso2_level;
     uint64_t serial2;
@@ -389,14 +392,15 @@ static float sample_material(const void *ctx, vec3_t x_m)
 static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo[3],
                         const int32_t hi[3])
 {
-    if (L->mcb2_ready && (!L->iso2_on || L->mcb2.iso != L->iso2_level)) {
+    if (L->mcb2_ready && (!L->iso2_on || L->mcb2.iso != L->iso2_level ||
+                          grid_mesh_view_stale(&L->mcb2_view, g))) {
         mc_blocks_free(&L->mcb2);
         L->mcb2_ready = false;
     }
     if (!L->iso2_on)
         return;
     if (!L->mcb2_ready) {
-        if (mc_blocks_init(&L->mcb2, g->dims, g->spacing_m, g->origin_m, L->iso2_level) !=
+        if (grid_mesh_blocks_init(&L->mcb2, &L->mcb2_view, g, L->iso2_level) !=
             ARGIL_OK) {
             L->iso2_on = false; /* no memory for it: the window shows it off */
             return;
@@ -404,9 +408,10 @@ static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo
         L->mcb2_ready = true;
         L->serial2++;
     } else if (!empty) {
-        mc_blocks_mark(&L->mcb2, lo, hi);
+        grid_mesh_mark(&L->mcb2, &L->mcb2_view, lo, hi);
     }
-    if (mc_blocks_update(&L->mcb2, g->density, NULL) == ARGIL_OK && L->mcb2.blocks_meshed > 0)
+    if (mc_blocks_update_read(&L->mcb2, grid_mesh_read, &L->mcb2_view) == ARGIL_OK &&
+        L->mcb2.blocks_meshed > 0)
         L->serial2++;
 }
 
@@ -449,8 +454,13 @@ static void publish(live_t *L, session_frame_t *f)
 {
     peer_t *p = f->peer;
     const grid_t *g = p->grid;
+    if (L->mcb_ready && grid_mesh_view_stale(&L->mcb_view, g)) {
+        /* The clay grew past the mesher's box: set it up again over the new bounds. */
+        mc_blocks_free(&L->mcb);
+        L->mcb_ready = false;
+    }
     if (!L->mcb_ready && !L->mcb_failed) {
-        if (mc_blocks_init(&L->mcb, g->dims, g->spacing_m, g->origin_m, g->iso) == ARGIL_OK)
+        if (grid_mesh_blocks_init(&L->mcb, &L->mcb_view, g, g->iso) == ARGIL_OK)
             L->mcb_ready = true;
         else
             L->mcb_failed = true;
@@ -460,9 +470,12 @@ static void publish(live_t *L, session_frame_t *f)
         empty |= p->dirty_lo[a] >= p->dirty_hi[a];
     if (L->mcb_ready) {
         if (!empty)
-            mc_blocks_mark(&L->mcb, p->dirty_lo, p->dirty_hi);
+            grid_mesh_mark(&L->mcb, &L->mcb_view, p->dirty_lo, p->dirty_hi);
         /* Painted colour once anything was painted (the first paint re-meshes everything). */
-        if (mc_blocks_update(&L->mcb, g->density, g->rgb) == ARGIL_OK && L->mcb.blocks_meshed > 0)
+        if (mc_blocks_update_read_rgb(&L->mcb, grid_mesh_read,
+                                      grid_rgb_any(g) ? grid_mesh_read_rgb : NULL,
+                                      &L->mcb_view) == ARGIL_OK &&
+            L->mcb.blocks_meshed > 0)
             L->serial++;
     }
     update_iso2(L, g, empty, p->dirty_lo, p->dirty_hi);

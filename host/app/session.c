@@ -22,12 +22,14 @@
 #include "host/io/ply.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/model/grid.h"
 #include "sim/sim_device.h"
 
 #define SESSION_CLAY_RADIUS_M 0.030f
 #define SESSION_GRID_EDGE 88
 #define SESSION_SPACING_M 0.00125f
+#define SESSION_COMPACT_SOLVES 100u /* grid_compact every this many solves (1 s) */
 #define SESSION_TAIL_S 0.3f            /* simulated time after the script, to let the clay settle */
 #define SESSION_START_Z_M 0.060f       /* the workspace centre sits 60 mm in front of the clay */
 #define COMPUTE_HIST_BINS 2001u        /* 0 … 2000 µs; the last bin holds everything slower */
@@ -76,6 +78,7 @@ typedef struct {
     journal_t journal;                 /* autosave journal (when journaling) */
     bool journaling;
     peer_journal_t journal_steps;      /* what the journal has looked at, and its costs */
+    uint32_t compact_solves;           /* peer solves at the last grid_compact */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -132,7 +135,7 @@ static argil_err_t mesh_field(const grid_t *g, mesh_t *m, double *volume_m3)
 {
     mesh_free(m);
     mesh_init(m);
-    const argil_err_t e = mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, m);
+    const argil_err_t e = grid_mesh_extract(g, g->iso, m);
     if (e == ARGIL_OK)
         *volume_m3 = mesh_volume_m3(m);
     return e;
@@ -338,6 +341,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         goto done;
     }
     grid_fill_sphere(&s->grid, vec3(0, 0, 0), SESSION_CLAY_RADIUS_M);
+    sum->grid_bytes_start = grid_bytes(&s->grid);
 
     peer_cfg_t pcfg;
     peer_cfg_default(&pcfg);
@@ -518,6 +522,12 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         session_undo_observe(&s->undo, &s->peer); /* button 1 down at the host: a new stroke */
         peer_tick(&s->peer, dt_us);
         undo_requests(s, opts);
+        if (s->peer.stats.solves != s->compact_solves &&
+            s->peer.stats.solves % SESSION_COMPACT_SOLVES == 0) {
+            /* Blocks that came to rest uniform (carved empty, filled solid) give memory back. */
+            s->compact_solves = s->peer.stats.solves;
+            grid_compact(&s->grid);
+        }
         if (s->journaling) {
             bool stop_now = false;
             rc = peer_journal_step(&s->journal, &s->journal_steps, &s->peer,
@@ -580,6 +590,10 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         rc = ARGIL_ERR_STATE;
     }
 
+    grid_compact(&s->grid);
+    sum->grid_bytes_end = grid_bytes(&s->grid);
+    grid_bounds(&s->grid, sum->grid_lo, sum->grid_hi);
+    sum->grid_dense_bytes_end = grid_count(&s->grid) * GRID_CH_N * sizeof(float);
     {
         const argil_err_t me = mesh_field(&s->grid, &mesh, &sum->volume_after_m3);
         if (me != ARGIL_OK && rc == ARGIL_OK) {
@@ -622,15 +636,24 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         argil_doc_t doc;
         argil_doc_init(&doc);
         doc.grid = s->grid; /* borrowed: the document is not freed */
-        /* painted colour (COLR; none when nothing shows paint, as a recovery writes it) */
-        doc.rgb = grid_rgb_painted(&s->grid) ? s->grid.rgb : NULL;
+        /* painted colour (COLR over the grid's bounds, as the GRID box; none when nothing shows
+         * paint, as a recovery writes it) */
+        int32_t rlo[3], rn[3];
+        doc.rgb = grid_rgb_painted(&s->grid) ? grid_dense_copy_rgb(&s->grid, rlo, rn) : NULL;
         doc.state.device_offset_m = s->model_offset_m;
         doc.state.edits = s->journaling ? s->journal.seq : 0u;
         snprintf(path, sizeof(path), "%s/model.argil", opts->out_dir);
-        if (argil_file_write(path, &doc, ferr, sizeof(ferr)) != ARGIL_OK && rc == ARGIL_OK) {
+        if (doc.rgb == NULL && grid_rgb_painted(&s->grid)) {
+            if (rc == ARGIL_OK) {
+                snprintf(err, err_len, "%s: out of memory for the painted colour", path);
+                rc = ARGIL_ERR_NOMEM;
+            }
+        } else if (argil_file_write(path, &doc, ferr, sizeof(ferr)) != ARGIL_OK &&
+                   rc == ARGIL_OK) {
             snprintf(err, err_len, "%s", ferr);
             rc = ARGIL_ERR_IO;
         }
+        free(doc.rgb);
     }
 
     /* A clean end: the outputs are whole, so the journal is no longer needed. */

@@ -110,6 +110,10 @@ typedef struct {
     size_t undo_shadow_bytes;     /* the shadow of the model at the last boundary */
     double undo_max_work_ms;      /* thread CPU time of the slowest stroke boundary or undo */
     char undo_note[96];           /* why undo is off, or what it did last */
+    size_t grid_bytes_start;      /* the sparse grid's memory after the sphere fill */
+    size_t grid_bytes_end;        /* ... at the end (after grid_compact) */
+    size_t grid_dense_bytes_end;  /* a dense grid of the end bounds (4 channels of floats) */
+    int32_t grid_lo[3], grid_hi[3]; /* the grid's bounds at the end (samples; nominal 0..88) */
 } session_summary_t;
 
 void session_opts_default(session_opts_t *o);

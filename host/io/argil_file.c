@@ -26,8 +26,7 @@ void argil_doc_init(argil_doc_t *d)
 
 void argil_doc_free(argil_doc_t *d)
 {
-    if (d->grid.density != NULL)
-        grid_free(&d->grid);
+    grid_free(&d->grid);
     free(d->rgb);
     rbf_free(&d->rbf);
     octfit_free(&d->octree);
@@ -50,6 +49,9 @@ static uint64_t get_u64(const uint8_t *p)
 typedef struct {
     const argil_doc_t *d;
     size_t n; /* samples */
+    int32_t dims[3], lo[3];           /* the dense box written: the grid's bounds */
+    const float *dens;                /* its densities */
+    const float *mat[GRID_MAT_N];     /* its painted channels (NULL: unpainted) */
     uint32_t mat_runs[GRID_MAT_N];    /* MTLS runs per painted channel (0: not written) */
     uint64_t mat_samples[GRID_MAT_N]; /* samples inside those runs */
 } af_wctx_t;
@@ -172,6 +174,13 @@ static uint64_t af_octb_bytes(const octfit_model_t *m)
     return 40u + 4u * (uint64_t)m->n_nodes + 4u * OCTFIT_NCOEF * (uint64_t)m->n_leaves;
 }
 
+static void af_wctx_free(af_wctx_t *c)
+{
+    free((void *)c->dens);
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        free((void *)c->mat[ch]);
+}
+
 static const char *af_write_body(FILE *f, const void *vctx)
 {
     const af_wctx_t *c = vctx;
@@ -202,13 +211,13 @@ static const char *af_write_body(FILE *f, const void *vctx)
     uint8_t b[64];
     af_begin(&o, "GRID", af_grid_bytes(c->n));
     for (int a = 0; a < 3; a++)
-        io_put_u32le(b + 4 * a, (uint32_t)g->dims[a]);
-    const float gf[6] = {g->spacing_m, g->origin_m.x, g->origin_m.y, g->origin_m.z, g->iso,
-                         g->band_m};
+        io_put_u32le(b + 4 * a, (uint32_t)c->dims[a]);
+    const vec3_t org = grid_box_origin(g, c->lo);
+    const float gf[6] = {g->spacing_m, org.x, org.y, org.z, g->iso, g->band_m};
     for (int k = 0; k < 6; k++)
         io_put_f32le(b + 12 + 4 * k, gf[k]);
     af_put(&o, b, 36);
-    af_put_f32s(&o, g->density, c->n);
+    af_put_f32s(&o, c->dens, c->n);
     af_end(&o);
 
     af_begin(&o, "MATL", 20);
@@ -250,7 +259,7 @@ static const char *af_write_body(FILE *f, const void *vctx)
             io_put_u32le(b, (uint32_t)ch);
             io_put_u32le(b + 4, c->mat_runs[ch]);
             af_put(&o, b, 8);
-            const float *mv = g->mat[ch], def = grid_mat_default((grid_mat_t)ch);
+            const float *mv = c->mat[ch], def = grid_mat_default((grid_mat_t)ch);
             size_t pos = 0, r0, r1;
             while (af_next_run(mv, c->n, def, &pos, &r0, &r1)) {
                 io_put_u32le(b, (uint32_t)r0);
@@ -311,17 +320,36 @@ static bool af_finite(const float *v, size_t n)
     return true;
 }
 
+static argil_err_t af_write_ctx(const char *path, af_wctx_t *cp, char *err, size_t err_len);
+
 argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, size_t err_len)
 {
-    if (path == NULL || d == NULL || d->grid.density == NULL) {
+    if (path == NULL || d == NULL || grid_count(&d->grid) == 0) {
         io_err(err, err_len, "argil_file_write: no path or no model grid");
         return ARGIL_ERR_ARG;
     }
     const grid_t *g = &d->grid;
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    af_wctx_t c = {d, grid_count(g), {0}, {0}, NULL, {NULL}, {0}, {0}};
+    float *dens = grid_dense_copy(g, GRID_DENSITY, c.lo, c.dims);
+    if (dens == NULL) {
+        io_err(err, err_len, "argil_file_write: %s: out of memory", path);
+        return ARGIL_ERR_NOMEM;
+    }
+    c.dens = dens;
+    const argil_err_t e = af_write_ctx(path, &c, err, err_len);
+    af_wctx_free(&c);
+    return e;
+}
+
+static argil_err_t af_write_ctx(const char *path, af_wctx_t *cp, char *err, size_t err_len)
+{
+    af_wctx_t c = *cp;
+    const argil_doc_t *d = c.d;
+    const grid_t *g = &d->grid;
+    const size_t n = c.n;
     const float gf[6] = {g->spacing_m, g->origin_m.x, g->origin_m.y, g->origin_m.z, g->iso,
                          g->band_m};
-    if (!af_finite(gf, 6) || !af_finite(g->density, n) ||
+    if (!af_finite(gf, 6) || !af_finite(c.dens, n) ||
         (d->has_rbf && (!af_finite(d->rbf.centre_m, 3 * (size_t)d->rbf.n) ||
                         !af_finite(d->rbf.weight, d->rbf.n) || !af_finite(d->rbf.poly, 4)))) {
         io_err(err, err_len, "argil_file_write: %s: the model holds NaN or Inf", path);
@@ -344,11 +372,16 @@ argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, 
         io_err(err, err_len, "argil_file_write: %s: RBF has too many centres", path);
         return ARGIL_ERR_ARG;
     }
-    af_wctx_t c = {d, n, {0}, {0}};
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        const float *m = g->mat[ch];
-        if (m == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
+        int32_t mlo[3], mn[3];
+        float *m = grid_dense_copy_mat(g, (grid_mat_t)ch, mlo, mn);
+        if (m == NULL) {
+            io_err(err, err_len, "argil_file_write: %s: out of memory", path);
+            return ARGIL_ERR_NOMEM;
+        }
+        c.mat[ch] = cp->mat[ch] = m;
         for (size_t i = 0; i < n; i++)
             if (!grid_mat_valid((grid_mat_t)ch, m[i])) {
                 io_err(err, err_len, "argil_file_write: %s: painted material channel %d holds "
@@ -410,11 +443,28 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     }
     d->grid.iso = gf[4];
     d->grid.band_m = gf[5];
+    float *v = malloc((size_t)n * sizeof(float));
+    if (v == NULL) {
+        io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
+               (unsigned long long)n);
+        return ARGIL_ERR_NOMEM;
+    }
     for (size_t i = 0; i < (size_t)n; i++) {
-        const float v = io_get_f32le(p + 36 + 4 * i);
-        if (!isfinite(v) || v < 0.0f || v > 1.0f)
+        v[i] = io_get_f32le(p + 36 + 4 * i);
+        if (!isfinite(v[i]) || v[i] < 0.0f || v[i] > 1.0f) {
+            free(v);
             return af_fail(c, off + 36 + 4 * i, "GRID density not a finite number in [0, 1]");
-        d->grid.density[i] = d->grid.rest[i] = v;
+        }
+    }
+    const int32_t zero[3] = {0, 0, 0};
+    argil_err_t e = grid_write_box(&d->grid, GRID_DENSITY, zero, dims, v);
+    if (e == ARGIL_OK)
+        e = grid_write_box(&d->grid, GRID_REST, zero, dims, v);
+    free(v);
+    if (e != ARGIL_OK) {
+        io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
+               (unsigned long long)n);
+        return e;
     }
     return ARGIL_OK;
 }
@@ -524,7 +574,8 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
             at += 8 + 4 * count;
         }
         /* ... then store them. */
-        float *m = grid_mat_alloc(&d->grid, (grid_mat_t)ch);
+        int32_t mlo[3], mn[3];
+        float *m = grid_dense_copy_mat(&d->grid, (grid_mat_t)ch, mlo, mn);
         if (m == NULL) {
             io_err(c->err, c->err_len, "%s: out of memory", c->path);
             return ARGIL_ERR_NOMEM;
@@ -533,6 +584,12 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
             const size_t start = io_get_u32le(p + q), count = io_get_u32le(p + q + 4);
             af_get_f32s(p + q + 8, m + start, count);
             q += 8 + 4 * (uint64_t)count;
+        }
+        const argil_err_t we = grid_mat_write_box(&d->grid, (grid_mat_t)ch, mlo, mn, m);
+        free(m);
+        if (we != ARGIL_OK) {
+            io_err(c->err, c->err_len, "%s: out of memory", c->path);
+            return we;
         }
     }
     if (at != len)
@@ -674,7 +731,7 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
     if (!seen_grid)
         return af_fail(c, ARGIL_FILE_HEADER_BYTES, "no GRID section (the model)");
     d->grid.material = matl;
-    const size_t n = (size_t)d->grid.dims[0] * (size_t)d->grid.dims[1] * (size_t)d->grid.dims[2];
+    const size_t n = grid_count(&d->grid);
     if (colr != NULL) {
         if (colr_len != 3u * (uint64_t)n)
             return af_fail(c, colr_off, "COLR section is not 3 bytes per GRID sample");

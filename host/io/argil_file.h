@@ -38,7 +38,7 @@ typedef struct {
 
 typedef struct {
     grid_t grid;            /* densities (rest = density on load), material, iso, band, and
-                             * the painted material channels grid.mat (section MTLS) */
+                             * the painted material channels (section MTLS) */
     uint8_t *rgb;           /* 3 per sample, or NULL */
     argil_tool_settings_t tool;
     argil_state_t state;

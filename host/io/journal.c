@@ -177,6 +177,62 @@ static bool doc_set_rgb(argil_doc_t *doc, const uint8_t *rgb, size_t n)
 
 /* ---- the model as a journal holds it ---- */
 
+/* True when g can be journalled by j: its bounds lie within the journal's box [lo, lo + dims). */
+static bool journal_fits(const journal_t *j, const grid_t *g)
+{
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        if (lo[a] < j->lo[a] || hi[a] > j->lo[a] + j->dims[a])
+            return false;
+    return true;
+}
+
+static void dense_all_free(float **dens, float *mat[GRID_MAT_N], uint8_t **rgb)
+{
+    free(*dens);
+    *dens = NULL;
+    free(*rgb);
+    *rgb = NULL;
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        free(mat[ch]);
+        mat[ch] = NULL;
+    }
+}
+
+/* Dense copies over [zero, zero + dims) of g's densities, of each painted channel (NULL =
+ * unpainted) and of its colour (3 bytes per sample; NULL = never painted). */
+static argil_err_t grid_dense_all(const grid_t *g, const int32_t zero[3], const int32_t dims[3],
+                                  float **dens, float *mat[GRID_MAT_N], uint8_t **rgb)
+{
+    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    *rgb = NULL;
+    *dens = malloc(n * sizeof(float));
+    if (*dens == NULL)
+        return ARGIL_ERR_NOMEM;
+    grid_read_box(g, GRID_DENSITY, zero, dims, *dens);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        mat[ch] = NULL;
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
+            continue;
+        mat[ch] = malloc(n * sizeof(float));
+        if (mat[ch] == NULL) {
+            dense_all_free(dens, mat, rgb);
+            return ARGIL_ERR_NOMEM;
+        }
+        grid_mat_read_box(g, (grid_mat_t)ch, zero, dims, mat[ch]);
+    }
+    if (grid_rgb_any(g)) {
+        *rgb = malloc(3 * n);
+        if (*rgb == NULL) {
+            dense_all_free(dens, mat, rgb);
+            return ARGIL_ERR_NOMEM;
+        }
+        grid_rgb_read_box(g, zero, dims, *rgb);
+    }
+    return ARGIL_OK;
+}
+
 argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
                               float *const mat[GRID_MAT_N], argil_doc_t *doc)
 {
@@ -184,17 +240,20 @@ argil_err_t journal_model_doc(const journal_info_t *info, const float *density,
     argil_err_t e = grid_init(&doc->grid, info->dims, info->spacing_m, info->origin_m);
     if (e != ARGIL_OK)
         return e;
-    const size_t n = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
-    memcpy(doc->grid.density, density, n * sizeof(float));
+    const int32_t zero[3] = {0, 0, 0};
+    e = grid_write_box(&doc->grid, GRID_DENSITY, zero, info->dims, density);
+    if (e != ARGIL_OK)
+        return e;
     for (int ch = 0; mat != NULL && ch < GRID_MAT_N; ch++) {
         if (mat[ch] == NULL)
             continue;
-        float *m = grid_mat_alloc(&doc->grid, (grid_mat_t)ch);
-        if (m == NULL)
-            return ARGIL_ERR_NOMEM;
-        memcpy(m, mat[ch], n * sizeof(float));
+        e = grid_mat_write_box(&doc->grid, (grid_mat_t)ch, zero, info->dims, mat[ch]);
+        if (e != ARGIL_OK)
+            return e;
     }
-    memcpy(doc->grid.rest, density, n * sizeof(float));
+    e = grid_write_box(&doc->grid, GRID_REST, zero, info->dims, density);
+    if (e != ARGIL_OK)
+        return e;
     doc->grid.iso = info->iso;
     doc->grid.band_m = info->band_m;
     doc->grid.material = info->material;
@@ -219,19 +278,23 @@ static void writer_info(const journal_t *j, uint32_t edits, journal_info_t *info
 argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
                                 const char *path, char *err, size_t err_len)
 {
-    if ((g == NULL && j->shadow == NULL) ||
-        (g != NULL && (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] ||
-                       g->dims[2] != j->dims[2] || g->density == NULL))) {
+    if ((g == NULL && j->shadow == NULL) || (g != NULL && !journal_fits(j, g))) {
         io_err(err, err_len, "%s: the journal holds no model (or not this grid's)", path);
         return ARGIL_ERR_STATE;
     }
     journal_info_t info;
     writer_info(j, edits, &info);
     argil_doc_t doc;
-    argil_err_t e = g != NULL ? journal_model_doc(&info, g->density, g->mat, &doc)
-                              : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
-    if (e == ARGIL_OK && !doc_set_rgb(&doc, g != NULL ? g->rgb : j->rgb_shadow, j->n))
+    argil_doc_init(&doc);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
+    argil_err_t e = g != NULL ? grid_dense_all(g, j->lo, j->dims, &dens, mat, &rgb) : ARGIL_OK;
+    if (e == ARGIL_OK)
+        e = g != NULL ? journal_model_doc(&info, dens, mat, &doc)
+                      : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
+    if (e == ARGIL_OK && !doc_set_rgb(&doc, g != NULL ? rgb : j->rgb_shadow, j->n))
         e = ARGIL_ERR_NOMEM;
+    dense_all_free(&dens, mat, &rgb);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", path);
         argil_doc_free(&doc);
@@ -334,29 +397,34 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
     memset(j, 0, sizeof(*j));
     j->fd = -1;
     if (!(cfg->autosave_s > 0.0f) || !(cfg->checkpoint_s > 0.0f) || cfg->checkpoint_bytes == 0 ||
-        g->density == NULL) {
+        grid_count(g) == 0) {
         io_err(err, err_len, "journal: autosave and checkpoint intervals must be > 0");
         return ARGIL_ERR_ARG;
     }
     j->cfg = *cfg;
-    for (int a = 0; a < 3; a++)
-        j->dims[a] = g->dims[a];
+    int32_t glo[3], ghi[3];
+    grid_bounds(g, glo, ghi);
+    for (int a = 0; a < 3; a++) {
+        j->lo[a] = glo[a];
+        j->dims[a] = ghi[a] - glo[a];
+    }
     j->spacing_m = g->spacing_m;
-    j->origin_m = g->origin_m;
+    j->origin_m = grid_box_origin(g, glo);
     j->iso = g->iso;
     j->band_m = g->band_m;
     j->material = g->material;
-    j->n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    j->n = (size_t)j->dims[0] * (size_t)j->dims[1] * (size_t)j->dims[2];
     j->dir = strdup(dir);
     j->shadow = malloc(j->n * sizeof(float));
-    if (j->dir == NULL || j->shadow == NULL) {
+    j->cur = malloc(j->n * sizeof(float));
+    if (j->dir == NULL || j->shadow == NULL || j->cur == NULL || !journal_fits(j, g)) {
         io_err(err, err_len, "%s: out of memory for the journal", dir);
         journal_close(j);
         return ARGIL_ERR_NOMEM;
     }
-    memcpy(j->shadow, g->density, j->n * sizeof(float));
+    grid_read_box(g, GRID_DENSITY, j->lo, j->dims, j->shadow);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (g->mat[ch] == NULL)
+        if (!grid_mat_painted(g, (grid_mat_t)ch))
             continue;
         j->mat_shadow[ch] = malloc(j->n * sizeof(float));
         if (j->mat_shadow[ch] == NULL) {
@@ -364,17 +432,17 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
             journal_close(j);
             return ARGIL_ERR_NOMEM;
         }
-        memcpy(j->mat_shadow[ch], g->mat[ch], j->n * sizeof(float));
+        grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->mat_shadow[ch]);
     }
     j->mat_writes = g->mat_writes;
-    if (g->rgb != NULL) {
+    if (grid_rgb_any(g)) {
         j->rgb_shadow = malloc(3 * j->n);
         if (j->rgb_shadow == NULL) {
             io_err(err, err_len, "%s: out of memory for the journal", dir);
             journal_close(j);
             return ARGIL_ERR_NOMEM;
         }
-        memcpy(j->rgb_shadow, g->rgb, 3 * j->n);
+        grid_rgb_read_box(g, j->lo, j->dims, j->rgb_shadow);
     }
     j->rgb_writes = g->rgb_writes;
     if (journal_exists(dir)) {
@@ -576,6 +644,90 @@ static bool put_rgb_runs(journal_t *j, const uint8_t *rgb, uint32_t *runs)
     return true;
 }
 
+/* Fetches into cur the grid's current values of the samples [from, to) (journal indices) that
+ * lie outside the box [lo, hi) read for a record (a run bridges them). */
+static void bridge_outside(journal_t *j, const grid_t *g, const int32_t lo[3], const int32_t hi[3],
+                           size_t from, size_t to)
+{
+    const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
+    for (size_t i = from; i < to; i++) {
+        const int32_t s[3] = {(int32_t)(i % nx), (int32_t)(i / nx % ny), (int32_t)(i / (nx * ny))};
+        bool in = true;
+        for (int a = 0; a < 3; a++)
+            in = in && s[a] >= lo[a] && s[a] < hi[a];
+        if (!in)
+            j->cur[i] =
+                grid_get(g, GRID_DENSITY, j->lo[0] + s[0], j->lo[1] + s[1], j->lo[2] + s[2]);
+    }
+}
+
+/* The clay grew past the journal's box: everything buffered is written, the shadows take the
+ * whole grid over its new bounds and a checkpoint makes that the new base (header and base file
+ * with the new box). */
+static argil_err_t journal_rebase(journal_t *j, const grid_t *g, uint32_t edits, double sim_s,
+                                  char *err, size_t err_len)
+{
+    argil_err_t e = journal_sync(j, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    /* The new box: the old one and the bounds, with room to grow on every side that grew (so a
+     * growing stroke rebases every JOURNAL_GROW_SAMPLES, not every sample). */
+    int32_t glo[3], ghi[3], dims[3];
+    grid_bounds(g, glo, ghi);
+    for (int a = 0; a < 3; a++) {
+        const int32_t olo = j->lo[a], ohi = j->lo[a] + j->dims[a];
+        glo[a] = glo[a] < olo ? glo[a] - JOURNAL_GROW_SAMPLES : olo;
+        ghi[a] = ghi[a] > ohi ? ghi[a] + JOURNAL_GROW_SAMPLES : ohi;
+        dims[a] = ghi[a] - glo[a];
+    }
+    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    float *sh = malloc(n * sizeof(float)), *cur = malloc(n * sizeof(float));
+    float *msh[GRID_MAT_N] = {NULL};
+    uint8_t *rsh = grid_rgb_any(g) ? malloc(3 * n) : NULL;
+    bool ok = sh != NULL && cur != NULL && (rsh != NULL || !grid_rgb_any(g));
+    for (int ch = 0; ok && ch < GRID_MAT_N; ch++)
+        if (grid_mat_painted(g, (grid_mat_t)ch)) {
+            msh[ch] = malloc(n * sizeof(float));
+            ok = msh[ch] != NULL;
+        }
+    if (!ok) {
+        free(sh);
+        free(cur);
+        free(rsh);
+        for (int ch = 0; ch < GRID_MAT_N; ch++)
+            free(msh[ch]);
+        io_err(err, err_len, "%s: out of memory for the journal of the grown clay", j->dir);
+        return ARGIL_ERR_NOMEM;
+    }
+    grid_read_box(g, GRID_DENSITY, glo, dims, sh);
+    for (int ch = 0; ch < GRID_MAT_N; ch++) {
+        if (msh[ch] != NULL)
+            grid_mat_read_box(g, (grid_mat_t)ch, glo, dims, msh[ch]);
+        free(j->mat_shadow[ch]);
+        j->mat_shadow[ch] = msh[ch];
+    }
+    if (rsh != NULL)
+        grid_rgb_read_box(g, glo, dims, rsh);
+    free(j->rgb_shadow);
+    j->rgb_shadow = rsh;
+    j->rgb_writes = g->rgb_writes;
+    free(j->shadow);
+    free(j->cur);
+    j->shadow = sh;
+    j->cur = cur;
+    for (int a = 0; a < 3; a++) {
+        j->lo[a] = glo[a];
+        j->dims[a] = dims[a];
+    }
+    j->n = n;
+    j->origin_m = grid_box_origin(g, glo);
+    j->material = g->material;
+    j->mat_writes = g->mat_writes;
+    j->edits = edits;
+    j->stats.rebases++;
+    return journal_checkpoint(j, sim_s, err, err_len);
+}
+
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len)
@@ -585,20 +737,45 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         io_err(err, err_len, "journal: not open (or stopped by an earlier failure)");
         return ARGIL_ERR_STATE;
     }
-    if (g->dims[0] != j->dims[0] || g->dims[1] != j->dims[1] || g->dims[2] != j->dims[2]) {
-        io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
-        return ARGIL_ERR_ARG;
+    if (!journal_fits(j, g)) {
+        if (g->spacing_m != j->spacing_m) {
+            io_err(err, err_len, "journal: the grid is not the one the journal was opened on");
+            return ARGIL_ERR_ARG;
+        }
+        const argil_err_t re = journal_rebase(j, g, edits, sim_s, err, err_len);
+        *appended = re == ARGIL_OK;
+        return re;
     }
     const bool material_changed = !same_bits(&g->material, &j->material, sizeof(j->material));
     /* The box to compare, clipped to the grid. */
     int32_t lo[3] = {0, 0, 0}, hi[3] = {j->dims[0], j->dims[1], j->dims[2]};
     if (box != NULL) {
-        for (int a = 0; a < 3; a++) {
-            lo[a] = box->lo[a] < 0 ? 0 : (box->lo[a] > j->dims[a] ? j->dims[a] : box->lo[a]);
-            hi[a] = box->hi[a] < lo[a] ? lo[a] : (box->hi[a] > j->dims[a] ? j->dims[a] : box->hi[a]);
+        for (int a = 0; a < 3; a++) { /* into the journal's own indices */
+            const int64_t bl = (int64_t)box->lo[a] - j->lo[a], bh = (int64_t)box->hi[a] - j->lo[a];
+            lo[a] = bl < 0 ? 0 : (bl > j->dims[a] ? j->dims[a] : (int32_t)bl);
+            hi[a] = bh < lo[a] ? lo[a] : (bh > j->dims[a] ? j->dims[a] : (int32_t)bh);
         }
     }
     const size_t x0 = (size_t)lo[0], x1 = (size_t)hi[0];
+    /* The grid's densities in the box, read in one go and laid into cur row by row (the
+     * samples a run bridges outside the box are fetched when bridged: bridge_outside). */
+    if (x1 > x0 && hi[1] > lo[1] && hi[2] > lo[2]) {
+        const int32_t blo[3] = {j->lo[0] + lo[0], j->lo[1] + lo[1], j->lo[2] + lo[2]};
+        const int32_t bn[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+        float *box_d = malloc((size_t)bn[0] * (size_t)bn[1] * (size_t)bn[2] * sizeof(float));
+        if (box_d == NULL) {
+            io_err(err, err_len, "%s: out of memory for journal records", j->dir);
+            return ARGIL_ERR_NOMEM; /* nothing written yet: the journal goes on */
+        }
+        grid_read_box(g, GRID_DENSITY, blo, bn, box_d);
+        const float *src = box_d;
+        for (int32_t z = lo[2]; z < hi[2]; z++)
+            for (int32_t y = lo[1]; y < hi[1]; y++, src += bn[0])
+                memcpy(j->cur + (size_t)j->dims[0] * ((size_t)y + (size_t)j->dims[1] * (size_t)z) + x0,
+                       src, (size_t)bn[0] * sizeof(float));
+        free(box_d);
+    }
+    const float *gd = j->cur;
     const size_t rec_at = j->buf_len;
     if (!reserve(j, 4 + JOURNAL_RECORD_HEAD_BYTES))
         goto nomem;
@@ -609,7 +786,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
     for (int32_t z = lo[2]; z < hi[2] && x1 > x0; z++) {
         for (int32_t y = lo[1]; y < hi[1]; y++) {
             const size_t r0 = ((size_t)y + (size_t)j->dims[1] * (size_t)z) * (size_t)j->dims[0];
-            const float *d = g->density + r0, *s = j->shadow + r0;
+            const float *d = gd + r0, *s = j->shadow + r0;
             if (same_bits(d + x0, s + x0, (x1 - x0) * sizeof(float)))
                 continue;
             for (size_t x = x0; x < x1; x++) {
@@ -617,11 +794,13 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
                     continue;
                 const size_t i = r0 + x;
                 if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
-                    run_end = i + 1; /* bridged samples are written with their current values */
+                    /* bridged samples are written with their current values */
+                    bridge_outside(j, g, lo, hi, run_end, i);
+                    run_end = i + 1;
                     continue;
                 }
                 if (open_run) {
-                    if (!put_run(j, g->density, run_start, run_end))
+                    if (!put_run(j, gd, run_start, run_end))
                         goto nomem;
                     runs++;
                 }
@@ -632,7 +811,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         }
     }
     if (open_run) {
-        if (!put_run(j, g->density, run_start, run_end))
+        if (!put_run(j, gd, run_start, run_end))
             goto nomem;
         runs++;
     }
@@ -648,9 +827,13 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         j->buf_len += 4;
     }
     if (look_mat) {
-        for (int ch = 0; ch < GRID_MAT_N; ch++)
-            if (!put_mat_block(j, (grid_mat_t)ch, g->mat[ch], &blocks))
+        for (int ch = 0; ch < GRID_MAT_N; ch++) {
+            const bool painted = grid_mat_painted(g, (grid_mat_t)ch);
+            if (painted) /* the density runs are written: cur is free again */
+                grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->cur);
+            if (!put_mat_block(j, (grid_mat_t)ch, painted ? j->cur : NULL, &blocks))
                 goto nomem;
+        }
         j->mat_writes = g->mat_writes;
     }
     if (look_rgb) {
@@ -658,7 +841,17 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         if (!reserve(j, 4))
             goto nomem;
         j->buf_len += 4;
-        if (!put_rgb_runs(j, g->rgb, &rgb_runs))
+        /* The grid's colour over the journal's box (NULL: never painted, the default). */
+        uint8_t *rgb = NULL;
+        if (grid_rgb_any(g)) {
+            rgb = malloc(3 * j->n);
+            if (rgb == NULL)
+                goto nomem;
+            grid_rgb_read_box(g, j->lo, j->dims, rgb);
+        }
+        const bool ok = put_rgb_runs(j, rgb, &rgb_runs);
+        free(rgb);
+        if (!ok)
             goto nomem;
         if (rgb_runs == 0)
             j->buf_len = rgb_at;
@@ -782,6 +975,8 @@ void journal_close(journal_t *j)
     j->fd = -1;
     free(j->dir);
     free(j->shadow);
+    free(j->cur);
+    j->cur = NULL;
     free(j->buf);
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
         free(j->mat_shadow[ch]);
@@ -1030,37 +1225,48 @@ static argil_err_t check_rgb_runs(const uint8_t *p, size_t payload, size_t *off,
     return ARGIL_OK;
 }
 
-/* Applies the checked colour runs at payload offset off to g's rgb. */
-static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, grid_t *g, const char *name,
-                                  char *err, size_t err_len)
+/* Applies the checked colour runs at payload offset off to the n-sample colour *rgb (made, every
+ * sample GRID_RGB_DEFAULT, when absent). */
+static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, uint8_t **rgb, size_t n,
+                                  const char *name, char *err, size_t err_len)
 {
-    if (grid_rgb_alloc(g) == NULL) {
-        io_err(err, err_len, "%s: out of memory for the painted colour", name);
-        return ARGIL_ERR_NOMEM;
+    if (*rgb == NULL) {
+        *rgb = malloc(3 * n);
+        if (*rgb == NULL) {
+            io_err(err, err_len, "%s: out of memory for the painted colour", name);
+            return ARGIL_ERR_NOMEM;
+        }
+        memset(*rgb, (int)GRID_RGB_DEFAULT, 3 * n);
     }
     const uint32_t runs = io_get_u32le(p + off);
     size_t o = off + 4;
     for (uint32_t r = 0; r < runs; r++) {
         const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
-        memcpy(g->rgb + 3 * start, p + o + 8, 3 * count);
+        memcpy(*rgb + 3 * start, p + o + 8, 3 * count);
         o += 8 + 3 * count;
     }
-    g->rgb_writes++;
     return ARGIL_OK;
 }
 
-/* Applies the checked material blocks at payload offset off to g's channels. */
-static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, const char *name,
-                                    char *err, size_t err_len)
+/* Applies the checked material blocks at payload offset off to the n-sample channels mat (an
+ * absent one is made, every sample the default, before it is written). */
+static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, float *mat[GRID_MAT_N],
+                                    size_t n, const char *name, char *err, size_t err_len)
 {
     const uint32_t blocks = io_get_u32le(p + off);
     size_t o = off + 4;
     /* Every channel the record touches exists before anything is written. */
     for (uint32_t k = 0; k < blocks; k++) {
         const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
-        if (grid_mat_alloc(g, (grid_mat_t)ch) == NULL) {
-            io_err(err, err_len, "%s: out of memory for a painted material channel", name);
-            return ARGIL_ERR_NOMEM;
+        if (mat[ch] == NULL) {
+            mat[ch] = malloc(n * sizeof(float));
+            if (mat[ch] == NULL) {
+                io_err(err, err_len, "%s: out of memory for a painted material channel", name);
+                return ARGIL_ERR_NOMEM;
+            }
+            const float def = grid_mat_default((grid_mat_t)ch);
+            for (size_t i = 0; i < n; i++)
+                mat[ch][i] = def;
         }
         o += 8;
         for (uint32_t r = 0; r < runs; r++)
@@ -1069,7 +1275,7 @@ static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, con
     o = off + 4;
     for (uint32_t k = 0; k < blocks; k++) {
         const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
-        float *m = g->mat[ch];
+        float *m = mat[ch];
         o += 8;
         for (uint32_t r = 0; r < runs; r++) {
             const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
@@ -1078,14 +1284,13 @@ static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, grid_t *g, con
             o += 8 + 4 * count;
         }
     }
-    g->mat_writes++;
     return ARGIL_OK;
 }
 
 /* Checks one record's payload (CRC already good) and, with density (and g), applies it. */
 static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, const char *name,
-                                float *density, grid_t *g, size_t n, journal_info_t *info,
-                                char *err, size_t err_len)
+                                float *density, float **mat, uint8_t **rgb, size_t n,
+                                journal_info_t *info, char *err, size_t err_len)
 {
     char why[160];
     const uint32_t rec = info->records + 1u;
@@ -1154,13 +1359,13 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
         return fail(err, err_len, name, at + 4 + off, why);
     }
-    if (type >= 2u && g != NULL && io_get_u32le(p + mat_off) > 0) {
-        const argil_err_t e = apply_mat_blocks(p, mat_off, g, name, err, err_len);
+    if (type >= 2u && mat != NULL && io_get_u32le(p + mat_off) > 0) {
+        const argil_err_t e = apply_mat_blocks(p, mat_off, mat, n, name, err, err_len);
         if (e != ARGIL_OK)
             return e;
     }
-    if (type == 3u && g != NULL) {
-        const argil_err_t e = apply_rgb_runs(p, rgb_off, g, name, err, err_len);
+    if (type == 3u && rgb != NULL) {
+        const argil_err_t e = apply_rgb_runs(p, rgb_off, rgb, n, name, err, err_len);
         if (e != ARGIL_OK)
             return e;
     }
@@ -1185,9 +1390,11 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     return ARGIL_OK;
 }
 
-/* journal_replay with an optional grid for the painted channels (density = g's then). */
+/* journal_replay with optional painted channels (mat[GRID_MAT_N], n samples each) and colour
+ * (*rgb, 3 n bytes, made when a record paints and it is NULL). */
 static argil_err_t replay(const uint8_t *data, size_t len, const char *name, float *density,
-                          size_t n, grid_t *g, journal_info_t *info, char *err, size_t err_len)
+                          size_t n, float **mat, uint8_t **rgb, journal_info_t *info, char *err,
+                          size_t err_len)
 {
     argil_err_t e = journal_header_decode(data, len, name, info, err, err_len);
     if (e != ARGIL_OK)
@@ -1221,8 +1428,8 @@ static argil_err_t replay(const uint8_t *data, size_t len, const char *name, flo
                      info->records + 1u);
             return fail(err, err_len, name, at, why);
         }
-        e = apply_record(data + at + 4, (size_t)payload, at, name, density, g, want, info, err,
-                         err_len);
+        e = apply_record(data + at + 4, (size_t)payload, at, name, density, mat, rgb, want, info,
+                         err, err_len);
         if (e != ARGIL_OK)
             return e;
         at += 8 + (size_t)payload;
@@ -1234,14 +1441,46 @@ static argil_err_t replay(const uint8_t *data, size_t len, const char *name, flo
 argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
                            size_t n, journal_info_t *info, char *err, size_t err_len)
 {
-    return replay(data, len, name, density, n, NULL, info, err, err_len);
+    return replay(data, len, name, density, n, NULL, NULL, info, err, err_len);
 }
 
 argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
                                 journal_info_t *info, char *err, size_t err_len)
 {
-    const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
-    return replay(data, len, name, g->density, n, g, info, err, err_len);
+    int32_t lo[3], hi[3], dims[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        dims[a] = hi[a] - lo[a];
+    const size_t n = grid_count(g);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
+    argil_err_t e = grid_dense_all(g, lo, dims, &dens, mat, &rgb);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return e;
+    }
+    e = replay(data, len, name, dens, n, mat, &rgb, info, err, err_len);
+    /* Even after a bad record (PARSE) the grid takes the model as of the record before it. */
+    argil_err_t we = grid_write_box(g, GRID_DENSITY, lo, dims, dens);
+    bool painted = false;
+    for (int ch = 0; ch < GRID_MAT_N && we == ARGIL_OK; ch++)
+        if (mat[ch] != NULL) {
+            we = grid_mat_write_box(g, (grid_mat_t)ch, lo, dims, mat[ch]);
+            painted = true;
+        }
+    if (painted)
+        g->mat_writes++;
+    if (we == ARGIL_OK && rgb != NULL) {
+        we = grid_rgb_write_box(g, lo, dims, rgb);
+        if (info->rgb_samples > 0)
+            g->rgb_writes++;
+    }
+    dense_all_free(&dens, mat, &rgb);
+    if (we != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return we;
+    }
+    return e;
 }
 
 static argil_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
@@ -1283,6 +1522,8 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     char *path = NULL, *base_path = NULL;
     argil_doc_t b;
     argil_doc_init(&b);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
     argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
     if (e != ARGIL_OK)
         goto out;
@@ -1299,10 +1540,23 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     if (e != ARGIL_OK)
         goto out;
     const grid_t *g = &b.grid;
-    const size_t bn = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    int32_t glo[3], ghi[3], gdims[3];
+    grid_bounds(g, glo, ghi);
+    for (int a = 0; a < 3; a++)
+        gdims[a] = ghi[a] - glo[a];
+    const size_t bn = grid_count(g);
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    const uint32_t crc = model_crc(g->density, g->mat, b.rgb, bn);
+    e = grid_dense_all(g, glo, gdims, &dens, mat, &rgb);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", base_path);
+        goto out;
+    }
+    /* The base's colour (its COLR, dense over the same box) is what the records paint on. */
+    free(rgb);
+    rgb = b.rgb;
+    b.rgb = NULL;
+    const uint32_t crc = model_crc(dens, mat, rgb, bn);
     if (blen != info->base_len || crc != info->base_crc ||
         !same_bits(&g->material, &info->material, sizeof(g->material)) ||
         b.state.edits != info->edits) {
@@ -1315,8 +1569,9 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
-    if (g->dims[0] != info->dims[0] || g->dims[1] != info->dims[1] ||
-        g->dims[2] != info->dims[2] || !same_f32(g->spacing_m, info->spacing_m) ||
+    if (glo[0] != 0 || glo[1] != 0 || glo[2] != 0 || gdims[0] != info->dims[0] ||
+        gdims[1] != info->dims[1] || gdims[2] != info->dims[2] ||
+        !same_f32(g->spacing_m, info->spacing_m) ||
         !same_f32(g->origin_m.x, info->origin_m.x) || !same_f32(g->origin_m.y, info->origin_m.y) ||
         !same_f32(g->origin_m.z, info->origin_m.z) || !same_f32(g->iso, info->iso) ||
         !same_f32(g->band_m, info->band_m)) {
@@ -1324,15 +1579,12 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         e = ARGIL_ERR_PARSE;
         goto out;
     }
-    /* The base's colour becomes the grid's, which the records then paint on. */
-    b.grid.rgb = b.rgb;
-    b.rgb = NULL;
-    e = journal_replay_grid(data, len, path, &b.grid, info, err, err_len);
+    e = replay(data, len, path, dens, bn, mat, &rgb, info, err, err_len);
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         goto out;
-    /* After a bad record (PARSE) the grid holds the model as of the record before it. */
-    argil_err_t me = journal_model_doc(info, b.grid.density, b.grid.mat, doc);
-    if (me == ARGIL_OK && !doc_set_rgb(doc, b.grid.rgb, bn))
+    /* After a bad record (PARSE) the arrays hold the model as of the record before it. */
+    argil_err_t me = journal_model_doc(info, dens, mat, doc);
+    if (me == ARGIL_OK && !doc_set_rgb(doc, rgb, bn))
         me = ARGIL_ERR_NOMEM;
     if (me != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the recovered model", path);
@@ -1341,8 +1593,9 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
 out:
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
         argil_doc_free(doc);
-    else if (e == ARGIL_ERR_PARSE && doc->grid.density == NULL)
+    else if (e == ARGIL_ERR_PARSE && grid_count(&doc->grid) == 0)
         argil_doc_free(doc);
+    dense_all_free(&dens, mat, &rgb);
     argil_doc_free(&b);
     free(data);
     free(path);

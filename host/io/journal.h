@@ -23,6 +23,7 @@
 #define JOURNAL_BASE_NAME_MAX 60u          /* bytes for the base file's name in the header */
 #define JOURNAL_FILE "journal.log"         /* inside the session's output directory */
 #define JOURNAL_BASE_PREFIX "journal-base-" /* + checkpoint number + ".argil" */
+#define JOURNAL_GROW_SAMPLES 16   /* room added on a side the clay grew past (journal_rebase) */
 #define JOURNAL_RUN_GAP 2u                 /* unchanged samples bridged inside one run */
 #define JOURNAL_RGB_CRC_ID 4u              /* the colour's id in the base identity CRC */
 
@@ -37,6 +38,7 @@ typedef struct {
     uint64_t bytes;           /* record bytes appended */
     uint32_t syncs;           /* write + fdatasync rounds */
     uint32_t checkpoints;     /* rotations onto a new base */
+    uint32_t rebases;         /* of them, because the clay grew past the journal's box */
     uint64_t samples;         /* sample values journaled */
     uint64_t mat_samples;     /* painted material values journaled */
     uint64_t rgb_samples;     /* painted colour samples (3 bytes each) journaled */
@@ -48,10 +50,12 @@ typedef struct {
     char *dir;
     int fd;
     int32_t dims[3];
+    int32_t lo[3];            /* grid sample index of the journal's sample 0 (its box's corner) */
     float spacing_m, iso, band_m;
-    vec3_t origin_m;
+    vec3_t origin_m;          /* model-space position of sample lo */
     size_t n;                 /* samples */
     float *shadow;            /* density as of the last record */
+    float *cur;               /* scratch: the grid's samples read for a record (n floats) */
     float *mat_shadow[GRID_MAT_N]; /* painted channels as of the last record (NULL: never
                                * painted, all grid_mat_default) */
     uint32_t mat_writes;      /* the grid's mat_writes when its channels were last compared */
@@ -111,7 +115,10 @@ typedef struct {
  * differ from the last record (buffered; *appended says whether one was made). Only densities
  * inside box are compared when box is not NULL: the caller promises nothing changed outside it;
  * the painted channels are compared whole when box is NULL or the grid's mat_writes moved, the
- * colour when box is NULL or rgb_writes moved. edits counts the session's edit steps. */
+ * colour when box is NULL or rgb_writes moved. edits counts the session's edit steps. When the
+ * grid's bounds have grown past the journal's box (the clay grew) the journal rotates onto a new
+ * base snapshot of the whole grid over its new bounds (a checkpoint) instead, and *appended is
+ * true. */
 argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *box,
                            uint32_t edits, double sim_s, double real_s, uint64_t wall_ms,
                            bool *appended, char *err, size_t err_len);

@@ -34,6 +34,8 @@ void mc_blocks_free(mc_blocks_t *b)
     free(b->dirty);
     free(b->tab);
     free(b->val);
+    free(b->rd);
+    free(b->rdc);
     free(b->ins);
     free(b->col);
     free(b->cache);
@@ -69,10 +71,13 @@ argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_
     b->dirty = malloc(b->n_blocks);
     b->tab = malloc(sizeof(*b->tab));
     b->val = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
+    b->rd = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
+    b->rdc = malloc(3 * MCB_L * MCB_L * MCB_L);
     b->ins = malloc(MCB_L * MCB_L * MCB_L);
     b->col = malloc(3 * MCB_L * MCB_L * MCB_L);
     b->cache = malloc(sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C);
     if (b->blocks == NULL || b->dirty == NULL || b->tab == NULL || b->val == NULL ||
+        b->rd == NULL || b->rdc == NULL ||
         b->ins == NULL || b->col == NULL || b->cache == NULL) {
         mc_blocks_free(b);
         return ARGIL_ERR_NOMEM;
@@ -160,6 +165,9 @@ typedef struct {
     mc_block_mesh_t *k;
     int32_t c0[3], nc[3]; /* first padded cell and cell count per axis */
     const uint8_t *rgb;
+    mc_read_fn read;     /* NULL: density is the whole field's array */
+    mc_read_rgb_fn read_rgb; /* colours through a reader (rgb NULL then) */
+    const void *ctx;
 } mcb_job_t;
 
 /* Scratch index of padded sample p (global padded coordinates). */
@@ -177,7 +185,8 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
     const int32_t *d = b->dims;
     memset(b->val, 0, sizeof(float) * MCB_L * MCB_L * MCB_L);
     memset(b->ins, 0, MCB_L * MCB_L * MCB_L);
-    if (j->rgb != NULL)
+    const bool colour = j->rgb != NULL || j->read_rgb != NULL;
+    if (colour)
         memset(b->col, 0, 3 * MCB_L * MCB_L * MCB_L);
     /* original sample o = padded - 1; scratch index l = padded - c0 + 1 */
     const int32_t o0[3] = {j->c0[0] - 2, j->c0[1] - 2, j->c0[2] - 2};
@@ -185,6 +194,23 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
     int32_t xlo = o0[0] < 0 ? 0 : o0[0];
     int32_t xhi = o0[0] + n_l[0] > d[0] ? d[0] : o0[0] + n_l[0];
     unsigned seen_in = 0, seen_out = 0;
+    /* Through a reader: the box of the field the scratch covers, read once, then rows of it. */
+    int32_t rlo[3] = {xlo, 0, 0}, rn[3] = {xhi - xlo, 0, 0};
+    if (j->read != NULL) {
+        for (int a = 1; a < 3; a++) {
+            const int32_t l = o0[a] < 0 ? 0 : o0[a];
+            const int32_t h = o0[a] + n_l[a] > d[a] ? d[a] : o0[a] + n_l[a];
+            rlo[a] = l;
+            rn[a] = h - l;
+        }
+        if (rn[0] <= 0 || rn[1] <= 0 || rn[2] <= 0) {
+            *mixed = false;
+            return true; /* the whole scratch lies beyond the field: all outside */
+        }
+        j->read(j->ctx, rlo, rn, b->rd);
+        if (j->read_rgb != NULL)
+            j->read_rgb(j->ctx, rlo, rn, b->rdc);
+    }
     for (int32_t lz = 0; lz < n_l[2]; lz++) {
         const int32_t oz = o0[2] + lz;
         if (oz < 0 || oz >= d[2])
@@ -195,8 +221,13 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
                 continue;
             const size_t src = (size_t)d[0] * ((size_t)oy + (size_t)d[1] * (size_t)oz);
             const size_t dst = MCB_L * ((size_t)ly + MCB_L * (size_t)lz);
+            const float *row =
+                j->read != NULL
+                    ? b->rd + (size_t)rn[0] * ((size_t)(oy - rlo[1]) +
+                                               (size_t)rn[1] * (size_t)(oz - rlo[2]))
+                    : density + src + xlo;
             for (int32_t ox = xlo; ox < xhi; ox++) {
-                const float v = density[src + (size_t)ox];
+                const float v = row[ox - xlo];
                 if (!isfinite(v))
                     return false;
                 b->val[dst + (size_t)(ox - o0[0])] = v;
@@ -204,6 +235,11 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
             }
             if (j->rgb != NULL)
                 memcpy(b->col + 3 * (dst + (size_t)(xlo - o0[0])), j->rgb + 3 * (src + (size_t)xlo),
+                       3 * (size_t)(xhi - xlo));
+            else if (j->read_rgb != NULL)
+                memcpy(b->col + 3 * (dst + (size_t)(xlo - o0[0])),
+                       b->rdc + 3 * (size_t)rn[0] * ((size_t)(oy - rlo[1]) +
+                                                     (size_t)rn[1] * (size_t)(oz - rlo[2])),
                        3 * (size_t)(xhi - xlo));
         }
     }
@@ -242,7 +278,8 @@ static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint
     vec3_t pos, n;
     mc_edge_point(b->origin_m, b->spacing_m, b->iso, p, a, d0, d1, mcb_gradient(j, p),
                   mcb_gradient(j, p1), &pos, &n);
-    argil_err_t e = mcb_grow_vert(k, j->rgb != NULL);
+    const bool colour = j->rgb != NULL || j->read_rgb != NULL;
+    argil_err_t e = mcb_grow_vert(k, colour);
     if (e != ARGIL_OK)
         return e;
     const uint32_t v = k->n_vert++;
@@ -253,7 +290,7 @@ static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint
     nn[0] = n.x;
     nn[1] = n.y;
     nn[2] = n.z;
-    if (j->rgb != NULL) {
+    if (colour) {
         const uint8_t *c = b->col + 3 * (d0 > b->iso ? i0 : i1); /* the inside end's paint */
         memcpy(k->rgb + 3 * (size_t)v, c, 3);
     }
@@ -317,13 +354,40 @@ static argil_err_t mcb_cells(mcb_job_t *j)
     return ARGIL_OK;
 }
 
+static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_t *rgb,
+                              mc_read_fn read, mc_read_rgb_fn read_rgb, const void *ctx);
+
 argil_err_t mc_blocks_update(mc_blocks_t *b, const float *density, const uint8_t *rgb)
 {
-    if (b == NULL || b->blocks == NULL || density == NULL)
+    if (density == NULL)
         return ARGIL_ERR_ARG;
-    if ((rgb != NULL) != (b->has_rgb != 0)) {
+    return mcb_update(b, density, rgb, NULL, NULL, NULL);
+}
+
+argil_err_t mc_blocks_update_read(mc_blocks_t *b, mc_read_fn read, const void *ctx)
+{
+    if (read == NULL)
+        return ARGIL_ERR_ARG;
+    return mcb_update(b, NULL, NULL, read, NULL, ctx);
+}
+
+argil_err_t mc_blocks_update_read_rgb(mc_blocks_t *b, mc_read_fn read, mc_read_rgb_fn read_rgb,
+                                      const void *ctx)
+{
+    if (read == NULL)
+        return ARGIL_ERR_ARG;
+    return mcb_update(b, NULL, NULL, read, read_rgb, ctx);
+}
+
+static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_t *rgb,
+                              mc_read_fn read, mc_read_rgb_fn read_rgb, const void *ctx)
+{
+    if (b == NULL || b->blocks == NULL)
+        return ARGIL_ERR_ARG;
+    const bool colour = rgb != NULL || read_rgb != NULL;
+    if (colour != (b->has_rgb != 0)) {
         mc_blocks_mark_all(b);
-        b->has_rgb = rgb != NULL;
+        b->has_rgb = colour;
     }
     b->blocks_meshed = 0;
     b->cells_meshed = 0;
@@ -333,7 +397,7 @@ argil_err_t mc_blocks_update(mc_blocks_t *b, const float *density, const uint8_t
             for (int32_t bx = 0; bx < b->nblk[0]; bx++, bi++) {
                 if (!b->dirty[bi])
                     continue;
-                mcb_job_t j = {b, &b->blocks[bi], {0}, {0}, rgb};
+                mcb_job_t j = {b, &b->blocks[bi], {0}, {0}, rgb, read, read_rgb, ctx};
                 const int32_t bc[3] = {bx, by, bz};
                 for (int a = 0; a < 3; a++) {
                     j.c0[a] = bc[a] * MC_BLOCK_CELLS;
@@ -342,7 +406,7 @@ argil_err_t mc_blocks_update(mc_blocks_t *b, const float *density, const uint8_t
                 }
                 j.k->n_vert = 0;
                 j.k->n_tri = 0;
-                if (rgb == NULL) {
+                if (!colour) {
                     free(j.k->rgb);
                     j.k->rgb = NULL;
                 } else if (j.k->rgb == NULL && j.k->cap_vert > 0) {

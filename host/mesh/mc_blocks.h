@@ -37,6 +37,8 @@ typedef struct {
     int has_rgb;         /* the last update had colours */
     mc_table_t *tab;
     float *val;          /* scratch: block samples with a one-sample halo */
+    float *rd;           /* scratch: what a reader returns for one block */
+    uint8_t *rdc;        /* scratch: what a colour reader returns for one block */
     uint8_t *ins, *col;
     uint32_t *cache;     /* scratch: vertex of each block-local edge */
     size_t blocks_meshed;  /* by the last update */
@@ -61,6 +63,23 @@ void mc_blocks_mark(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3]);
  * the colour of its edge's inside sample). Toggling rgb between updates re-meshes everything.
  * ARGIL_ERR_NONFINITE when a sample read is NaN or Inf (that block stays dirty), NOMEM, FULL. */
 argil_err_t mc_blocks_update(mc_blocks_t *b, const float *density, const uint8_t *rgb);
+
+/* Fills out (x fastest) with the densities of the sample box [lo, lo+n), which lies inside the
+ * mesher's dims. */
+typedef void (*mc_read_fn)(const void *ctx, const int32_t lo[3], const int32_t n[3], float *out);
+
+/* mc_blocks_update with the densities read through read(ctx, ...) a block at a time (no
+ * colours), so the field need not be one array. As mc_blocks_update. */
+argil_err_t mc_blocks_update_read(mc_blocks_t *b, mc_read_fn read, const void *ctx);
+
+/* Fills out (3 bytes per sample, x fastest) with the colours of the sample box [lo, lo+n). */
+typedef void (*mc_read_rgb_fn)(const void *ctx, const int32_t lo[3], const int32_t n[3],
+                               uint8_t *out);
+
+/* mc_blocks_update_read with colours read through read_rgb(ctx, ...) (NULL: no colours, as
+ * mc_blocks_update_read). As mc_blocks_update. */
+argil_err_t mc_blocks_update_read_rgb(mc_blocks_t *b, mc_read_fn read, mc_read_rgb_fn read_rgb,
+                                      const void *ctx);
 
 /* Joins the blocks into out (replaced): closed, edge-manifold, each grid edge one vertex, in
  * block order; colours when the last update had them. NOMEM / FULL; out empty on error. */

@@ -16,6 +16,7 @@
 #include "host/io/io_util.h"
 #include "shared/crc32c.h"
 #include "tests/fuzz/fuzz_file.h"
+#include "tests/unit/grid_view.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -46,7 +47,7 @@ static void parse_one(const uint8_t *data, size_t size)
     argil_doc_t d;
     const argil_err_t e = argil_file_read(path, &d, err, sizeof(err));
     if (e == ARGIL_OK) {
-        if (d.grid.density == NULL || (d.has_octree && (d.octree.n_nodes == 0 ||
+        if (grid_count(&d.grid) == 0 || (d.has_octree && (d.octree.n_nodes == 0 ||
                                                         d.octree.n_leaves == 0)))
             abort();
         if (d.has_octree) /* a decoded octree must evaluate without faults */
@@ -55,19 +56,19 @@ static void parse_one(const uint8_t *data, size_t size)
         const size_t n = (size_t)d.grid.dims[0] * (size_t)d.grid.dims[1] * (size_t)d.grid.dims[2];
         bool painted = false;
         for (int ch = 0; ch < GRID_MAT_N; ch++) {
-            if (d.grid.mat[ch] == NULL)
+            if (!grid_mat_painted(&d.grid, (grid_mat_t)ch))
                 continue;
             painted = true;
             if (d.file_version < ARGIL_FILE_VERSION_MTLS)
                 abort();
             for (size_t i = 0; i < n; i++)
-                if (!grid_mat_valid((grid_mat_t)ch, d.grid.mat[ch][i]))
+                if (!grid_mat_valid((grid_mat_t)ch, gv_mat(&d.grid, ch, i)))
                     abort();
         }
         if (painted)
             check_rewrite(&d, path);
         argil_doc_free(&d);
-    } else if (!fuzz_error_names_file(err, path) || d.grid.density != NULL || d.has_octree) {
+    } else if (!fuzz_error_names_file(err, path) || grid_count(&d.grid) > 0 || d.has_octree) {
         abort();
     }
     unlink(path);

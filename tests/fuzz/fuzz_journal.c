@@ -15,6 +15,7 @@
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
+#include "tests/unit/grid_view.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -59,7 +60,7 @@ static void check_one(const uint8_t *data, size_t size)
     if (grid_init(&g, scan.dims, 0.001f, vec3(0, 0, 0)) != ARGIL_OK)
         return;
     for (size_t i = 0; i < n; i++)
-        g.density[i] = 0.5f;
+        gv_set(&g, GRID_DENSITY, i, 0.5f);
     journal_info_t grid_play;
     char err3[512] = "";
     const argil_err_t e3 = journal_replay_grid(data, size, name, &g, &grid_play, err3,
@@ -67,12 +68,13 @@ static void check_one(const uint8_t *data, size_t size)
     if (e3 != e || grid_play.records != scan.records || grid_play.mat_samples != scan.mat_samples ||
         grid_play.rgb_samples != scan.rgb_samples || strcmp(err, err3) != 0)
         abort();
-    /* Type-3 records paint the grid's colour: present exactly when a colour run was replayed. */
-    if ((g.rgb != NULL) != (grid_play.rgb_samples > 0))
+    /* Type-3 records paint the grid's colour: present only when a colour run was replayed (a run
+     * of the clay's own grey leaves the sparse grid without colour arrays). */
+    if (grid_rgb_any(&g) && grid_play.rgb_samples == 0)
         abort();
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        for (size_t i = 0; g.mat[ch] != NULL && i < n; i++)
-            if (!grid_mat_valid((grid_mat_t)ch, g.mat[ch][i]))
+        for (size_t i = 0; grid_mat_painted(&g, (grid_mat_t)ch) && i < n; i++)
+            if (!grid_mat_valid((grid_mat_t)ch, gv_mat(&g, ch, i)))
                 abort();
     grid_free(&g);
 }

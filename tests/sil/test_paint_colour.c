@@ -20,6 +20,7 @@
 #include "host/app/session.h"
 #include "host/io/argil_file.h"
 #include "host/mesh/mc_blocks.h"
+#include "tests/unit/grid_view.h"
 
 #define RADIUS_MM 4.0
 #define PATH_MAX_POINTS 20000u
@@ -52,13 +53,11 @@ static void hook(void *ctx, session_frame_t *f)
     if (c->taken || !f->script_done)
         return;
     const grid_t *g = p->grid;
-    c->n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
-    c->rgb = malloc(3 * c->n);
+    /* over the grid's bounds, as model.argil holds it */
+    int32_t lo[3], dims[3];
+    c->n = grid_count(g);
+    c->rgb = grid_dense_copy_rgb(g, lo, dims);
     assert_non_null(c->rgb);
-    if (g->rgb != NULL)
-        memcpy(c->rgb, g->rgb, 3 * c->n);
-    else
-        memset(c->rgb, (int)GRID_RGB_DEFAULT, 3 * c->n);
     c->taken = true;
 }
 
@@ -140,9 +139,12 @@ static void test_paint_stroke_shows_and_persists(void **st)
     /* The final mesh, coloured as the window's mesher colours it. */
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract_region(g->density, d.rgb, g->dims, g->spacing_m, g->origin_m,
-                                       g->iso, NULL, NULL, &m),
+    float *dens = malloc(n * sizeof(float));
+    assert_non_null(dens);
+    assert_int_equal(mc_extract_region(gv_copy(g, GRID_DENSITY, dens), d.rgb, g->dims,
+                                       g->spacing_m, g->origin_m, g->iso, NULL, NULL, &m),
                      ARGIL_OK);
+    free(dens);
     assert_true(m.has_rgb);
     size_t in_n = 0, in_paint = 0, far_n = 0, far_base = 0;
     const uint8_t base[3] = {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT};
@@ -167,19 +169,20 @@ static void test_paint_stroke_shows_and_persists(void **st)
 
     /* Loaded into a new session's B-spline model: the same colour comes back to the grid. */
     grid_t *lg = &d.grid;
-    lg->rgb = d.rgb; /* the grid takes the file's colour (as a loading session would) */
-    d.rgb = NULL;
+    /* the grid takes the file's colour (as a loading session would) */
+    assert_int_equal(gv_rgb_store(lg, d.rgb), ARGIL_OK);
     gsolve_t gs;
     memset(&gs, 0, sizeof(gs));
     assert_int_equal(gsolve_init(&gs, lg), ARGIL_OK);
     assert_int_equal(gsolve_colour_from_grid(&gs, lg), ARGIL_OK);
     uint8_t *keep = malloc(3 * n);
     assert_non_null(keep);
-    memcpy(keep, lg->rgb, 3 * n);
-    memset(lg->rgb, 0, 3 * n);
+    gv_rgb_copy(lg, keep);
+    memset(d.rgb, 0, 3 * n);
+    assert_int_equal(gv_rgb_store(lg, d.rgb), ARGIL_OK);
     const int32_t lo[3] = {0, 0, 0};
     assert_int_equal(gsolve_colour_to_grid(&gs, lg, lo, lg->dims), ARGIL_OK);
-    assert_memory_equal(lg->rgb, keep, 3 * n);
+    assert_memory_equal(gv_rgb_copy(lg, d.rgb), keep, 3 * n);
     gsolve_free(&gs);
     free(keep);
     argil_doc_free(&d);

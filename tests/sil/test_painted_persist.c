@@ -17,6 +17,7 @@
 
 #include "host/app/session.h"
 #include "host/io/argil_file.h"
+#include "tests/unit/grid_view.h"
 
 /* The B-spline model's scales over the whole grid, taken once the script has finished (painting
  * only happens inside the script, so these are the session's final scales). */
@@ -59,7 +60,7 @@ static size_t painted(const grid_t *g, grid_mat_t ch, float *lo, float *hi)
     *lo = INFINITY;
     *hi = -INFINITY;
     for (size_t i = 0; i < n; i++) {
-        const float v = grid_mat_value(g, ch, i);
+        const float v = gv_mat(g, ch, i);
         if (v == 1.0f)
             continue;
         k++;
@@ -106,15 +107,15 @@ static void test_paint_save_load(void **st)
     assert_int_equal(n, cap.n);
     size_t diff_k = 0, diff_m = 0;
     for (size_t i = 0; i < n; i++) {
-        const float k = grid_mat_value(g, GRID_MAT_STIFFNESS, i);
-        const float m = grid_mat_value(g, GRID_MAT_MASS, i);
+        const float k = gv_mat(g, GRID_MAT_STIFFNESS, i);
+        const float m = gv_mat(g, GRID_MAT_MASS, i);
         diff_k += memcmp(&k, &cap.stiff[i], sizeof(float)) != 0;
         diff_m += memcmp(&m, &cap.mass[i], sizeof(float)) != 0;
     }
     assert_int_equal(diff_k, 0);
     assert_int_equal(diff_m, 0);
-    assert_null(g->mat[GRID_MAT_DAMPING]);
-    assert_null(g->mat[GRID_MAT_RESTLEN]);
+    assert_false(grid_mat_painted(g, GRID_MAT_DAMPING));
+    assert_false(grid_mat_painted(g, GRID_MAT_RESTLEN));
     float klo, khi, mlo, mhi;
     const size_t nk = painted(g, GRID_MAT_STIFFNESS, &klo, &khi);
     const size_t nm = painted(g, GRID_MAT_MASS, &mlo, &mhi);

@@ -24,6 +24,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/journal.h"
 #include "host/io/ply.h"
+#include "tests/unit/grid_view.h"
 
 #define CLAY_R_MM 30.0
 
@@ -258,7 +259,7 @@ static void test_recovery_after_undo(void **st)
     const size_t n = (size_t)a->dims[0] * a->dims[1] * a->dims[2];
     float dmax = 0.0f;
     for (size_t i = 0; i < n; i++) {
-        const float dd = fabsf(a->density[i] - b->density[i]);
+        const float dd = fabsf(gv_get(a, GRID_DENSITY, i) - gv_get(b, GRID_DENSITY, i));
         dmax = dd > dmax ? dd : dmax;
     }
     printf("# recovered after the undo: %u records, largest density difference to the final "

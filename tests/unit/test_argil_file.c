@@ -18,6 +18,7 @@
 #include "shared/crc32c.h"
 
 #include "tests/unit/test_files.h"
+#include "tests/unit/grid_view.h"
 
 static int setup_dir(void **state)
 {
@@ -65,8 +66,8 @@ static void test_round_trip(void **state)
         assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
         assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
         assert_memory_equal(r.grid.dims, d.grid.dims, sizeof(d.grid.dims));
-        assert_memory_equal(r.grid.density, d.grid.density, 120 * sizeof(float));
-        assert_memory_equal(r.grid.rest, d.grid.density, 120 * sizeof(float));
+        assert_true(gv_same(&r.grid, GRID_DENSITY, &d.grid, GRID_DENSITY));
+        assert_true(gv_same(&r.grid, GRID_REST, &d.grid, GRID_DENSITY));
         assert_float_equal(r.grid.iso, 0.4f, 0);
         assert_float_equal(r.grid.spacing_m, 0.002f, 0);
         assert_float_equal(r.grid.origin_m.y, -0.004f, 0);
@@ -111,11 +112,11 @@ static void test_atomic(void **state)
     assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
     argil_doc_free(&r);
     /* a save that fails (NaN in the model) leaves the file byte for byte as it was */
-    d.grid.density[7] = NAN;
+    gv_set(&d.grid, GRID_DENSITY, 7, NAN);
     assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_NONFINITE);
     assert_non_null(strstr(err, "NaN or Inf"));
     /* a save whose temp file cannot be created (it is a directory) fails with IO */
-    d.grid.density[7] = 0.5f;
+    gv_set(&d.grid, GRID_DENSITY, 7, 0.5f);
     unlink(tmp);
     assert_int_equal(mkdir(tmp, 0700), 0);
     assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_IO);
@@ -155,7 +156,7 @@ static void test_any_corruption_refused(void **state)
         const argil_err_t e = argil_file_read(q, &r, err, sizeof(err));
         if (e != ARGIL_ERR_PARSE || strstr(err, q) == NULL || strstr(err, "byte ") == NULL)
             fail_msg("flip at byte %zu: %d '%s'", i, e, err);
-        assert_null(r.grid.density);
+        assert_int_equal(grid_count(&r.grid), 0);
         b[i] ^= (uint8_t)(1u << (i % 8));
     }
     for (size_t cut = 0; cut < len; cut += 17) {
@@ -227,7 +228,7 @@ static void expect_rule(const char *path, const char *where, const char *rule)
     if (e != ARGIL_ERR_PARSE || strstr(err, path) == NULL || strstr(err, where) == NULL ||
         strstr(err, rule) == NULL)
         fail_msg("got %d '%s', want '%s' and '%s'", e, err, where, rule);
-    assert_null(r.grid.density);
+    assert_int_equal(grid_count(&r.grid), 0);
 }
 
 static void test_each_rule(void **state)
@@ -247,7 +248,7 @@ static void test_each_rule(void **state)
     argil_doc_t ok;
     char err[256];
     assert_int_equal(argil_file_read(p, &ok, err, sizeof(err)), ARGIL_OK); /* builder is right */
-    assert_float_equal(ok.grid.density[1], 0.5f, 0);
+    assert_float_equal(gv_get(&ok.grid, GRID_DENSITY, 1), 0.5f, 0);
     argil_doc_free(&ok);
     f.b[0] = 'X';
     test_spit(p, f.b, f.len + 4);
@@ -494,20 +495,17 @@ static void test_octb(void **state)
  * whose bits differ from the default 0, so it must be stored). */
 static void paint_doc(argil_doc_t *d)
 {
-    float *k = grid_mat_alloc(&d->grid, GRID_MAT_STIFFNESS);
-    float *m = grid_mat_alloc(&d->grid, GRID_MAT_MASS);
-    float *r = grid_mat_alloc(&d->grid, GRID_MAT_RESTLEN);
-    assert_non_null(k);
-    assert_non_null(m);
-    assert_non_null(r);
-    k[10] = 4.0f;
-    k[11] = 2.5f;
-    k[13] = 1.0000001f; /* gap of 1 at 12: bridged */
-    k[119] = 4.0f;      /* far: a second run */
-    m[0] = 0.5f;
-    m[1] = 1e-40f;      /* subnormal, still > 0 */
-    r[50] = -0.0f;
-    assert_non_null(grid_mat_alloc(&d->grid, GRID_MAT_DAMPING)); /* present, all default */
+    grid_t *g = &d->grid;
+    gv_mat_set(g, GRID_MAT_STIFFNESS, 10, 4.0f);
+    gv_mat_set(g, GRID_MAT_STIFFNESS, 11, 2.5f);
+    gv_mat_set(g, GRID_MAT_STIFFNESS, 13, 1.0000001f); /* gap of 1 at 12: bridged */
+    gv_mat_set(g, GRID_MAT_STIFFNESS, 119, 4.0f);      /* far: a second run */
+    gv_mat_set(g, GRID_MAT_MASS, 0, 0.5f);
+    gv_mat_set(g, GRID_MAT_MASS, 1, 1e-40f); /* subnormal, still > 0 */
+    gv_mat_set(g, GRID_MAT_RESTLEN, 50, -0.0f);
+    gv_mat_set(g, GRID_MAT_DAMPING, 0, 1.0f); /* present, all default */
+    assert_true(grid_mat_painted(g, GRID_MAT_STIFFNESS) && grid_mat_painted(g, GRID_MAT_MASS) &&
+                grid_mat_painted(g, GRID_MAT_RESTLEN) && grid_mat_painted(g, GRID_MAT_DAMPING));
 }
 
 /* Painted channels come back bit for bit; the file is version 2 and grows only by the painted
@@ -536,31 +534,31 @@ static void test_painted_round_trip(void **state)
     assert_int_equal(r.file_version, 2);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
         assert_true(grid_mat_equal(&r.grid, &d.grid, (grid_mat_t)ch));
-    assert_non_null(r.grid.mat[GRID_MAT_STIFFNESS]);
-    assert_null(r.grid.mat[GRID_MAT_DAMPING]);
-    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][10], 4.0f, 0);
-    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][12], 1.0f, 0); /* bridged, unpainted */
-    assert_float_equal(r.grid.mat[GRID_MAT_MASS][0], 0.5f, 0);
-    assert_true(signbit(r.grid.mat[GRID_MAT_RESTLEN][50]));
-    assert_memory_equal(r.grid.density, d.grid.density, 120 * sizeof(float));
+    assert_true(grid_mat_painted(&r.grid, GRID_MAT_STIFFNESS));
+    assert_false(grid_mat_painted(&r.grid, GRID_MAT_DAMPING));
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_STIFFNESS, 10), 4.0f, 0);
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_STIFFNESS, 12), 1.0f, 0); /* bridged, unpainted */
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_MASS, 0), 0.5f, 0);
+    assert_true(signbit(gv_mat(&r.grid, GRID_MAT_RESTLEN, 50)));
+    assert_true(gv_same(&r.grid, GRID_DENSITY, &d.grid, GRID_DENSITY));
     argil_doc_free(&r);
     /* A changed painted value is not the same model. */
-    d.grid.mat[GRID_MAT_MASS][0] = 0.25f;
+    gv_mat_set(&d.grid, GRID_MAT_MASS, 0, 0.25f);
     assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_OK);
     assert_false(grid_mat_equal(&r.grid, &d.grid, GRID_MAT_MASS));
     argil_doc_free(&r);
     /* Out-of-range paint is refused at write time, naming the channel and sample. */
-    d.grid.mat[GRID_MAT_MASS][3] = 0.0f;
+    gv_mat_set(&d.grid, GRID_MAT_MASS, 3, 0.0f);
     assert_int_equal(argil_file_write(q, &d, err, sizeof(err)), ARGIL_ERR_NONFINITE);
     assert_non_null(strstr(err, "channel 1 holds 0 at sample 3"));
-    d.grid.mat[GRID_MAT_MASS][3] = 1.0f;
+    gv_mat_set(&d.grid, GRID_MAT_MASS, 3, 1.0f);
     /* Every cut of a painted file is a clear refusal. */
     bq = test_slurp(q, &lq);
     for (size_t cut = 0; cut < lq; cut += 7) {
         test_spit(p, bq, cut);
         assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
         assert_non_null(strstr(err, p));
-        assert_null(r.grid.density);
+        assert_int_equal(grid_count(&r.grid), 0);
     }
     free(bq);
     argil_doc_free(&d);
@@ -601,11 +599,11 @@ static void test_old_version_loads(void **state)
     assert_int_equal(r.file_version, 1);
     assert_int_equal(r.grid.dims[0], 3);
     assert_int_equal(r.grid.dims[1], 2);
-    assert_float_equal(r.grid.density[5], 0.625f, 0);
+    assert_float_equal(gv_get(&r.grid, GRID_DENSITY, 5), 0.625f, 0);
     assert_float_equal(r.grid.material.stiffness, 7.0f, 0);
     assert_int_equal(r.state.edits, 5);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        assert_null(r.grid.mat[ch]);
+        assert_false(grid_mat_painted(&r.grid, ch));
     assert_int_equal(argil_file_write(q, &r, err, sizeof(err)), ARGIL_OK);
     size_t len;
     uint8_t *b = test_slurp(q, &len);
@@ -650,8 +648,8 @@ static void test_mtls_rules(void **state)
     mtls_case(p, 2, m, ml, 1);
     argil_doc_t r;
     assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK); /* builder is right */
-    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][0], 1.0f, 0);
-    assert_float_equal(r.grid.mat[GRID_MAT_STIFFNESS][1], 4.0f, 0);
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_STIFFNESS, 0), 1.0f, 0);
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_STIFFNESS, 1), 4.0f, 0);
     argil_doc_free(&r);
     /* Damping (2) then rest length (3): two channels, increasing ids. */
     uint8_t two[64];
@@ -663,8 +661,8 @@ static void test_mtls_rules(void **state)
     io_put_f32le(two + 40, -0.25f);
     mtls_case(p, 2, two, 44, 1);
     assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
-    assert_float_equal(r.grid.mat[GRID_MAT_DAMPING][0], 0.0f, 0);
-    assert_float_equal(r.grid.mat[GRID_MAT_RESTLEN][0], -0.25f, 0);
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_DAMPING, 0), 0.0f, 0);
+    assert_float_equal(gv_mat(&r.grid, GRID_MAT_RESTLEN, 0), -0.25f, 0);
     argil_doc_free(&r);
     io_put_u32le(two + 24, GRID_MAT_DAMPING);
     mtls_case(p, 2, two, 44, 1);

@@ -15,58 +15,99 @@
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
-#include "tests/unit/test_grids.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
 #define R 0.020f
 #define DT 0.01f
 
+static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+}
+
+/* A 48³ grid at 1.25 mm centred on the origin holding a 20 mm sphere. */
+static grid_t *sphere_grid(void)
+{
+    grid_t *g = malloc(sizeof(*g));
+    assert_non_null(g);
+    const int32_t dims[3] = {N, N, N};
+    const float o = -0.5f * (float)(N - 1) * H;
+    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(g, vec3(0, 0, 0), R);
+    return g;
+}
+
+static void free_grid(grid_t *g)
+{
+    grid_free(g);
+    free(g);
+}
+
+/* Where the density along +axis from the centre sample crosses 0.5 (m from the grid centre). */
+static float crossing_m(const grid_t *g, int axis)
+{
+    const int32_t c = N / 2;
+    int32_t at[3] = {c, c, c};
+    for (int32_t i = c; i + 1 < N; i++) {
+        at[axis] = i;
+        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        at[axis] = i + 1;
+        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        if (a >= 0.5f && b < 0.5f) {
+            const float pos = (float)i + (a - 0.5f) / (a - b);
+            return (pos - 0.5f * (float)(N - 1)) * H;
+        }
+    }
+    return -1.0f;
+}
+
 static void test_seed_makes_the_grid_the_models_view(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     const size_t n = (size_t)N * N * N;
     float *orig = malloc(n * sizeof(float));
     assert_non_null(orig);
-    memcpy(orig, g->density, n * sizeof(float));
-    const float x0 = test_crossing_m(g, 0);
+    gv_copy(g, GRID_DENSITY, orig);
+    const float x0 = crossing_m(g, 0);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     float ramp_err = 0.0f, any_err = 0.0f;
     for (size_t i = 0; i < n; i++) {
-        const float e = fabsf(g->density[i] - orig[i]);
+        const float e = fabsf(gv_get(g, GRID_DENSITY, i) - orig[i]);
         if (orig[i] > 0.15f && orig[i] < 0.85f && e > ramp_err)
             ramp_err = e;
         if (e > any_err)
             any_err = e;
-        assert_true(g->density[i] >= 0.0f && g->density[i] <= 1.0f);
-        assert_true(g->rest[i] == g->density[i]);
+        assert_true(gv_get(g, GRID_DENSITY, i) >= 0.0f && gv_get(g, GRID_DENSITY, i) <= 1.0f);
+        assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
     }
     print_message("# seed: ramp error %.2e, largest %.2e; +x surface %.4f mm (grid %.4f mm)\n",
-                  (double)ramp_err, (double)any_err, (double)test_crossing_m(g, 0) * 1e3,
+                  (double)ramp_err, (double)any_err, (double)crossing_m(g, 0) * 1e3,
                   (double)x0 * 1e3);
     /* The cubic B-spline reproduces the linear ramp: only its kinks at 0 and 1 round off. */
     assert_true(ramp_err < 5e-3f);  /* measured 3.7e-3 (the ramp bends round the sphere) */
     assert_true(any_err < 0.04f);   /* measured 0.027, at the kinks */
     assert_true(any_err > 1e-3f); /* it is the model's view, not the old grid */
-    assert_true(fabsf(test_crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
-    assert_true(fabsf(test_crossing_m(g, 0) - R) < 0.1e-3f);
+    assert_true(fabsf(crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
+    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f);
     gsolve_free(&gs);
     free(orig);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 static void test_field_at_rest_stays_put(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const int32_t lo[3] = {10, 28, 10}, hi[3] = {34, 48, 34};
     for (int k = 0; k < 30; k++) {
         int32_t dlo[3], dhi[3];
@@ -77,13 +118,13 @@ static void test_field_at_rest_stays_put(void **st)
         assert_true(change == 0.0f);
         assert_int_equal(dhi[0] - dlo[0], 0);
     }
-    assert_memory_equal(before, g->density, n * sizeof(float));
+    assert_true(gv_equal(g, GRID_DENSITY, before));
     assert_int_equal(gs.stats.windows_opened, 1);
     assert_int_equal(gs.stats.steps, 1);       /* then at rest: not stepped */
     assert_int_equal(gs.stats.rest_skips, 29);
     free(before);
     gsolve_free(&gs);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 /* Pushes the surface on +y with a force spread like the board's Gaussian filter (σ 1.5
@@ -92,18 +133,18 @@ static void test_field_at_rest_stays_put(void **st)
 static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *at_moved,
                           float *far_moved)
 {
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     gsolve_t gs;
     if (bspline)
         assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     /* the surface sample on +y nearest density 0.5 */
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[test_gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
         sy++;
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     for (int k = 0; k < 30; k++) {
@@ -131,22 +172,21 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
                     assert_true(dlo[a] <= lo[a] && dhi[a] >= (hi[a] < N ? hi[a] : N));
             }
         } else {
-            spring_field_t f = grid_springs(g);
-            springs_step(&f, &g->material, lo, hi, DT);
+            grid_springs_step(g, lo, hi, DT);
         }
     }
     double sum = 0.0;
     for (size_t i = 0; i < n; i++)
-        sum += (double)g->density[i] - before[i];
+        sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
-    const size_t at = test_gidx(g, c, sy, c);
-    *at_moved = g->density[at] - before[at];
-    const size_t far = test_gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
-    *far_moved = g->density[far] - before[far];
+    const size_t at = gidx(g, c, sy, c);
+    *at_moved = gv_get(g, GRID_DENSITY, at) - before[at];
+    const size_t far = gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
+    *far_moved = gv_get(g, GRID_DENSITY, far) - before[far];
     free(before);
     if (bspline)
         gsolve_free(&gs);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 static void test_impulse_moves_as_much_clay_as_the_springs(void **st)
@@ -174,7 +214,7 @@ static void test_impulse_moves_as_much_clay_as_the_springs(void **st)
  * with painted material in it or without. */
 static void moved_window_matches_a_fresh_one(bool painted)
 {
-    grid_t *g1 = test_sphere_grid(N, H, R), *g2 = test_sphere_grid(N, H, R);
+    grid_t *g1 = sphere_grid(), *g2 = sphere_grid();
     gsolve_t a, b;
     assert_int_equal(gsolve_init(&a, g1), ARGIL_OK);
     assert_int_equal(gsolve_init(&b, g2), ARGIL_OK);
@@ -207,12 +247,12 @@ static void moved_window_matches_a_fresh_one(bool painted)
     assert_int_equal(a.stats.windows_opened, 1);
     assert_int_equal(a.stats.windows_moved, 3);
     assert_int_equal(b.stats.windows_opened, 4);
-    assert_memory_equal(g1->density, g2->density, sizeof(float) * N * N * N);
+    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
     assert_true(largest > 1e-3f); /* the forces did move the clay */
     gsolve_free(&a);
     gsolve_free(&b);
-    test_grid_free(g1);
-    test_grid_free(g2);
+    free_grid(g1);
+    free_grid(g2);
 }
 
 static void test_moved_window_matches_a_fresh_one(void **st)
@@ -225,14 +265,14 @@ static void test_moved_window_matches_a_fresh_one(void **st)
 static void test_carve_goes_through_the_model(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, R);
-    grid_t *ref = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
+    grid_t *ref = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const vec3_t at = vec3(0, R, 0);
     const float radius = 5e-3f;
     int32_t lo[3], hi[3], rlo[3], rhi[3];
@@ -241,18 +281,18 @@ static void test_carve_goes_through_the_model(void **st)
     assert_true(hi[0] > lo[0]);
     assert_int_equal(gs.stats.carves, 1);
     /* the surface on +y moved in by the tool's radius, as the grid's own carve puts it */
-    const float y_b = test_crossing_m(g, 1), y_g = test_crossing_m(ref, 1);
+    const float y_b = crossing_m(g, 1), y_g = crossing_m(ref, 1);
     print_message("# carve: +y surface %.2f mm (grid carve %.2f mm, sphere %.1f)\n",
                   (double)y_b * 1e3, (double)y_g * 1e3, (double)R * 1e3);
     assert_true(y_b < R - 4e-3f);
     assert_true(fabsf(y_b - y_g) < 0.5e-3f);
-    assert_true(fabsf(test_crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
+    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
     /* every change lies in the box reported */
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = test_gidx(g, x, y, z);
-                if (g->density[i] != before[i])
+                const size_t i = gidx(g, x, y, z);
+                if (gv_get(g, GRID_DENSITY, i) != before[i])
                     assert_true(x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] &&
                                 z >= lo[2] && z < hi[2]);
             }
@@ -267,17 +307,17 @@ static void test_carve_goes_through_the_model(void **st)
                              ARGIL_OK);
     }
     assert_true(change < 1e-3f);
-    assert_true(test_crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
+    assert_true(crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
     free(before);
     gsolve_free(&gs);
-    test_grid_free(ref);
-    test_grid_free(g);
+    free_grid(ref);
+    free_grid(g);
 }
 
 static void test_painted_material(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     peer_cfg_t cfg;
     peer_cfg_default(&cfg);
     cfg.global_solve = PEER_SOLVE_SPRINGS;
@@ -311,25 +351,25 @@ static void test_painted_material(void **st)
     peer_free(springs);
     free(bs);
     free(springs);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 /* Elastic clay pushed in: where the stiffness is painted 50x it springs back sooner. */
 static float springback_left(bool painted)
 {
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     g->material.plastic_rate_hz = 0.0f;
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (g->density[test_gidx(g, c, sy + 1, c)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
         sy++;
     const vec3_t at = vec3(0.5f * H, (float)(sy - c) * H + 0.5f * H, 0.5f * H);
     if (painted)
         assert_int_equal(gsolve_paint(&gs, GSOLVE_MAT_STIFFNESS, at, 8e-3f, 50.0f), ARGIL_OK);
-    const size_t i = test_gidx(g, c, sy, c);
-    const float d0 = g->density[i];
+    const size_t i = gidx(g, c, sy, c);
+    const float d0 = gv_get(g, GRID_DENSITY, i);
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     float deepest = 0.0f;
     for (int k = 0; k < 60; k++) {
@@ -338,15 +378,15 @@ static float springback_left(bool painted)
         int32_t dlo[3], dhi[3];
         float change;
         assert_int_equal(gsolve_step(&gs, g, lo, hi, DT, dlo, dhi, &change), ARGIL_OK);
-        if (d0 - g->density[i] > deepest)
-            deepest = d0 - g->density[i];
+        if (d0 - gv_get(g, GRID_DENSITY, i) > deepest)
+            deepest = d0 - gv_get(g, GRID_DENSITY, i);
     }
     print_message("# elastic push: %.4f deepest, %.4f at the end\n", (double)deepest,
-                  (double)(d0 - g->density[i]));
+                  (double)(d0 - gv_get(g, GRID_DENSITY, i)));
     assert_true(deepest > 5e-3f);
-    const float left = (d0 - g->density[i]) / deepest;
+    const float left = (d0 - gv_get(g, GRID_DENSITY, i)) / deepest;
     gsolve_free(&gs);
-    test_grid_free(g);
+    free_grid(g);
     return left;
 }
 

@@ -11,11 +11,34 @@
 #include <string.h>
 
 #include "host/model/grid.h"
-#include "tests/unit/test_grids.h"
+#include "tests/unit/grid_view.h"
 
 #define N 64
 #define H 1.25e-3f
 #define R 0.030f
+
+/* A 64³ grid at 1.25 mm, centred on the origin, holding a 30 mm sphere. */
+static grid_t *sphere_grid(void)
+{
+    grid_t *g = malloc(sizeof(*g));
+    assert_non_null(g);
+    const int32_t dims[3] = {N, N, N};
+    const float o = -0.5f * (float)(N - 1) * H;
+    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(g, vec3(0.0f, 0.0f, 0.0f), R);
+    return g;
+}
+
+static void drop_grid(grid_t *g)
+{
+    grid_free(g);
+    free(g);
+}
+
+static size_t idx(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+}
 
 static vec3_t sample_pos(const grid_t *g, int32_t x, int32_t y, int32_t z)
 {
@@ -40,13 +63,14 @@ static void test_init_defaults_and_errors(void **state)
     assert_float_equal(g.band_m, 0.008f, 1e-9f);
     assert_true(spring_material_valid(&g.material));
     for (size_t i = 0; i < 120; i++)
-        assert_true(g.density[i] == 0.0f && g.rest[i] == 0.0f && g.velocity[i] == 0.0f &&
-                    g.force[i] == 0.0f);
-    spring_field_t f = grid_springs(&g);
-    assert_int_equal(f.dims[0], 4);
-    assert_int_equal(f.dims[2], 6);
-    assert_ptr_equal(f.density, g.density);
-    assert_ptr_equal(f.force, g.force);
+        assert_true(gv_get(&g, GRID_DENSITY, i) == 0.0f && gv_get(&g, GRID_REST, i) == 0.0f &&
+                    gv_get(&g, GRID_VELOCITY, i) == 0.0f && gv_get(&g, GRID_FORCE, i) == 0.0f);
+    int32_t lo[3], hi[3];
+    grid_bounds(&g, lo, hi);
+    assert_int_equal(lo[0], 0);
+    assert_int_equal(hi[0], 4);
+    assert_int_equal(hi[2], 6);
+    assert_int_equal(grid_count(&g), 120);
     grid_free(&g);
     grid_free(&g); /* twice is harmless */
 
@@ -63,7 +87,7 @@ static void test_init_defaults_and_errors(void **state)
 static void test_sphere_profile(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     assert_float_equal(grid_density_at(g, vec3(0, 0, 0)), 1.0f, 1e-6f);
     assert_float_equal(grid_profile(0.0f, 1.0f), 0.5f, 0.0f);
     for (int k = 0; k < 20; k++) {
@@ -83,13 +107,13 @@ static void test_sphere_profile(void **state)
     assert_float_equal(grid_density_at(g, vec3(1.0f, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(grid_density_at(g, vec3(NAN, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(vec3_norm(grid_gradient_at(g, vec3(0, -1.0f, 0))), 0.0f, 0.0f);
-    test_grid_free(g);
+    drop_grid(g);
 }
 
 static void test_gradient_matches_finite_differences(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     const float step = 1e-3f * H;
     for (int k = 0; k < 200; k++) {
         /* Points in the band, kept away from cell faces so the difference stays in one cell. */
@@ -113,20 +137,20 @@ static void test_gradient_matches_finite_differences(void **state)
         /* |grad| is 100 /m; float differences over 1.25 µm carry ~1 /m of rounding. */
         assert_true(vec3_norm(vec3_sub(grad, fd)) < 2.0f);
     }
-    test_grid_free(g);
+    drop_grid(g);
 }
 
 static void test_carve_sphere(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     float *rest_before = malloc(n * sizeof(float));
     assert_non_null(before);
     assert_non_null(rest_before);
-    memcpy(before, g->density, n * sizeof(float));
-    memcpy(rest_before, g->rest, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
+    gv_copy(g, GRID_REST, rest_before);
 
     const vec3_t c = vec3(R, 0.0f, 0.0f);
     const float rc = 0.008f;
@@ -138,18 +162,20 @@ static void test_carve_sphere(void **state)
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = test_gidx(g, x, y, z);
+                const size_t i = idx(g, x, y, z);
                 const float dist = vec3_norm(vec3_sub(sample_pos(g, x, y, z), c));
                 if (dist < rc - g->band_m)
-                    assert_true(g->density[i] == 0.0f && g->rest[i] == 0.0f);
+                    assert_true(gv_get(g, GRID_DENSITY, i) == 0.0f &&
+                                gv_get(g, GRID_REST, i) == 0.0f);
                 if (dist < rc)
-                    assert_true(g->density[i] < 0.5f);
+                    assert_true(gv_get(g, GRID_DENSITY, i) < 0.5f);
                 if (dist > rc + g->band_m + H) {
-                    assert_memory_equal(&g->density[i], &before[i], sizeof(float));
-                    assert_memory_equal(&g->rest[i], &rest_before[i], sizeof(float));
+                    assert_true(gv_bits(gv_get(g, GRID_DENSITY, i), before[i]));
+                    assert_true(gv_bits(gv_get(g, GRID_REST, i), rest_before[i]));
                 }
-                assert_true(g->density[i] <= before[i]);
-                if (g->density[i] != before[i] || g->rest[i] != rest_before[i]) {
+                assert_true(gv_get(g, GRID_DENSITY, i) <= before[i]);
+                if (gv_get(g, GRID_DENSITY, i) != before[i] ||
+                    gv_get(g, GRID_REST, i) != rest_before[i]) {
                     changed++;
                     const int32_t s[3] = {x, y, z};
                     for (int a = 0; a < 3; a++) {
@@ -179,13 +205,13 @@ static void test_carve_sphere(void **state)
         assert_true(lo[a] == 0 && hi[a] == 0);
     free(before);
     free(rest_before);
-    test_grid_free(g);
+    drop_grid(g);
 }
 
 static void test_window_corner_and_extract(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     const int32_t win[3] = {32, 5, 8};
     /* p at sample index (10.2, 20.0, 60.7). */
     const vec3_t p = vec3(g->origin_m.x + 10.2f * H, g->origin_m.y + 20.0f * H,
@@ -208,8 +234,7 @@ static void test_window_corner_and_extract(void **state)
                     assert_true(out[o] == 0.0f);
                     zeros_outside++;
                 } else {
-                    assert_memory_equal(&out[o], &g->density[test_gidx(g, gx, gy, gz)],
-                                        sizeof(float));
+                    assert_true(gv_bits(out[o], gv_get(g, GRID_DENSITY, idx(g, gx, gy, gz))));
                 }
             }
     assert_int_equal(zeros_outside, 32 * 5 * 8 - 27 * 5 * 7);
@@ -223,45 +248,46 @@ static void test_window_corner_and_extract(void **state)
 
     grid_window_corner(g, vec3(INFINITY, 0, 0), win, corner);
     assert_int_equal(corner[0], 0);
-    test_grid_free(g);
+    drop_grid(g);
 }
 
 static void test_add_force(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
-    assert_false(grid_add_force(g, -1, 0, 0, 1.0f));
-    assert_false(grid_add_force(g, 0, N, 0, 1.0f));
-    assert_false(grid_add_force(g, 0, 0, N + 5, 1.0f));
+    grid_t *g = sphere_grid();
+    /* Beyond the nominal box the sparse grid still holds samples; only the index limit refuses. */
+    assert_true(grid_add_force(g, -1, 0, 0, 1.0f));
+    assert_float_equal(grid_get(g, GRID_FORCE, -1, 0, 0), 1.0f, 0.0f);
+    assert_false(grid_add_force(g, -GRID_INDEX_MAX - 1, 0, 0, 1.0f));
+    assert_false(grid_add_force(g, 0, GRID_INDEX_MAX, 0, 1.0f));
     assert_false(grid_add_force(g, 1, 1, 1, NAN));
     assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
     assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
     assert_true(grid_add_force(g, 1, 2, 3, 1.0f));
-    assert_float_equal(g->force[test_gidx(g, 1, 2, 3)], 2.5f, 0.0f);
-    test_grid_free(g);
+    assert_float_equal(gv_get(g, GRID_FORCE, idx(g, 1, 2, 3)), 2.5f, 0.0f);
+    drop_grid(g);
 }
 
 static void test_springs_push_lowers_density(void **state)
 {
     (void)state;
-    grid_t *g = test_sphere_grid(N, H, R);
+    grid_t *g = sphere_grid();
     /* The sample on the +x surface of the sphere: 30 mm = 24 spacings from the centre. */
     const int32_t x = 31 + 24, y = 31, z = 31;
-    const size_t i = test_gidx(g, x, y, z);
-    const float d0 = g->density[i];
+    const size_t i = idx(g, x, y, z);
+    const float d0 = gv_get(g, GRID_DENSITY, i);
     assert_true(d0 > 0.2f && d0 < 0.8f);
-    const float far0 = g->density[test_gidx(g, 5, 5, 5)];
+    const float far0 = gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5));
     assert_true(grid_add_force(g, x, y, z, -50.0f));
 
-    spring_field_t f = grid_springs(g);
     const int32_t lo[3] = {0, 0, 0}, hi[3] = {N, N, N};
     const float dt = springs_stable_dt_s(&g->material);
-    springs_step(&f, &g->material, lo, hi, dt);
+    grid_springs_step(g, lo, hi, dt);
     /* a = F/m = -50 /s²; after one step of ~21 ms the density falls by a*dt² ≈ 0.02. */
-    assert_true(g->density[i] < d0 - 0.01f);
-    assert_float_equal(g->force[i], 0.0f, 0.0f); /* consumed */
-    assert_float_equal(g->density[test_gidx(g, 5, 5, 5)], far0, 0.0f);
-    test_grid_free(g);
+    assert_true(gv_get(g, GRID_DENSITY, i) < d0 - 0.01f);
+    assert_float_equal(gv_get(g, GRID_FORCE, i), 0.0f, 0.0f); /* consumed */
+    assert_float_equal(gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5)), far0, 0.0f);
+    drop_grid(g);
 }
 
 
@@ -275,9 +301,9 @@ static void test_painted_channels(void **state)
     assert_int_equal(grid_init(&a, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
     assert_int_equal(grid_init(&b, dims, 0.001f, vec3(0, 0, 0)), ARGIL_OK);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        assert_null(a.mat[ch]);
-    assert_float_equal(grid_mat_value(&a, GRID_MAT_STIFFNESS, 5), 1.0f, 0);
-    assert_float_equal(grid_mat_value(&a, GRID_MAT_RESTLEN, 5), 0.0f, 0);
+        assert_false(grid_mat_painted(&a, ch));
+    assert_float_equal(gv_mat(&a, GRID_MAT_STIFFNESS, 5), 1.0f, 0);
+    assert_float_equal(gv_mat(&a, GRID_MAT_RESTLEN, 5), 0.0f, 0);
     assert_true(grid_mat_valid(GRID_MAT_MASS, 1e-6f));
     assert_false(grid_mat_valid(GRID_MAT_MASS, 0.0f));
     assert_true(grid_mat_valid(GRID_MAT_STIFFNESS, 0.0f));
@@ -285,23 +311,93 @@ static void test_painted_channels(void **state)
     assert_true(grid_mat_valid(GRID_MAT_RESTLEN, -0.5f));
     assert_false(grid_mat_valid(GRID_MAT_STIFFNESS, INFINITY));
     assert_false(grid_mat_valid(GRID_MAT_N, 1.0f));
-    float *m = grid_mat_alloc(&a, GRID_MAT_MASS);
-    assert_non_null(m);
-    assert_ptr_equal(grid_mat_alloc(&a, GRID_MAT_MASS), m); /* allocated once */
-    assert_null(grid_mat_alloc(&a, GRID_MAT_N));
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, 0, 0, 0, 1.0f), ARGIL_OK);
+    assert_true(grid_mat_painted(&a, GRID_MAT_MASS));
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_N, 0, 0, 0, 1.0f), ARGIL_ERR_ARG);
+    assert_int_equal(grid_mat_set(&a, GRID_MAT_MASS, GRID_INDEX_MAX, 0, 0, 1.0f), ARGIL_ERR_ARG);
     for (int i = 0; i < 12; i++)
-        assert_float_equal(m[i], 1.0f, 0);
+        assert_float_equal(gv_mat(&a, GRID_MAT_MASS, (size_t)i), 1.0f, 0);
     assert_true(grid_mat_equal(&a, &b, GRID_MAT_MASS)); /* all default = absent */
-    m[7] = 0.5f;
+    gv_mat_set(&a, GRID_MAT_MASS, 7, 0.5f);
     assert_false(grid_mat_equal(&a, &b, GRID_MAT_MASS));
     assert_false(grid_mat_equal(&b, &a, GRID_MAT_MASS));
-    float *r = grid_mat_alloc(&b, GRID_MAT_RESTLEN);
-    r[0] = -0.0f; /* == 0, other bits */
+    gv_mat_set(&b, GRID_MAT_RESTLEN, 0, -0.0f); /* == 0, other bits */
     assert_false(grid_mat_equal(&a, &b, GRID_MAT_RESTLEN));
     grid_free(&a);
     grid_free(&b);
     for (int ch = 0; ch < GRID_MAT_N; ch++)
-        assert_null(a.mat[ch]);
+        assert_false(grid_mat_painted(&a, ch));
+}
+
+/* Sparse storage: blocks wholly outside (0) or inside (1) the sphere hold no sample arrays, so
+ * memory follows the surface: a sphere of twice the radius takes ~4x, not 8x (a dense grid:
+ * 16 bytes per sample of the box whatever the clay). */
+static size_t sphere_bytes(int32_t n, float radius_m)
+{
+    grid_t g;
+    const int32_t dims[3] = {n, n, n};
+    const float o = -0.5f * (float)(n - 1) * H;
+    assert_int_equal(grid_init(&g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(&g, vec3(0, 0, 0), radius_m);
+    const size_t bytes = grid_bytes(&g);
+    /* Every block holding arrays lies on the surface's band. */
+    assert_true(g.data_blocks > 0);
+    grid_free(&g);
+    return bytes;
+}
+
+static void test_memory_follows_the_surface(void **state)
+{
+    (void)state;
+    /* The session's clay (r 30 mm in 88^3 at 1.25 mm) and one of twice the radius. */
+    const size_t small = sphere_bytes(88, 0.030f), big = sphere_bytes(176, 0.060f);
+    const double dense_small = 88.0 * 88 * 88 * GRID_CH_N * sizeof(float);
+    print_message("# sphere r 30 mm in 88^3: %zu bytes (dense %.0f); r 60 mm in 176^3: %zu bytes "
+                  "(dense %.0f), ratio %.2f\n", small, dense_small, big, 8.0 * dense_small,
+                  (double)big / (double)small);
+    assert_true((double)small < 0.3 * dense_small); /* measured 0.19 */
+    const double ratio = (double)big / (double)small;
+    assert_true(ratio > 3.0 && ratio < 5.0); /* the surface's 4x, not the volume's 8x */
+}
+
+/* The clay can be written anywhere (negative indices too); bounds grow to hold it, reading
+ * beyond them is empty clay, compaction gives back blocks that came to rest uniform. */
+static void test_grows_in_every_direction(void **state)
+{
+    (void)state;
+    grid_t g;
+    const int32_t dims[3] = {16, 16, 16};
+    assert_int_equal(grid_init(&g, dims, H, vec3(0, 0, 0)), ARGIL_OK);
+    int32_t lo[3], hi[3];
+    grid_bounds(&g, lo, hi);
+    assert_true(lo[0] == 0 && hi[0] == 16 && grid_bytes(&g) < 4096); /* no sample arrays */
+    assert_int_equal(grid_set(&g, GRID_DENSITY, -20, 3, 40, 0.75f), ARGIL_OK);
+    grid_bounds(&g, lo, hi);
+    assert_int_equal(lo[0], -20);
+    assert_int_equal(hi[2], 41);
+    assert_int_equal(lo[1], 0);
+    assert_float_equal(grid_get(&g, GRID_DENSITY, -20, 3, 40), 0.75f, 0.0f);
+    assert_float_equal(grid_density_at(&g, vec3(-20 * H, 3 * H, 40 * H)), 0.75f, 1e-5f);
+    /* A box across old and new ground reads back what was written, 0 elsewhere. */
+    float box[27];
+    const int32_t b0[3] = {-21, 2, 39}, bn[3] = {3, 3, 3};
+    grid_read_box(&g, GRID_DENSITY, b0, bn, box);
+    for (int i = 0; i < 27; i++)
+        assert_float_equal(box[i], i == 13 ? 0.75f : 0.0f, 0.0f);
+    assert_int_equal(g.data_blocks, 1);
+    /* Writing empty clay over empty space allocates nothing. */
+    for (int i = 0; i < 27; i++)
+        box[i] = 0.0f;
+    const int32_t far[3] = {100, 100, 100};
+    assert_int_equal(grid_write_box(&g, GRID_DENSITY, far, bn, box), ARGIL_OK);
+    assert_int_equal(g.data_blocks, 1);
+    /* Back to empty: compaction frees the block and the bounds shrink to the nominal box. */
+    assert_int_equal(grid_set(&g, GRID_DENSITY, -20, 3, 40, 0.0f), ARGIL_OK);
+    grid_compact(&g);
+    assert_int_equal(g.data_blocks, 0);
+    grid_bounds(&g, lo, hi);
+    assert_true(lo[0] == 0 && hi[0] == 16 && lo[2] == 0 && hi[2] == 16);
+    grid_free(&g);
 }
 
 int main(void)
@@ -315,6 +411,8 @@ int main(void)
         cmocka_unit_test(test_add_force),
         cmocka_unit_test(test_springs_push_lowers_density),
         cmocka_unit_test(test_painted_channels),
+        cmocka_unit_test(test_memory_follows_the_surface),
+        cmocka_unit_test(test_grows_in_every_direction),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,7 +1,7 @@
 /* Painted colour on the B-spline model and its grid view (gsolve_apply_tool with HOST_ACT_PAINT /
  * HOST_ACT_SOFT_PAINT, gsolve_colour_to_grid, gsolve_colour_from_grid): paint reaches exactly the
  * samples inside the tool (and their mirror images), changes no density and leaves the window
- * alone, soft paint blends in step by step, the grid's rgb stays NULL until something is painted,
+ * alone, soft paint blends in step by step, the grid holds no colour arrays until something is painted,
  * and the colour goes from grid to model and back byte for byte. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +15,7 @@
 
 #include "host/app/global_solve.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 40
 #define H 1.25e-3f
@@ -64,22 +65,24 @@ static void test_paint_colours_the_ball_only(void **st)
     (void)st;
     gsolve_t gs;
     grid_t *g = sphere_grid(&gs);
-    assert_null(g->rgb);
+    assert_false(grid_rgb_any(g));
     const size_t n = (size_t)N * N * N;
-    float *d0 = malloc(n * sizeof(float));
-    assert_non_null(d0);
-    memcpy(d0, g->density, n * sizeof(float));
+    float *d0 = malloc(n * sizeof(float)), *d1 = malloc(n * sizeof(float));
+    uint8_t *col = malloc(3 * n);
+    assert_true(d0 != NULL && d1 != NULL && col != NULL);
+    gv_copy(g, GRID_DENSITY, d0);
     const uint32_t w0 = g->rgb_writes;
     const uint8_t red[3] = {230, 20, 20};
     const vec3_t at = vec3(R, 0, 0); /* on the +x surface, mirrored onto -x */
     int32_t lo[3], hi[3];
     assert_int_equal(paint(&gs, g, HOST_ACT_PAINT, HOST_MIRROR_X, 0.0f, red, 4e-3f, at, lo, hi),
                      ARGIL_OK);
-    assert_non_null(g->rgb);
+    assert_true(grid_rgb_any(g));
     assert_true(g->rgb_writes > w0); /* once per mirror image that changed */
     const uint32_t w1 = g->rgb_writes;
     assert_true(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2]);
-    assert_memory_equal(g->density, d0, n * sizeof(float)); /* no clay moved */
+    assert_memory_equal(gv_copy(g, GRID_DENSITY, d1), d0, n * sizeof(float)); /* no clay moved */
+    gv_rgb_copy(g, col);
     assert_false(gs.stale);                                /* nor the window reloaded */
     size_t in = 0, in_red = 0, out_red = 0, edge = 0;
     for (size_t i = 0; i < n; i++) {
@@ -87,10 +90,10 @@ static void test_paint_colours_the_ball_only(void **st)
         const float dp = vec3_norm(vec3_sub(p, at));
         const float dm = vec3_norm(vec3_sub(p, vec3(-R, 0, 0)));
         const float dist = dp < dm ? dp : dm;
-        const bool is_red = memcmp(&g->rgb[3 * i], red, 3) == 0;
-        const bool is_base = g->rgb[3 * i] == GRID_RGB_DEFAULT &&
-                             g->rgb[3 * i + 1] == GRID_RGB_DEFAULT &&
-                             g->rgb[3 * i + 2] == GRID_RGB_DEFAULT;
+        const bool is_red = memcmp(&col[3 * i], red, 3) == 0;
+        const bool is_base = col[3 * i] == GRID_RGB_DEFAULT &&
+                             col[3 * i + 1] == GRID_RGB_DEFAULT &&
+                             col[3 * i + 2] == GRID_RGB_DEFAULT;
         assert_true(is_red || is_base); /* paint is all or nothing */
         if (dist < 4e-3f - 1e-5f) {
             in++;
@@ -118,6 +121,8 @@ static void test_paint_colours_the_ball_only(void **st)
     assert_int_equal(g->rgb_writes, w1);
     assert_true(lo[0] == hi[0]);
     free(d0);
+    free(d1);
+    free(col);
     free_all(&gs, g);
 }
 
@@ -130,25 +135,27 @@ static void test_soft_paint_blends_in(void **st)
     /* the sample at the tool centre, 10.6 mm inside the +x surface (density 1) */
     const size_t c = (size_t)(N / 2 + 8) + (size_t)N * ((size_t)(N / 2) + (size_t)N * (N / 2));
     const vec3_t at = sample_pos(g, c);
-    assert_true(g->density[c] == 1.0f);
+    assert_true(gv_get(g, GRID_DENSITY, c) == 1.0f);
     /* per step the colour moves by w = 20 /s x 10 ms x phi x d of the way, phi the tool's
      * profile at its centre: 0.5 + 0.5 x 4 mm / band (5 mm) = 0.9, so w = 0.18 */
     const float phi = 0.5f + 0.5f * 4e-3f / g->band_m;
     const double w = 20.0 * DT * phi;
     int32_t lo[3], hi[3];
     double r_want = GRID_RGB_DEFAULT, b_want = GRID_RGB_DEFAULT;
+    uint8_t cc[3];
     for (int k = 0; k < 10; k++) {
         assert_int_equal(paint(&gs, g, HOST_ACT_SOFT_PAINT, 0, 20.0f, blue, 4e-3f, at, lo, hi),
                          ARGIL_OK);
-        assert_non_null(g->rgb);
+        assert_true(grid_rgb_any(g));
         r_want += (0.0 - r_want) * w;
         b_want += (255.0 - b_want) * w;
-        assert_true(fabs(g->rgb[3 * c] - r_want) <= 1.0 && fabs(g->rgb[3 * c + 2] - b_want) <= 1.0);
+        gv_rgb(g, c, cc);
+        assert_true(fabs(cc[0] - r_want) <= 1.0 && fabs(cc[2] - b_want) <= 1.0);
     }
     print_message("# soft paint (w %.3f per step): centre after 10 steps %u %u %u (want %.1f, "
-                  "%.1f)\n", w, g->rgb[3 * c], g->rgb[3 * c + 1], g->rgb[3 * c + 2], r_want, b_want);
+                  "%.1f)\n", w, cc[0], cc[1], cc[2], r_want, b_want);
     /* 0.82^10 = 0.137 of the way left */
-    assert_true(g->rgb[3 * c] < 32 && g->rgb[3 * c + 2] > 245);
+    assert_true(cc[0] < 32 && cc[2] > 245);
     free_all(&gs, g);
 }
 
@@ -163,30 +170,33 @@ static void test_carve_leaves_no_colour_and_round_trip(void **st)
     const vec3_t at = vec3(0, R, 0);
     assert_int_equal(gsolve_apply_tool(&gs, g, &t, 3e-3f, vec3(0, 0, 1), &at, 1, DT, lo, hi),
                      ARGIL_OK);
-    assert_null(g->rgb); /* a carve paints nothing: unpainted sessions stay as before */
+    assert_false(grid_rgb_any(g)); /* a carve paints nothing: unpainted sessions stay as before */
     const int32_t all_lo[3] = {0, 0, 0};
     assert_int_equal(gsolve_colour_to_grid(&gs, g, all_lo, g->dims), ARGIL_OK);
-    assert_null(g->rgb);
+    assert_false(grid_rgb_any(g));
     /* every byte value survives grid -> model -> grid */
     const size_t n = (size_t)N * N * N;
-    uint8_t *rgb = grid_rgb_alloc(g);
+    uint8_t *rgb = malloc(3 * n);
     assert_non_null(rgb);
     for (size_t i = 0; i < 3 * n; i++)
         rgb[i] = (uint8_t)(i * 7u + i / 3u);
+    assert_int_equal(gv_rgb_store(g, rgb), ARGIL_OK);
     uint8_t *keep = malloc(3 * n);
     assert_non_null(keep);
     memcpy(keep, rgb, 3 * n);
     assert_int_equal(gsolve_colour_from_grid(&gs, g), ARGIL_OK);
     memset(rgb, (int)GRID_RGB_DEFAULT, 3 * n);
+    assert_int_equal(gv_rgb_store(g, rgb), ARGIL_OK);
     const uint32_t w = g->rgb_writes;
     assert_int_equal(gsolve_colour_to_grid(&gs, g, all_lo, g->dims), ARGIL_OK);
-    assert_memory_equal(g->rgb, keep, 3 * n);
+    assert_memory_equal(gv_rgb_copy(g, rgb), keep, 3 * n);
     assert_int_equal(g->rgb_writes, w + 1);
     /* a box beyond the grid is clipped, not refused */
     const int32_t blo[3] = {-10, -10, -10}, bhi[3] = {N + 10, 3, 3};
     assert_int_equal(gsolve_colour_to_grid(&gs, g, blo, bhi), ARGIL_OK);
     assert_true(grid_rgb_painted(g));
     free(keep);
+    free(rgb);
     free_all(&gs, g);
 }
 

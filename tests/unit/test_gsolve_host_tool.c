@@ -16,6 +16,7 @@
 #include "host/app/global_solve.h"
 #include "host/app/peer.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
@@ -58,9 +59,9 @@ static float crossing_m(const grid_t *g, int axis, int sign, int32_t off)
     const int32_t start = sign > 0 ? c1 : c0;
     for (int32_t k = 0; k + 1 < N / 2; k++) {
         at[axis] = start + sign * k;
-        const float a = g->density[gidx(g, at[0], at[1], at[2])];
+        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         at[axis] = start + sign * (k + 1);
-        const float b = g->density[gidx(g, at[0], at[1], at[2])];
+        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
         if (a >= 0.5f && b < 0.5f) {
             const float pos = (float)(start + sign * k) + (float)sign * (a - 0.5f) / (a - b);
             return fabsf(pos - 0.5f * (float)(N - 1)) * H;
@@ -73,7 +74,7 @@ static double volume_m3(const grid_t *g)
 {
     double s = 0.0;
     for (size_t i = 0; i < (size_t)N * N * N; i++)
-        s += g->density[i];
+        s += gv_get(g, GRID_DENSITY, i);
     return s * (double)H * H * H;
 }
 
@@ -170,13 +171,13 @@ static void test_strength_is_per_second(void **st)
         gsolve_t gs;
         grid_t *g = sphere_grid(&gs);
         const int32_t c = N / 2, x = N - 4; /* 5.6 mm beyond the surface: density 0 */
-        const float before = g->density[gidx(g, x, c, c)];
+        const float before = gv_get(g, GRID_DENSITY, gidx(g, x, c, c));
         const float px = ((float)x - 0.5f * (float)(N - 1)) * H;
         assert_int_equal(apply(&gs, g, HOST_ACT_TOOTHPASTE, HOST_SHAPE_SPHERE, 0, 5.0f, 4e-3f,
                                vec3(px, ((float)c - 0.5f * (float)(N - 1)) * H,
                                     ((float)c - 0.5f * (float)(N - 1)) * H),
                                k == 0 ? DT : 2.0f * DT), ARGIL_OK);
-        rise[k] = g->density[gidx(g, x, c, c)] - before;
+        rise[k] = gv_get(g, GRID_DENSITY, gidx(g, x, c, c)) - before;
         free_all(&gs, g);
     }
     print_message("# toothpaste 5/s: density at the tool centre +%.4f (10 ms), +%.4f (20 ms)\n",
@@ -249,7 +250,7 @@ static void test_bad_settings_change_nothing(void **st)
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     host_tool_t t;
     host_tool_default(&t);
     const vec3_t at = vec3(0, R, 0);
@@ -278,7 +279,7 @@ static void test_bad_settings_change_nothing(void **st)
                      ARGIL_ERR_ARG);
     assert_int_equal(lo[0], 0);
     assert_int_equal(hi[0], 0);
-    assert_memory_equal(before, g->density, n * sizeof(float));
+    assert_true(gv_equal(g, GRID_DENSITY, before));
     free(before);
     free_all(&gs, g);
 }

@@ -18,19 +18,62 @@
 #include "host/app/script.h"
 #include "host/mesh/mc.h"
 #include "host/model/grid.h"
-#include "tests/unit/test_grids.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
 #define RAD 0.020f
 #define DT 0.01f
 
+static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+}
+
+/* A 48³ grid at 1.25 mm centred on the origin holding a 20 mm sphere. */
+static grid_t *sphere_grid(void)
+{
+    grid_t *g = malloc(sizeof(*g));
+    assert_non_null(g);
+    const int32_t dims[3] = {N, N, N};
+    const float o = -0.5f * (float)(N - 1) * H;
+    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
+    grid_fill_sphere(g, vec3(0, 0, 0), RAD);
+    return g;
+}
+
+static void free_grid(grid_t *g)
+{
+    grid_free(g);
+    free(g);
+}
+
+/* Where the density along +axis from the centre sample crosses 0.5 (m from the grid centre). */
+static float crossing_m(const grid_t *g, int axis)
+{
+    const int32_t c = N / 2;
+    int32_t at[3] = {c, c, c};
+    for (int32_t i = c; i + 1 < N; i++) {
+        at[axis] = i;
+        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        at[axis] = i + 1;
+        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        if (a >= 0.5f && b < 0.5f) {
+            const float pos = (float)i + (a - 0.5f) / (a - b);
+            return (pos - 0.5f * (float)(N - 1)) * H;
+        }
+    }
+    return -1.0f;
+}
+
 static size_t mesh_vertices(const grid_t *g)
 {
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract(g->density, g->dims, g->spacing_m, g->origin_m, g->iso, &m),
-                     ARGIL_OK);
+    float *d = gv_dup(g, GRID_DENSITY);
+    assert_non_null(d);
+    assert_int_equal(mc_extract(d, g->dims, g->spacing_m, g->origin_m, g->iso, &m), ARGIL_OK);
+    free(d);
     const size_t n = m.n_vert;
     mesh_free(&m);
     return n;
@@ -56,7 +99,7 @@ static void push_at(grid_t *g, int32_t x, int32_t y, int32_t z, float force_n)
 static int32_t surface_y(const grid_t *g)
 {
     int32_t sy = N / 2;
-    while (g->density[test_gidx(g, N / 2, sy + 1, N / 2)] >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gidx(g, N / 2, sy + 1, N / 2)) >= 0.5f)
         sy++;
     return sy;
 }
@@ -69,25 +112,25 @@ static void test_seed_at_coarser_ratios(void **st)
      * 2.5e-2 and 0.105 mm) */
     const float ramp_max[2] = {0.015f, 0.035f}, surf_max_m[2] = {0.03e-3f, 0.03e-3f};
     for (int k = 0; k < 2; k++) {
-        grid_t *g = test_sphere_grid(N, H, RAD);
+        grid_t *g = sphere_grid();
         const size_t n = (size_t)N * N * N;
         float *orig = malloc(n * sizeof(float));
         assert_non_null(orig);
-        memcpy(orig, g->density, n * sizeof(float));
-        const float x0 = test_crossing_m(g, 0);
+        gv_copy(g, GRID_DENSITY, orig);
+        const float x0 = crossing_m(g, 0);
         gsolve_t gs;
         assert_int_equal(gsolve_init_ratio(&gs, g, ratios[k]), ARGIL_OK);
         assert_int_equal(gsolve_ratio(&gs), ratios[k]);
         float ramp_err = 0.0f, any_err = 0.0f;
         for (size_t i = 0; i < n; i++) {
-            const float e = fabsf(g->density[i] - orig[i]);
+            const float e = fabsf(gv_get(g, GRID_DENSITY, i) - orig[i]);
             if (orig[i] > 0.15f && orig[i] < 0.85f && e > ramp_err)
                 ramp_err = e;
             if (e > any_err)
                 any_err = e;
-            assert_true(g->rest[i] == g->density[i]);
+            assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
         }
-        const float dx = test_crossing_m(g, 0) - x0;
+        const float dx = crossing_m(g, 0) - x0;
         print_message("# seed R=%d: ramp error %.2e, largest %.2e; +x surface moved %.4f mm\n",
                       (int)ratios[k], (double)ramp_err, (double)any_err, (double)dx * 1e3);
         /* Quasi-interpolation (p_c = density at sample R c) then GSOLVE_SEED_FIT_ITERS of
@@ -97,14 +140,14 @@ static void test_seed_at_coarser_ratios(void **st)
         assert_true(fabsf(dx) < surf_max_m[k]);
         gsolve_free(&gs);
         free(orig);
-        test_grid_free(g);
+        free_grid(g);
     }
-    grid_t *g = test_sphere_grid(N, H, RAD);
+    grid_t *g = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init_ratio(&gs, g, 3), ARGIL_ERR_ARG);
     assert_int_equal(gsolve_init_ratio(&gs, g, 0), ARGIL_ERR_ARG);
     assert_int_equal(gsolve_init_ratio(&gs, g, 8), ARGIL_ERR_ARG);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 /* Pushes the +y surface for a step (40 N for 10 ms) with the window on it and lets it flow for
@@ -125,7 +168,7 @@ static void push_and_flow(gsolve_t *gs, grid_t *g, float force_n, int flow)
 /* Refines a field in motion (pushed, flowing) started at ratio r0: R halves, no sample moves. */
 static void refine_keeps_the_shape(int32_t r0)
 {
-    grid_t *g = test_sphere_grid(N, H, RAD);
+    grid_t *g = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init_ratio(&gs, g, r0), ARGIL_OK);
     push_and_flow(&gs, g, -40.0f, 3); /* still moving: the refinement sees velocities */
@@ -133,7 +176,7 @@ static void refine_keeps_the_shape(int32_t r0)
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
     for (int32_t r = r0; r > 1; r /= 2) {
-        memcpy(before, g->density, n * sizeof(float));
+        gv_copy(g, GRID_DENSITY, before);
         const size_t verts = mesh_vertices(g);
         const size_t coef_blocks = gs.field.coef.count;
         float dd = -1.0f;
@@ -150,7 +193,7 @@ static void refine_keeps_the_shape(int32_t r0)
         /* nothing crossed the view's threshold: the grid, so the mesh and the board's window,
          * stayed as they were */
         assert_int_equal(hi[0] - lo[0], 0);
-        assert_memory_equal(before, g->density, n * sizeof(float));
+        assert_true(gv_equal(g, GRID_DENSITY, before));
         assert_int_equal(mesh_vertices(g), verts);
         assert_false(gs.win_open); /* reopened on the new lattice by the next step */
         push_and_flow(&gs, g, 0.0f, 1);
@@ -158,7 +201,7 @@ static void refine_keeps_the_shape(int32_t r0)
     }
     assert_int_equal(gs.stats.refines, r0 == 4 ? 2 : 1);
     /* R = 1: refused, nothing changes */
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const uint32_t gen = gs.field.lattice_gen;
     float dd = -1.0f;
     int32_t lo[3], hi[3];
@@ -166,10 +209,10 @@ static void refine_keeps_the_shape(int32_t r0)
     assert_int_equal(gsolve_ratio(&gs), 1);
     assert_int_equal(gs.field.lattice_gen, gen);
     assert_true(dd == 0.0f);
-    assert_memory_equal(before, g->density, n * sizeof(float));
+    assert_true(gv_equal(g, GRID_DENSITY, before));
     free(before);
     gsolve_free(&gs);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 static void test_refine_keeps_the_shape(void **st)
@@ -183,7 +226,7 @@ static void test_refine_keeps_the_shape(void **st)
  * `refines` times first: the density moved in total and at the pushed sample. */
 static void dent(int32_t r0, int refines, float *sum_moved, float *at_moved)
 {
-    grid_t *g = test_sphere_grid(N, H, RAD);
+    grid_t *g = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init_ratio(&gs, g, r0), ARGIL_OK);
     push_and_flow(&gs, g, 0.0f, 2); /* a window open (and resting) before the refinement */
@@ -195,17 +238,17 @@ static void dent(int32_t r0, int refines, float *sum_moved, float *at_moved)
     const size_t n = (size_t)N * N * N;
     float *before = malloc(n * sizeof(float));
     assert_non_null(before);
-    memcpy(before, g->density, n * sizeof(float));
+    gv_copy(g, GRID_DENSITY, before);
     const int32_t c = N / 2, sy = surface_y(g);
     push_and_flow(&gs, g, -40.0f, 30);
     double sum = 0.0;
     for (size_t i = 0; i < n; i++)
-        sum += (double)g->density[i] - before[i];
+        sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
-    *at_moved = g->density[test_gidx(g, c, sy, c)] - before[test_gidx(g, c, sy, c)];
+    *at_moved = gv_get(g, GRID_DENSITY, gidx(g, c, sy, c)) - before[gidx(g, c, sy, c)];
     free(before);
     gsolve_free(&gs);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 static void test_push_after_refine_moves_the_clay(void **st)
@@ -241,7 +284,7 @@ static void test_push_after_refine_moves_the_clay(void **st)
 static void test_window_shift_at_ratio_2(void **st)
 {
     (void)st;
-    grid_t *g1 = test_sphere_grid(N, H, RAD), *g2 = test_sphere_grid(N, H, RAD);
+    grid_t *g1 = sphere_grid(), *g2 = sphere_grid();
     gsolve_t a, b;
     assert_int_equal(gsolve_init_ratio(&a, g1, 2), ARGIL_OK);
     assert_int_equal(gsolve_init_ratio(&b, g2, 2), ARGIL_OK);
@@ -268,7 +311,7 @@ static void test_window_shift_at_ratio_2(void **st)
     assert_int_equal(a.stats.windows_opened, 1);
     assert_int_equal(a.stats.windows_moved, 3);
     assert_int_equal(b.stats.windows_opened, 4);
-    assert_memory_equal(g1->density, g2->density, sizeof(float) * N * N * N);
+    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
     assert_true(largest > 1e-4f); /* the forces did move the clay */
     /* one sample to the side (samples 26..46 → 27..47): the same coefficients 13..23 */
     const int32_t lo[3] = {c + 3, sy - 8, c - 8}, hi[3] = {c + 24, sy + 8, c + 8};
@@ -282,15 +325,15 @@ static void test_window_shift_at_ratio_2(void **st)
     assert_int_equal(a.stats.windows_moved, moved);
     gsolve_free(&a);
     gsolve_free(&b);
-    test_grid_free(g1);
-    test_grid_free(g2);
+    free_grid(g1);
+    free_grid(g2);
 }
 
 /* Carving at R = 2 (tool_apply on coefficients 2.5 mm apart) cuts where the grid's carve does. */
 static void test_carve_at_ratio_2(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, RAD), *ref = test_sphere_grid(N, H, RAD);
+    grid_t *g = sphere_grid(), *ref = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init_ratio(&gs, g, 2), ARGIL_OK);
     const vec3_t at = vec3(0, RAD, 0);
@@ -298,7 +341,7 @@ static void test_carve_at_ratio_2(void **st)
     int32_t lo[3], hi[3], rlo[3], rhi[3];
     assert_int_equal(gsolve_carve_sphere(&gs, g, at, radius, lo, hi), ARGIL_OK);
     grid_carve_sphere(ref, at, radius, rlo, rhi);
-    const float y_b = test_crossing_m(g, 1), y_g = test_crossing_m(ref, 1);
+    const float y_b = crossing_m(g, 1), y_g = crossing_m(ref, 1);
     print_message("# carve at R=2: +y surface %.2f mm (grid carve %.2f mm, sphere %.1f)\n",
                   (double)y_b * 1e3, (double)y_g * 1e3, (double)RAD * 1e3);
     assert_true(hi[0] > lo[0]);
@@ -313,17 +356,17 @@ static void test_carve_at_ratio_2(void **st)
     float dd;
     assert_int_equal(gsolve_refine(&gs, g, &dd, lo, hi), ARGIL_OK);
     assert_true(dd < 1e-5f);
-    assert_true(fabsf(test_crossing_m(g, 1) - y_b) < 0.05e-3f);
+    assert_true(fabsf(crossing_m(g, 1) - y_b) < 0.05e-3f);
     gsolve_free(&gs);
-    test_grid_free(ref);
-    test_grid_free(g);
+    free_grid(ref);
+    free_grid(g);
 }
 
 /* The peer's refine: refused with the springs solve and at R = 1; at R = 2 it halves R. */
 static void test_peer_refine(void **st)
 {
     (void)st;
-    grid_t *g = test_sphere_grid(N, H, RAD);
+    grid_t *g = sphere_grid();
     peer_cfg_t cfg;
     peer_cfg_default(&cfg);
     assert_int_equal(cfg.knot_ratio, 1);
@@ -350,7 +393,7 @@ static void test_peer_refine(void **st)
     assert_int_equal(p->stats.refines, 1);
     peer_free(p);
     free(p);
-    test_grid_free(g);
+    free_grid(g);
 }
 
 static void test_script_refine_verb(void **st)

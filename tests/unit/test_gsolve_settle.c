@@ -13,6 +13,7 @@
 
 #include "host/app/global_solve.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 48
 #define H 1.25e-3f
@@ -96,7 +97,7 @@ static grid_t *run(run_t how, bool elastic, int after, gsolve_stats_t *stats)
 
 static float dent_at(const grid_t *g)
 {
-    return g->density[gidx(g, C, SY, C)];
+    return gv_get(g, GRID_DENSITY, gidx(g, C, SY, C));
 }
 
 /* Largest |a - b| over the top window's samples. */
@@ -106,7 +107,8 @@ static float top_diff(const grid_t *a, const grid_t *b)
     for (int32_t z = C - 8; z < C + 8; z++)
         for (int32_t y = SY - 8; y < N; y++)
             for (int32_t x = C - 8; x < C + 8; x++) {
-                const float d = fabsf(a->density[gidx(a, x, y, z)] - b->density[gidx(b, x, y, z)]);
+                const float d = fabsf(gv_get(a, GRID_DENSITY, gidx(a, x, y, z)) -
+                                      gv_get(b, GRID_DENSITY, gidx(b, x, y, z)));
                 if (d > m)
                     m = d;
             }
@@ -199,7 +201,7 @@ static void test_settling_region_rests(void **st)
     assert_int_equal(s.settle_rested, 1);
     assert_true(s.settle_steps >= 2 && s.settle_steps < 60);
     for (size_t i = 0; i < (size_t)N * N * N; i++)
-        assert_true(g->density[i] >= 0.0f && g->density[i] <= 1.0f);
+        assert_true(gv_get(g, GRID_DENSITY, i) >= 0.0f && gv_get(g, GRID_DENSITY, i) <= 1.0f);
     grid_free(g);
     free(g);
 }

@@ -19,6 +19,7 @@
 #include "host/mesh/mc_blocks.h"
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #include "tests/unit/test_files.h"
 
@@ -43,7 +44,7 @@ static void sphere_mesh(mesh_t *m, bool colours)
         rgb[3 * i + 2] = 7;
     }
     mesh_init(m);
-    assert_int_equal(mc_extract_region(g.density, colours ? rgb : NULL, g.dims, g.spacing_m,
+    assert_int_equal(mc_extract_region(gv_dense(&g), colours ? rgb : NULL, g.dims, g.spacing_m,
                                        g.origin_m, 0.5f, NULL, NULL, m),
                      ARGIL_OK);
     free(rgb);

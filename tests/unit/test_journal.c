@@ -20,6 +20,7 @@
 #include "shared/crc32c.h"
 
 #include "tests/unit/test_files.h"
+#include "tests/unit/grid_view.h"
 
 #define EDGE_X 10
 #define EDGE_Y 9
@@ -75,7 +76,7 @@ static sess_t *sess_new(const journal_cfg_t *cfg)
     char err[512] = "";
     assert_int_equal(journal_open(&s->j, g_test_dir, &s->grid, &c, 0.0, 0.0, err, sizeof(err)),
                      ARGIL_OK);
-    memcpy(s->after[0], s->grid.density, sizeof(s->after[0]));
+    gv_copy(&s->grid, GRID_DENSITY, s->after[0]);
     s->mat_after[0] = s->grid.material;
     return s;
 }
@@ -92,7 +93,7 @@ static void sess_free(sess_t *s)
  * whether a record was appended, after checking the journal agrees. */
 static bool sess_step(sess_t *s, uint32_t k, double sim_s, double real_s)
 {
-    float *d = s->grid.density;
+    grid_t *g = &s->grid;
     const bool material_only = k % 7 == 6, nothing = k % 5 == 4 && !material_only;
     if (material_only) {
         s->grid.material.stiffness += 0.25f;
@@ -100,12 +101,13 @@ static bool sess_step(sess_t *s, uint32_t k, double sim_s, double real_s)
         const uint32_t start = rng_next(&s->rng) % (N_SAMPLES - 40);
         for (uint32_t i = 0; i < 30; i++)
             if (i % 4 != 3) /* gaps of one unchanged sample: bridged into one run */
-                d[start + i] = (float)(rng_next(&s->rng) % 100001u) * 1e-5f;
+                gv_set(g, GRID_DENSITY, start + i, (float)(rng_next(&s->rng) % 100001u) * 1e-5f);
         for (uint32_t i = 0; i < 5; i++)
-            d[rng_next(&s->rng) % N_SAMPLES] = (float)(rng_next(&s->rng) % 1000u) * 1e-3f;
-        d[rng_next(&s->rng) % N_SAMPLES] = -0.0f;
-        d[rng_next(&s->rng) % N_SAMPLES] = 1e-40f;
-        d[rng_next(&s->rng) % N_SAMPLES] = 1.0f;
+            gv_set(g, GRID_DENSITY, rng_next(&s->rng) % N_SAMPLES,
+                   (float)(rng_next(&s->rng) % 1000u) * 1e-3f);
+        gv_set(g, GRID_DENSITY, rng_next(&s->rng) % N_SAMPLES, -0.0f);
+        gv_set(g, GRID_DENSITY, rng_next(&s->rng) % N_SAMPLES, 1e-40f);
+        gv_set(g, GRID_DENSITY, rng_next(&s->rng) % N_SAMPLES, 1.0f);
     }
     bool appended = false;
     char err[512] = "";
@@ -116,7 +118,7 @@ static bool sess_step(sess_t *s, uint32_t k, double sim_s, double real_s)
     if (appended) {
         s->records++;
         assert_true(s->records <= MAX_STEPS);
-        memcpy(s->after[s->records], d, sizeof(s->after[0]));
+        gv_copy(g, GRID_DENSITY, s->after[s->records]);
         s->mat_after[s->records] = s->grid.material;
     }
     assert_int_equal(journal_tick(&s->j, sim_s, real_s, err, sizeof(err)), ARGIL_OK);
@@ -129,11 +131,6 @@ static void sess_steps(sess_t *s, uint32_t n)
         (void)sess_step(s, k, 0.1 * (double)k, 0.05 * (double)k);
     char err[512] = "";
     assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
-}
-
-static void assert_density(const float *got, const float *want)
-{
-    assert_memory_equal(got, want, N_SAMPLES * sizeof(float));
 }
 
 static void test_round_trip(void **state)
@@ -149,8 +146,8 @@ static void test_round_trip(void **state)
     journal_info_t info;
     char err[512] = "";
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
-    assert_density(doc.grid.density, s->grid.density);
-    assert_density(doc.grid.rest, s->grid.density);
+    assert_true(gv_same(&doc.grid, GRID_DENSITY, &s->grid, GRID_DENSITY));
+    assert_true(gv_same(&doc.grid, GRID_REST, &s->grid, GRID_DENSITY));
     assert_int_equal(info.records, 24);
     assert_int_equal(info.first_seq, 1);
     assert_int_equal(info.last_seq, 24);
@@ -198,7 +195,7 @@ static void test_no_records_gives_the_base(void **state)
     char err[512] = "";
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 0);
-    assert_density(doc.grid.density, s->after[0]);
+    assert_true(gv_equal(&doc.grid, GRID_DENSITY, s->after[0]));
     argil_doc_free(&doc);
     sess_free(s);
 }
@@ -230,7 +227,7 @@ static void test_torn_tail_every_byte(void **state)
         assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
         assert_int_equal(info.records, 3);
         assert_int_equal(info.torn_bytes, cut - last);
-        assert_density(doc.grid.density, s->after[3]);
+        assert_true(gv_equal(&doc.grid, GRID_DENSITY, s->after[3]));
         argil_doc_free(&doc);
     }
     /* A cut inside the header is a clear refusal, not a crash. */
@@ -240,7 +237,7 @@ static void test_torn_tail_every_byte(void **state)
     char err[512] = "";
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "shorter than the journal header"));
-    assert_null(doc.grid.density);
+    assert_int_equal(grid_count(&doc.grid), 0);
     free(full);
     sess_free(s);
 }
@@ -269,8 +266,8 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
     snprintf(want, sizeof(want), "byte %zu:", r2);
     assert_non_null(strstr(err, want));
     assert_int_equal(info.records, 1);
-    assert_non_null(doc.grid.density);
-    assert_density(doc.grid.density, s->after[1]);
+    assert_true(grid_count(&doc.grid) > 0);
+    assert_true(gv_equal(&doc.grid, GRID_DENSITY, s->after[1]));
     argil_doc_free(&doc);
     full[r2 + 70] ^= 0x10;
 
@@ -280,7 +277,7 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 3);
     assert_int_equal(info.torn_bytes, len - r4);
-    assert_density(doc.grid.density, s->after[3]);
+    assert_true(gv_equal(&doc.grid, GRID_DENSITY, s->after[3]));
     argil_doc_free(&doc);
     free(full);
     sess_free(s);
@@ -301,12 +298,12 @@ static void test_wrong_base_refused(void **state)
     journal_info_t info;
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "is not the one this journal continues"));
-    assert_null(doc.grid.density);
+    assert_int_equal(grid_count(&doc.grid), 0);
     /* No base at all. */
     assert_int_equal(unlink(bp), 0);
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_IO);
     assert_non_null(strstr(err, "journal-base-0.argil"));
-    assert_null(doc.grid.density);
+    assert_int_equal(grid_count(&doc.grid), 0);
     sess_free(s);
 }
 
@@ -330,7 +327,7 @@ static void test_checkpoint_rotation(void **state)
     assert_true(info.first_seq > 1);
     assert_int_equal(info.last_seq, s->records);
     assert_int_equal(info.edits, s->records);
-    assert_density(doc.grid.density, s->grid.density);
+    assert_true(gv_same(&doc.grid, GRID_DENSITY, &s->grid, GRID_DENSITY));
     assert_memory_equal(&doc.grid.material, &s->grid.material, sizeof(spring_material_t));
     argil_doc_free(&doc);
     sess_free(s);
@@ -532,13 +529,13 @@ static void test_box_hint(void **state)
 {
     (void)state;
     sess_t *s = sess_new(NULL);
-    float *d = s->grid.density;
+    grid_t *g = &s->grid;
     char err[512] = "";
     bool appended = false;
     const size_t inside = 1 + EDGE_X * (2 + EDGE_Y * 3);     /* (1, 2, 3) */
     const size_t outside = 9 + EDGE_X * (8 + EDGE_Y * 7);    /* (9, 8, 7) */
-    d[inside] = 0.123f;
-    d[outside] = 0.456f;
+    gv_set(g, GRID_DENSITY, inside, 0.123f);
+    gv_set(g, GRID_DENSITY, outside, 0.456f);
     const journal_box_t box = {{-5, 0, 1}, {4, 3, 4}};       /* x clipped to [0, 4) */
     assert_int_equal(journal_record(&s->j, &s->grid, &box, 1, 0.01, 0.0, 0, &appended, err,
                                     sizeof(err)),
@@ -561,7 +558,7 @@ static void test_box_hint(void **state)
     journal_info_t info;
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 2);
-    assert_density(doc.grid.density, d);
+    assert_true(gv_same(&doc.grid, GRID_DENSITY, g, GRID_DENSITY));
     argil_doc_free(&doc);
     sess_free(s);
 }
@@ -570,10 +567,9 @@ static void test_box_hint(void **state)
 /* Paints (what gsolve_material_to_grid does): channel ch of samples [at, at + n) set to v. */
 static void paint(grid_t *g, grid_mat_t ch, size_t at, size_t n, float v)
 {
-    float *m = grid_mat_alloc(g, ch);
-    assert_non_null(m);
     for (size_t i = 0; i < n; i++)
-        m[at + i] = v;
+        gv_mat_set(g, ch, at + i, v);
+    assert_true(grid_mat_painted(g, ch));
     g->mat_writes++;
 }
 
@@ -616,7 +612,7 @@ static void test_painted_material(void **state)
     s->grid.mat_writes++;
     record(s, &corner, 0.2, false);
     /* A change that skips mat_writes waits for the whole-grid comparison. */
-    s->grid.mat[GRID_MAT_STIFFNESS][5] = 2.0f;
+    gv_mat_set(&s->grid, GRID_MAT_STIFFNESS, 5, 2.0f);
     record(s, &corner, 0.3, false);
     record(s, NULL, 0.4, true);
     assert_int_equal(s->j.stats.mat_samples, 61);
@@ -625,7 +621,7 @@ static void test_painted_material(void **state)
     assert_int_equal(s->j.stats.checkpoints, 1);
     paint(&s->grid, GRID_MAT_STIFFNESS, 100, 10, 3.0f);
     paint(&s->grid, GRID_MAT_RESTLEN, 0, 1, -0.0f);
-    s->grid.density[7] = 0.75f;
+    gv_set(&s->grid, GRID_DENSITY, 7, 0.75f);
     record(s, &corner, 1.2, true);
     assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
 
@@ -635,12 +631,12 @@ static void test_painted_material(void **state)
     assert_int_equal(info.checkpoint, 1);
     assert_int_equal(info.records, 1);
     assert_int_equal(info.mat_samples, 11);
-    assert_density(doc.grid.density, s->grid.density);
+    assert_true(gv_same(&doc.grid, GRID_DENSITY, &s->grid, GRID_DENSITY));
     assert_mat(&doc.grid, &s->grid);
-    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][105], 3.0f, 0);
-    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][139], 4.0f, 0);
-    assert_float_equal(doc.grid.mat[GRID_MAT_MASS][149], 0.5f, 0);
-    assert_true(signbit(doc.grid.mat[GRID_MAT_RESTLEN][0]));
+    assert_float_equal(gv_mat(&doc.grid, GRID_MAT_STIFFNESS, 105), 3.0f, 0);
+    assert_float_equal(gv_mat(&doc.grid, GRID_MAT_STIFFNESS, 139), 4.0f, 0);
+    assert_float_equal(gv_mat(&doc.grid, GRID_MAT_MASS, 149), 0.5f, 0);
+    assert_true(signbit(gv_mat(&doc.grid, GRID_MAT_RESTLEN, 0)));
     /* The writer's model and the recovered one are the same bytes, painted (version 2). */
     char a[128], b[128];
     test_path(a, sizeof(a), "writer.argil");
@@ -667,9 +663,9 @@ static void test_painted_material(void **state)
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
     assert_int_equal(info.records, 0);
     assert_true(info.torn_bytes > 0);
-    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][105], 4.0f, 0);
-    assert_float_equal(doc.grid.mat[GRID_MAT_STIFFNESS][5], 2.0f, 0);
-    assert_null(doc.grid.mat[GRID_MAT_RESTLEN]);
+    assert_float_equal(gv_mat(&doc.grid, GRID_MAT_STIFFNESS, 105), 4.0f, 0);
+    assert_float_equal(gv_mat(&doc.grid, GRID_MAT_STIFFNESS, 5), 2.0f, 0);
+    assert_false(grid_mat_painted(&doc.grid, GRID_MAT_RESTLEN));
     argil_doc_free(&doc);
     test_spit(jp, full, len);
 
@@ -678,12 +674,12 @@ static void test_painted_material(void **state)
     test_path(bp, sizeof(bp), "journal-base-1.argil");
     argil_doc_t base;
     assert_int_equal(argil_file_read(bp, &base, err, sizeof(err)), ARGIL_OK);
-    base.grid.mat[GRID_MAT_MASS][130] = 0.25f;
+    gv_mat_set(&base.grid, GRID_MAT_MASS, 130, 0.25f);
     assert_int_equal(argil_file_write(bp, &base, err, sizeof(err)), ARGIL_OK);
     argil_doc_free(&base);
     assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
     assert_non_null(strstr(err, "is not the one this journal continues"));
-    assert_null(doc.grid.density);
+    assert_int_equal(grid_count(&doc.grid), 0);
 
     /* Record rules for the material blocks (the last record's, its CRC fixed). */
     size_t r = JOURNAL_HEADER_BYTES;
@@ -717,6 +713,61 @@ static void test_painted_material(void **state)
     MAT_CASE(blocks, 1, "bytes after the last run");
 #undef MAT_CASE
     free(full);
+    sess_free(s);
+}
+
+/* The clay grows past the journal's box (the sparse grid holds any index): the journal rebases
+ * onto a new checkpoint over a box that holds it, and recovery rebuilds the grown model bit for
+ * bit, in the new box's indices. */
+static void test_growth_rebases(void **state)
+{
+    (void)state;
+    sess_t *s = sess_new(NULL);
+    grid_t *g = &s->grid;
+    char err[512] = "";
+    bool appended = false;
+    assert_int_equal(grid_set(g, GRID_DENSITY, EDGE_X + 5, 2, 3, 0.625f), ARGIL_OK);
+    assert_int_equal(grid_set(g, GRID_DENSITY, 1, -3, 2, 1e-40f), ARGIL_OK);
+    const journal_box_t box = {{0, -3, 2}, {EDGE_X + 6, 3, 4}};
+    assert_int_equal(journal_record(&s->j, g, &box, 1, 0.01, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.rebases, 1);
+    assert_int_equal(s->j.stats.checkpoints, 1);
+    /* The new box: the old one, grown by JOURNAL_GROW_SAMPLES past each side the clay crossed. */
+    assert_int_equal(s->j.lo[0], 0);
+    assert_int_equal(s->j.lo[1], -3 - JOURNAL_GROW_SAMPLES);
+    assert_int_equal(s->j.dims[0], EDGE_X + 6 + JOURNAL_GROW_SAMPLES);
+    /* A change inside the new box is an ordinary record again. */
+    assert_int_equal(grid_set(g, GRID_DENSITY, EDGE_X + 2, 0, 0, 0.25f), ARGIL_OK);
+    const journal_box_t box2 = {{EDGE_X + 2, 0, 0}, {EDGE_X + 3, 1, 1}};
+    assert_int_equal(journal_record(&s->j, g, &box2, 2, 0.02, 0.0, 0, &appended, err,
+                                    sizeof(err)),
+                     ARGIL_OK);
+    assert_true(appended);
+    assert_int_equal(s->j.stats.rebases, 1);
+    assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
+    argil_doc_t doc;
+    journal_info_t info;
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(info.records, 1);
+    assert_int_equal(doc.grid.dims[0], s->j.dims[0]);
+    int32_t lo[3], hi[3];
+    grid_bounds(g, lo, hi);
+    size_t differ = 0, n = 0;
+    for (int32_t z = lo[2]; z < hi[2]; z++)
+        for (int32_t y = lo[1]; y < hi[1]; y++)
+            for (int32_t x = lo[0]; x < hi[0]; x++, n++)
+                differ += !gv_bits(grid_get(&doc.grid, GRID_DENSITY, x - s->j.lo[0],
+                                            y - s->j.lo[1], z - s->j.lo[2]),
+                                   grid_get(g, GRID_DENSITY, x, y, z));
+    assert_int_equal(differ, 0);
+    assert_true(n > N_SAMPLES);
+    assert_float_equal(grid_get(&doc.grid, GRID_DENSITY, EDGE_X + 5, 2 + 3 + JOURNAL_GROW_SAMPLES,
+                                3),
+                       0.625f, 0.0f);
+    argil_doc_free(&doc);
     sess_free(s);
 }
 
@@ -769,6 +820,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_each_rule, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_box_hint, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_painted_material, setup_dir, test_dir_teardown),
+        cmocka_unit_test_setup_teardown(test_growth_rebases, setup_dir, test_dir_teardown),
         cmocka_unit_test_setup_teardown(test_discard_and_bad_config, setup_dir, test_dir_teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

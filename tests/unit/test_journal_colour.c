@@ -19,6 +19,7 @@
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
 
+#include "tests/unit/grid_view.h"
 #include "tests/unit/test_files.h"
 
 #define EDGE 10
@@ -56,10 +57,11 @@ static void sess_open(sess_t *s, const char *sub)
  * records an edit step whose density box does not cover them: the colour is compared whole. */
 static void sess_paint(sess_t *s, size_t start, size_t count, const uint8_t c[3])
 {
-    uint8_t *rgb = grid_rgb_alloc(&s->grid);
-    assert_non_null(rgb);
-    for (size_t i = start; i < start + count; i++)
-        memcpy(rgb + 3 * i, c, 3);
+    for (size_t i = start; i < start + count; i++) {
+        int32_t x, y, z;
+        gv_xyz(&s->grid, i, &x, &y, &z);
+        assert_int_equal(grid_rgb_set(&s->grid, x, y, z, c), ARGIL_OK);
+    }
     s->grid.rgb_writes++;
     const journal_box_t box = {{0, 0, 0}, {0, 0, 0}};
     bool appended = false;
@@ -83,8 +85,13 @@ static void sess_recover_equal(sess_t *s, const char *sub, uint32_t want_records
         fail_msg("recover: %s", err);
     assert_int_equal(info.records, want_records);
     assert_non_null(d.rgb);
-    assert_memory_equal(d.rgb, s->grid.rgb, 3 * N_SAMPLES);
-    assert_memory_equal(d.grid.density, s->grid.density, N_SAMPLES * sizeof(float));
+    uint8_t rgb[3 * N_SAMPLES];
+    assert_memory_equal(d.rgb, gv_rgb_copy(&s->grid, rgb), 3 * N_SAMPLES);
+    float *da = malloc(2 * N_SAMPLES * sizeof(float));
+    assert_non_null(da);
+    assert_memory_equal(gv_copy(&d.grid, GRID_DENSITY, da),
+                        gv_copy(&s->grid, GRID_DENSITY, da + N_SAMPLES), N_SAMPLES * sizeof(float));
+    free(da);
     if (want_rgb_samples > 0)
         assert_int_equal(info.rgb_samples, want_rgb_samples);
     argil_doc_free(&d);
@@ -137,7 +144,7 @@ static void test_unpainted_has_no_colour_record(void **state)
     (void)state;
     sess_t s;
     sess_open(&s, "b");
-    s.grid.density[555] = 0.25f;
+    gv_set(&s.grid, GRID_DENSITY, 555, 0.25f);
     bool appended = false;
     char err[512] = "";
     assert_int_equal(journal_record(&s.j, &s.grid, NULL, 1, 0.01, 0.0, 1700000000000ull,
@@ -145,7 +152,11 @@ static void test_unpainted_has_no_colour_record(void **state)
                      ARGIL_OK);
     assert_true(appended);
     /* a colour array that holds only the clay's grey is no paint either */
-    assert_non_null(grid_rgb_alloc(&s.grid));
+    const uint8_t red[3] = {230, 20, 20}, grey[3] = {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT,
+                                                     GRID_RGB_DEFAULT};
+    assert_int_equal(grid_rgb_set(&s.grid, 1, 2, 3, red), ARGIL_OK);
+    assert_int_equal(grid_rgb_set(&s.grid, 1, 2, 3, grey), ARGIL_OK);
+    assert_true(grid_rgb_any(&s.grid));
     s.grid.rgb_writes++;
     assert_int_equal(journal_record(&s.j, &s.grid, NULL, 2, 0.02, 0.0, 1700000000000ull,
                                     &appended, err, sizeof(err)),
@@ -299,11 +310,13 @@ static void test_crafted_colour_records(void **state)
         fail_msg("good record: %s", err);
     assert_int_equal(info.records, 1);
     assert_int_equal(info.rgb_samples, 3);
-    assert_non_null(g.rgb);
-    assert_memory_equal(g.rgb + 9, c6, 6);
-    assert_int_equal(g.rgb[3 * 999 + 2], 9);
-    assert_int_equal(g.rgb[0], GRID_RGB_DEFAULT);
-    assert_int_equal(g.rgb[3 * 5], GRID_RGB_DEFAULT);
+    assert_true(grid_rgb_any(&g));
+    uint8_t rgb[3 * N_SAMPLES];
+    gv_rgb_copy(&g, rgb);
+    assert_memory_equal(rgb + 9, c6, 6);
+    assert_int_equal(rgb[3 * 999 + 2], 9);
+    assert_int_equal(rgb[0], GRID_RGB_DEFAULT);
+    assert_int_equal(rgb[3 * 5], GRID_RGB_DEFAULT);
     grid_free(&g);
 }
 

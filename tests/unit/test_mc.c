@@ -14,6 +14,7 @@
 #include "host/mesh/mesh.h"
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -199,13 +200,13 @@ static void test_carved_grid_stays_closed(void **state)
     grid_fill_sphere(&g, vec3(0, 0, 0), 0.030f);
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, g.iso, &m), ARGIL_OK);
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, g.iso, &m), ARGIL_OK);
     const double v_full = mesh_volume_m3(&m);
     int32_t lo[3], hi[3];
     grid_carve_sphere(&g, vec3(0.030f, 0, 0), 0.010f, lo, hi);
     for (int k = -6; k <= 6; k++)
         grid_carve_sphere(&g, vec3(0, 0, 0.005f * (float)k), 0.006f, lo, hi);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, g.iso, &m), ARGIL_OK);
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, g.iso, &m), ARGIL_OK);
     assert_int_equal(assert_closed_manifold(&m, 1e-12f), 0); /* drilled through: genus 1 */
     const double v = mesh_volume_m3(&m);
     assert_true(v < v_full - 0.5 * PI_D * 0.006 * 0.006 * 0.060);

@@ -13,9 +13,11 @@
 #include <string.h>
 
 #include "host/mesh/mc.h"
+#include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 static void make_grid(grid_t *g, int32_t n, float spacing_m, float radius_m)
 {
@@ -68,8 +70,8 @@ static void test_matches_whole_grid_mesher(void **state)
     mesh_t whole, blk;
     mesh_init(&whole);
     mesh_init(&blk);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, 0.5f, &whole), ARGIL_OK);
-    assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, 0.5f,
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, 0.5f, &whole), ARGIL_OK);
+    assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, 0.5f,
                                        NULL, NULL, &blk),
                      ARGIL_OK);
     assert_true(blk.n_tri > 10000);
@@ -94,8 +96,9 @@ static void test_incremental_equals_full(void **state)
     grid_t g;
     make_grid(&g, 96, 1e-3f, 0.035f);
     mc_blocks_t inc;
-    assert_int_equal(mc_blocks_init(&inc, g.dims, g.spacing_m, g.origin_m, 0.5f), ARGIL_OK);
-    assert_int_equal(mc_blocks_update(&inc, g.density, NULL), ARGIL_OK);
+    grid_mesh_view_t view;
+    assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
     const size_t all_blocks = inc.blocks_meshed;
     assert_int_equal(all_blocks, inc.n_blocks);
     mesh_t a, b;
@@ -108,8 +111,8 @@ static void test_incremental_equals_full(void **state)
         grid_carve_sphere(&g, vec3(0.035f * cosf(ang), 0.035f * sinf(ang), 0.01f * (float)(k - 2)),
                           0.008f, lo, hi);
         assert_true(hi[0] > lo[0]);
-        mc_blocks_mark(&inc, lo, hi);
-        assert_int_equal(mc_blocks_update(&inc, g.density, NULL), ARGIL_OK);
+        grid_mesh_mark(&inc, &view, lo, hi);
+        assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
         /* A 16 mm carve touches at most 3 blocks per axis (plus the normal halo: 4). */
         assert_true(inc.blocks_meshed <= 64);
         assert_true(inc.blocks_meshed * 8 < all_blocks);
@@ -117,14 +120,14 @@ static void test_incremental_equals_full(void **state)
     assert_int_equal(mc_blocks_assemble(&inc, &a), ARGIL_OK);
     mc_blocks_t full;
     assert_int_equal(mc_blocks_init(&full, g.dims, g.spacing_m, g.origin_m, 0.5f), ARGIL_OK);
-    assert_int_equal(mc_blocks_update(&full, g.density, NULL), ARGIL_OK);
+    assert_int_equal(mc_blocks_update(&full, gv_dense(&g), NULL), ARGIL_OK);
     assert_int_equal(mc_blocks_assemble(&full, &b), ARGIL_OK);
     assert_same_mesh(&a, &b);
     assert_closed(&a);
     /* and the whole-grid mesher sees the same surface */
     mesh_t w;
     mesh_init(&w);
-    assert_int_equal(mc_extract(g.density, g.dims, g.spacing_m, g.origin_m, 0.5f, &w), ARGIL_OK);
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, g.spacing_m, g.origin_m, 0.5f, &w), ARGIL_OK);
     assert_int_equal(w.n_tri, a.n_tri);
     assert_float_equal(mesh_volume_m3(&w), mesh_volume_m3(&a), 1e-12);
     mesh_free(&w);
@@ -213,7 +216,7 @@ static void test_painted_colours(void **state)
     }
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(mc_extract_region(g.density, rgb, g.dims, g.spacing_m, g.origin_m, 0.5f, NULL,
+    assert_int_equal(mc_extract_region(gv_dense(&g), rgb, g.dims, g.spacing_m, g.origin_m, 0.5f, NULL,
                                        NULL, &m),
                      ARGIL_OK);
     assert_true(m.has_rgb);
@@ -245,7 +248,7 @@ static void test_region_and_iso(void **state)
     mesh_init(&m);
     /* The x < 24 half of the sphere: closed at the cut, about half the volume. */
     const int32_t lo[3] = {0, 0, 0}, hi[3] = {24, 48, 48};
-    assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, 0.5f, lo,
+    assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, 0.5f, lo,
                                        hi, &m),
                      ARGIL_OK);
     assert_closed(&m);
@@ -258,7 +261,7 @@ static void test_region_and_iso(void **state)
     double vol[3];
     const float iso[3] = {0.25f, 0.5f, 0.75f};
     for (int k = 0; k < 3; k++) {
-        assert_int_equal(mc_extract_region(g.density, NULL, g.dims, g.spacing_m, g.origin_m, iso[k],
+        assert_int_equal(mc_extract_region(gv_dense(&g), NULL, g.dims, g.spacing_m, g.origin_m, iso[k],
                                            NULL, NULL, &m),
                          ARGIL_OK);
         assert_closed(&m);

@@ -16,6 +16,7 @@
 #include "host/fit/octree_fit.h"
 #include "host/mesh/mc.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 typedef double (*sdf_fn)(vec3_t p); /* true signed distance, positive inside */
 
@@ -120,11 +121,11 @@ static dist_t measure(const octfit_model_t *m, sdf_fn sd, const float half[3], f
             for (int32_t x = 0; x < dims[0]; x++, i++) {
                 const vec3_t p = vec3(g.origin_m.x + h * (float)x, g.origin_m.y + h * (float)y,
                                       g.origin_m.z + h * (float)z);
-                g.density[i] = grid_profile(octfit_eval(m, p), 2.0f * h);
+                gv_set(&g, GRID_DENSITY, i, grid_profile(octfit_eval(m, p), 2.0f * h));
             }
     mesh_t me;
     mesh_init(&me);
-    assert_int_equal(mc_extract(g.density, g.dims, h, g.origin_m, 0.5f, &me), ARGIL_OK);
+    assert_int_equal(mc_extract(gv_dense(&g), g.dims, h, g.origin_m, 0.5f, &me), ARGIL_OK);
     dist_t r = {0, 0, me.n_vert};
     for (size_t v = 0; v < me.n_vert; v++) {
         const double d = fabs(sd(vec3(me.pos[3 * v], me.pos[3 * v + 1], me.pos[3 * v + 2])));

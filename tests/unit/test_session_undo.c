@@ -18,6 +18,7 @@
 #include "host/app/global_solve.h"
 #include "host/app/session_undo.h"
 #include "host/model/grid.h"
+#include "tests/unit/grid_view.h"
 
 #define N 32
 #define H 1.25e-3f
@@ -70,7 +71,7 @@ static void state_take(const rig_t *r, state_t *st)
     }
     st->grid_d = malloc((size_t)N * N * N * sizeof(float));
     assert_non_null(st->grid_d);
-    memcpy(st->grid_d, r->g.density, (size_t)N * N * N * sizeof(float));
+    gv_copy(&r->g, GRID_DENSITY, st->grid_d);
 }
 
 static void state_free(state_t *st)
@@ -102,7 +103,7 @@ static float grid_diff(const rig_t *r, const state_t *st)
 {
     float m = 0.0f;
     for (size_t i = 0; i < (size_t)N * N * N; i++) {
-        const float d = fabsf(r->g.density[i] - st->grid_d[i]);
+        const float d = fabsf(gv_get(&r->g, GRID_DENSITY, i) - st->grid_d[i]);
         m = d > m ? d : m;
     }
     return m;
@@ -140,7 +141,10 @@ static void dynamics(rig_t *r, vec3_t at, float force_n, int steps)
         int32_t dlo[3], dhi[3];
         float change = 0.0f;
         assert_int_equal(gsolve_step(&r->gs, g, lo, hi, DT, dlo, dhi, &change), ARGIL_OK);
-        memset(g->force, 0, (size_t)N * N * N * sizeof(float));
+        for (int32_t z = c[2] - 1; z <= c[2] + 1; z++)
+            for (int32_t y = c[1] - 1; y <= c[1] + 1; y++)
+                for (int32_t x = c[0] - 1; x <= c[0] + 1; x++)
+                    assert_int_equal(grid_set(g, GRID_FORCE, x, y, z, 0.0f), ARGIL_OK);
     }
 }
 
