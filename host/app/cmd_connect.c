@@ -5,6 +5,7 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -22,6 +23,7 @@
 #include "host/app/host_tool.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
+#include "host/app/session_undo.h"
 #include "host/io/argil_file.h"
 #include "host/io/ply.h"
 #include "host/link/link.h"
@@ -102,6 +104,11 @@ typedef struct {
     journal_t journal;
     peer_journal_t journal_steps;
     bool journaling;
+    /* undo / redo of strokes (host/app/session_undo.h), asked for on standard input */
+    session_undo_t undo;
+    session_undo_lines_t cmd;
+    bool stdin_open;
+    uint32_t undo_solves;           /* peer solves seen by the undo */
 } conn_solver_t;
 
 static uint64_t mono_us(void)
@@ -261,6 +268,51 @@ static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t r
     }
 }
 
+/* ---- undo and redo: command lines on standard input ---- */
+
+/* Reads what standard input has (never waits), queues its undo and redo lines, then works on the
+ * queue right after a solve step (session_undo_process); says on stderr what each did. */
+static void undo_commands(conn_solver_t *s, bool tty)
+{
+    const char *nl = tty ? "\n" : "";
+    while (s->stdin_open) {
+        struct pollfd pfd = {STDIN_FILENO, POLLIN, 0};
+        if (poll(&pfd, 1, 0) <= 0 || (pfd.revents & (POLLIN | POLLHUP | POLLERR)) == 0)
+            break;
+        char buf[256];
+        const ssize_t n = read(STDIN_FILENO, buf, sizeof(buf));
+        if (n <= 0) {
+            if (n < 0 && (errno == EINTR || errno == EAGAIN))
+                break;
+            s->stdin_open = false; /* end of input: the session goes on */
+            break;
+        }
+        for (ssize_t i = 0; i < n; i++) {
+            const session_undo_cmd_t c = session_undo_feed(&s->cmd, buf[i]);
+            if (c == SESSION_UNDO_CMD_BAD)
+                fprintf(stderr, "%sargil connect: stdin: '%s' is no command (undo, redo)\n", nl,
+                        s->cmd.bad);
+            else if (c != SESSION_UNDO_CMD_NONE &&
+                     !session_undo_request(&s->undo, (session_undo_op_t)c, 0))
+                fprintf(stderr, "%sargil connect: %s refused: too many requests waiting\n", nl,
+                        c == SESSION_UNDO_CMD_UNDO ? "undo" : "redo");
+        }
+    }
+    const bool solved = s->peer.stats.solves != s->undo_solves;
+    s->undo_solves = s->peer.stats.solves;
+    const bool held = s->peer.have_tm && (s->peer.last_tm.buttons & 1u) != 0;
+    for (;;) {
+        int line = 0;
+        char msg[160];
+        const session_undo_result_t r =
+            session_undo_process(&s->undo, &s->peer, held, solved, &line, msg, sizeof(msg));
+        if (r == SESSION_UNDO_NONE || r == SESSION_UNDO_WAIT)
+            break;
+        fprintf(stderr, "%sargil connect: %s (undo %zu | redo %zu)\n", nl, msg,
+                session_undo_undo_count(&s->undo), session_undo_redo_count(&s->undo));
+    }
+}
+
 /* ---- files ---- */
 
 static int make_dir(const char *path)
@@ -268,15 +320,21 @@ static int make_dir(const char *path)
     return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
 }
 
-/* Writes DIR/final.ply and DIR/model.argil (edits: the journal's edit count) from the clay;
- * one line into err on failure. */
-static argil_err_t write_model(const grid_t *g, const char *dir, uint32_t edits,
-                               size_t *triangles, char *err, size_t err_len)
+/* Writes DIR/final.ply and DIR/model.argil (edits: the journal's edit count) from the clay, as
+ * argil sculpt does: painted colour as vertex colours and COLR, a paint tool's settings in TOOL
+ * and PNTS; one line into err on failure. */
+static argil_err_t write_model(const grid_t *g, const host_tool_t *ht, const char *dir,
+                               uint32_t edits, size_t *triangles, char *err, size_t err_len)
 {
     char path[4096];
     mesh_t m;
     mesh_init(&m);
-    argil_err_t rc = grid_mesh_extract(g, g->iso, &m);
+    int32_t rlo[3], rn[3];
+    const bool painted = grid_rgb_painted(g);
+    uint8_t *rgb = painted ? grid_dense_copy_rgb(g, rlo, rn) : NULL;
+    argil_err_t rc = painted && rgb == NULL ? ARGIL_ERR_NOMEM
+                     : rgb != NULL          ? grid_mesh_region(g, rgb, g->iso, &m)
+                                            : grid_mesh_extract(g, g->iso, &m);
     if (rc != ARGIL_OK) {
         snprintf(err, err_len, "meshing the clay failed");
     } else {
@@ -286,14 +344,26 @@ static argil_err_t write_model(const grid_t *g, const char *dir, uint32_t edits,
             rc = ply_write(path, &m, err, err_len);
     }
     mesh_free(&m);
-    if (rc != ARGIL_OK)
+    if (rc != ARGIL_OK) {
+        free(rgb);
         return rc;
+    }
     argil_doc_t doc;
     argil_doc_init(&doc);
     doc.grid = *g; /* borrowed: the document is not freed */
+    doc.rgb = rgb;
+    if (host_action_paints(ht->action)) { /* the paint settings; other sessions' files as before */
+        doc.tool.paint_chosen = true;
+        memcpy(doc.tool.paint_rgb, ht->rgb, 3);
+        doc.tool.soft_paint_per_s = ht->action == HOST_ACT_SOFT_PAINT
+                                        ? ht->strength
+                                        : host_action_default_strength(HOST_ACT_SOFT_PAINT);
+    }
     doc.state.edits = edits;
     snprintf(path, sizeof(path), "%s/model.argil", dir);
-    return argil_file_write(path, &doc, err, err_len);
+    rc = argil_file_write(path, &doc, err, err_len);
+    free(rgb);
+    return rc;
 }
 
 /* ---- the command ---- */
@@ -332,7 +402,7 @@ static void usage_connect(FILE *f)
             "                     [--out DIR] [--quiet] [--global-solve bspline|springs]\n"
             "                     [--knot-ratio 1|2|4] [--action NAME [--strength S]]\n"
             "                     [--shape NAME] [--mirror AXES] [--autosave-s S]\n"
-            "                     [--no-journal] [--discard-journal]\n"
+            "                     [--no-journal] [--discard-journal] [--undo-mb N]\n"
             "\n"
             "A live session with a board: the host keeps the global clay, sends the board its\n"
             "local window and tool, applies the impulses the board sends back, and records the\n"
@@ -376,6 +446,13 @@ static void usage_connect(FILE *f)
             "                   Ctrl-C) removes it, after a crash 'argil recover DIR' restores\n"
             "                   the model\n"
             "  --no-journal     no autosave journal\n"
+            "  --undo-mb N      memory for undo and redo, MiB (default 256; 0: no undo; needs\n"
+            "                   the B-spline model): one step per stroke (a press of stylus\n"
+            "                   button 1 that touched the clay, until the next), the oldest\n"
+            "                   dropped first. Type 'undo' or 'redo' and Enter on standard\n"
+            "                   input (as the sculpt script's verbs; done after the next solve\n"
+            "                   step, refused while button 1 is held); each says on stderr\n"
+            "                   what it did\n"
             "  --discard-journal\n"
             "                   start even though DIR holds an unfinished session's journal,\n"
             "                   deleting it\n"
@@ -402,6 +479,7 @@ typedef struct {
     bool journal;                   /* autosave journal in out_dir */
     bool discard_journal;
     float autosave_s;
+    uint32_t undo_mb;               /* undo journal budget, MiB (0: no undo) */
 } connect_opts_t;
 
 /* The host-model settings after the options: strength against the action, the B-spline model
@@ -442,6 +520,7 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
     host_tool_default(&o->host_tool);
     o->journal = true;
     o->autosave_s = 1.0f;
+    o->undo_mb = SESSION_UNDO_MB_DEFAULT;
     bool solve_given = false, strength_given = false;
     const char *host_opt = NULL;    /* the first of --action, --shape, --mirror given */
     for (int i = 0; i < argc; i++) {
@@ -472,6 +551,16 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
                 return 2;
             }
             i++;
+        } else if (strcmp(a, "--undo-mb") == 0) {
+            char *end = NULL;
+            const long mb = v ? strtol(v, &end, 10) : -1;
+            if (!v || v[0] == '\0' || *end != '\0' || mb < 0 || mb > (long)SESSION_UNDO_MB_MAX) {
+                fprintf(stderr, "argil connect: --undo-mb needs MiB 0..%u (0: no undo)\n",
+                        SESSION_UNDO_MB_MAX);
+                return 2;
+            }
+            i++;
+            o->undo_mb = (uint32_t)mb;
         } else if (strcmp(a, "--autosave-s") == 0) {
             if (!cli_autosave_s(v, &o->autosave_s)) {
                 fprintf(stderr, "argil connect: --autosave-s needs " CLI_AUTOSAVE_EXPECTS
@@ -636,15 +725,23 @@ int cmd_connect(int argc, char **argv)
     pc.adaptive_region = true; /* real time: a slow solve narrows its region, never the board */
     pc.global_solve = o.global_solve;
     pc.knot_ratio = o.knot_ratio;
+    /* The sphere is in the grid before the peer starts: the B-spline model is fitted to the
+     * grid as peer_init finds it (an empty grid gave an empty model, whose solve then emptied
+     * the clay inside every window it stepped). */
     if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
-            ARGIL_OK ||
-        peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
+        ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory for the clay\n");
         exit_code = 1;
         goto close_link;
     }
     grid_fill_sphere(&s->grid, vec3_sub(centre, vec3(0, 0, CONNECT_CLAY_BELOW_M)),
                      CONNECT_CLAY_RADIUS_M);
+    if (peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: out of memory for the clay\n");
+        exit_code = 1;
+        grid_free(&s->grid);
+        goto close_link;
+    }
     if (peer_set_host_tool(&s->peer, &o.host_tool) != ARGIL_OK) {
         fprintf(stderr, "argil connect: the host tool was refused (needs the B-spline model)\n");
         exit_code = 1;
@@ -657,6 +754,11 @@ int cmd_connect(int argc, char **argv)
     peer_set_tool(&s->peer, &tool);
     if (o.arm)
         peer_request_arm(&s->peer);
+    /* Undo: off with the springs (their grid keeps no history) or --undo-mb 0 (the summary
+     * says so; a request is refused with that reason). */
+    (void)session_undo_init(&s->undo, s->peer.gs ? &s->peer.gs->field : NULL,
+                            (size_t)o.undo_mb << 20);
+    s->stdin_open = true;
 
     char csv_path[4096], csv_tmp[4200];
     if (make_dir(o.out_dir) != 0) {
@@ -782,9 +884,12 @@ int cmd_connect(int argc, char **argv)
         if (dt_us > 50000u)
             dt_us = 50000u; /* after a stall, do not replay time */
         if (dt_us > 0) {
+            /* a press starts a stroke; the last one's diff goes a slice a tick */
+            session_undo_observe(&s->undo, &s->peer, (uint32_t)dt_us);
             peer_tick(&s->peer, (uint32_t)dt_us);
             last_us = s->now_us;
         }
+        undo_commands(s, tty);
         if (s->journaling) {
             bool stop_now = false;
             if (peer_journal_step(&s->journal, &s->journal_steps, &s->peer, elapsed_s,
@@ -844,8 +949,9 @@ int cmd_connect(int argc, char **argv)
             fprintf(stderr, "argil connect: %s: cannot write: %s\n", csv_path, strerror(errno));
             exit_code = 1;
         }
-        if (write_model(&s->grid, o.out_dir, s->journaling ? s->journal.seq : 0u, &triangles,
-                        err, sizeof(err)) != ARGIL_OK) {
+        if (write_model(&s->grid, &s->peer.host_tool, o.out_dir,
+                        s->journaling ? s->journal.seq : 0u, &triangles, err,
+                        sizeof(err)) != ARGIL_OK) {
             fprintf(stderr, "argil connect: %s\n", err);
             exit_code = 1;
         }
@@ -911,6 +1017,16 @@ int cmd_connect(int argc, char **argv)
         if (s->rtt_samples > 0)
             printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
                    s->rtt_worst_ms, s->rtt_samples);
+        if (s->undo.on)
+            printf("  undo                %u stroke%s recorded (%u undone, %u redone, %u refused), "
+                   "%.1f KiB held of %u MiB; recording CPU time per tick median %.2f ms, max "
+                   "%.2f ms\n",
+                   s->undo.stats.steps, s->undo.stats.steps == 1 ? "" : "s",
+                   s->undo.stats.undos, s->undo.stats.redos, s->undo.stats.refused,
+                   (double)session_undo_bytes(&s->undo) / 1024.0, o.undo_mb,
+                   session_undo_work_median_ms(&s->undo), s->undo.stats.max_work_ms);
+        else
+            printf("  undo                %s\n", s->undo.off_reason);
         printf("  files               %s (%u rows), %s/final.ply (%zu triangles), "
                "%s/model.argil\n",
                csv_path, s->csv_rows, o.out_dir, triangles, o.out_dir);
@@ -939,6 +1055,7 @@ close_csv:
 free_clay:
     if (s->journaling)
         journal_close(&s->journal); /* keeps its files: the end was not clean */
+    session_undo_free(&s->undo);
     peer_free(&s->peer);
     grid_free(&s->grid);
 close_link:

@@ -23,7 +23,8 @@ static void usage_recover(FILE *f)
             "Rebuilds the model of a session that did not end cleanly (a crash, kill -9, power\n"
             "loss) from the autosave journal in DIR (DIR/" JOURNAL_FILE " on its base snapshot\n"
             "DIR/" JOURNAL_BASE_PREFIX "N.argil), exactly as of the last whole journal record, and\n"
-            "writes it as a model and a PLY mesh. A record cut short by the crash is ignored.\n"
+            "writes it as a model and a PLY mesh (with the painted colour as vertex colours).\n"
+            "A record cut short by the crash is ignored.\n"
             "\n"
             "options:\n"
             "  -o FILE.argil   where to write the model (default DIR/recovered.argil); the mesh\n"
@@ -164,7 +165,9 @@ int cmd_recover(int argc, char **argv)
     mesh_t mesh;
     mesh_init(&mesh);
     const grid_t *g = &doc.grid;
-    argil_err_t me = grid_mesh_extract(g, g->iso, &mesh);
+    /* The painted colour (doc.rgb, over the grid's box as COLR) as vertex colours. */
+    argil_err_t me = doc.rgb != NULL ? grid_mesh_region(g, doc.rgb, g->iso, &mesh)
+                                     : grid_mesh_extract(g, g->iso, &mesh);
     if (me == ARGIL_OK && mesh.n_tri > 0)
         me = ply_write(ply_path, &mesh, werr, sizeof(werr));
     const size_t tris = mesh.n_tri;

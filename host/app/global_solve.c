@@ -123,6 +123,7 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
      * with it on; the cause was the board's bisected contact crossing, which turned one ulp of
      * state into a 0.01 mm step of penetration (firmware/core/haptics.c bracket_crossing). */
     gs->settle_enabled = true;
+    gs->settle_clip = true;
     gs->field.iso = g->iso;
     gs->field.band_m = g->band_m; /* the grid's density ramp, so tools cut the same profile */
     solver_cfg_default(&gs->cfg);
@@ -569,6 +570,41 @@ static void settle_take(gsolve_t *gs, const int32_t lo[3], const int32_t hi[3])
     st->quiet_steps = 0;
 }
 
+/* Clips the settling region's coefficient box [clo, chi) (the box the window left) to what its
+ * step needs beside the window's coefficient box [wlo, whi): the bounding box of the layers the
+ * window left, grown by GSOLVE_SETTLE_MARGIN inside the old box (every held coefficient that
+ * reaches a free one's equations; those farther act the same through d_fixed, at the place the
+ * field holds). Left as it was when the left part is not one box (the window moved along two
+ * or more axes, or shrank on both sides of one) or the boxes do not meet. False when the window
+ * covers the whole box (nothing left to settle). */
+static bool settle_clip_box(int32_t clo[3], int32_t chi[3], const int32_t wlo[3],
+                            const int32_t whi[3])
+{
+    int cut_axis = -1, cuts = 0;
+    for (int a = 0; a < 3; a++) {
+        if (whi[a] <= clo[a] || wlo[a] >= chi[a])
+            return true; /* apart: the window left all of it */
+        if (wlo[a] > clo[a] || whi[a] < chi[a]) {
+            cut_axis = a;
+            cuts++;
+        }
+    }
+    if (cuts == 0)
+        return false;
+    const int a = cut_axis;
+    const bool low = wlo[a] > clo[a], high = whi[a] < chi[a];
+    if (cuts > 1 || (low && high))
+        return true;
+    /* The left layers: [clo, wlo) below the window or [whi, chi) above it. */
+    const int32_t llo = low ? clo[a] : whi[a], lhi = low ? wlo[a] : chi[a];
+    const int32_t lo = llo - GSOLVE_SETTLE_MARGIN, hi = lhi + GSOLVE_SETTLE_MARGIN;
+    clo[a] = lo > clo[a] ? lo : clo[a];
+    chi[a] = hi < chi[a] ? hi : chi[a];
+    if (chi[a] - clo[a] < 4) /* physwin_open's least; not reached: a layer + the margin is 4 */
+        chi[a] = clo[a] + 4;
+    return true;
+}
+
 /* One step of the settling region, after the main window's: every coefficient the main window
  * holds free is fixed here (block Gauss-Seidel: each coefficient moves once per period), the
  * rest of its box moves freely with no external force. Reloaded every step, since the main
@@ -582,6 +618,13 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
     argil_err_t e;
     int32_t clo[3], chi[3];
     coef_box(f, st->box_lo, st->box_hi, clo, chi);
+    /* Every step, against where the main window is now (it may have moved on without taking a
+     * newer region, when it rested): the region's free coefficients are the same either way. */
+    if (gs->settle_clip && gs->win_open && !settle_clip_box(clo, chi, gs->win.clo, gs->win.chi)) {
+        /* The main window took it all over. */
+        st->active = false;
+        return ARGIL_OK;
+    }
     if (st->open) {
         bool same = true;
         for (int a = 0; a < 3; a++)
@@ -661,6 +704,7 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
         return e;
     }
     gs->stats.settle_steps++;
+    gs->stats.settle_coefs += s->ncoef;
     float change = 0.0f;
     bool quiet = false;
     st->quiet_steps++;

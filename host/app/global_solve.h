@@ -45,6 +45,12 @@
 #define GSOLVE_SETTLE_DD 5e-5f
 /* ... for this many steps in a row (a motion that turns round is slow for a step or two). */
 #define GSOLVE_SETTLE_QUIET_STEPS 10
+/* Coefficients (knot spans, at any R) past the layers the window left that a settling region
+ * keeps, held on the window's path: a free coefficient's row of the implicit system reaches
+ * the samples of its support ((c - 2, c + 2) knot spans), the neighbour springs one sample
+ * further, and the coefficients whose supports touch those, 3 spans away; anything farther
+ * does not enter its equations, so clipping the region there changes nothing but round-off. */
+#define GSOLVE_SETTLE_MARGIN 3
 /* The grid view follows a field density once it differs by more than this. */
 #define GSOLVE_VIEW_EPS 1e-5f
 
@@ -65,6 +71,8 @@ typedef struct {
     uint32_t settle_rested;           /* such regions that came to rest */
     uint32_t settle_dropped;          /* such regions given up still moving (a newer one came) */
     uint32_t settle_reloads;          /* main window re-read because such a region moved it */
+    uint64_t settle_coefs;            /* coefficients of the settling regions' physical windows,
+                                       * summed over their steps (what a settling step costs) */
 } gsolve_stats_t;
 
 /* A region the board's window left while it was still moving (clay springing back after the
@@ -78,7 +86,7 @@ typedef struct {
     bool plain;                       /* win's material is the base */
     uint32_t quiet_steps;             /* steps in a row below GSOLVE_SETTLE_DD */
     float *next;                      /* where held coefficients end a step (win's ncoef) */
-    int32_t box_lo[3], box_hi[3];     /* sample box it simulates */
+    int32_t box_lo[3], box_hi[3];     /* sample box the window left (the old window's box) */
 } gsolve_settle_t;
 
 typedef struct {
@@ -94,6 +102,9 @@ typedef struct {
     gsolve_settle_t settle;           /* the region the window left last, while it moves */
     bool settle_enabled;              /* true (gsolve_init: see there); false: left regions
                                        * freeze where the window left them */
+    bool settle_clip;                 /* true (gsolve_init): a settling region's physical window
+                                       * is the layers the window left plus GSOLVE_SETTLE_MARGIN
+                                       * (their bounding box); false: the whole old box */
     float *buf;                       /* window-sized scratch (samples) */
     size_t buf_n;
     gsolve_stats_t stats;
@@ -122,8 +133,9 @@ void gsolve_set_material(gsolve_t *gs, const spring_material_t *m);
 /* One implicit step of dt_s over the coefficients of the sample box [lo, hi) (the physical
  * window; moved or reopened when the box changes). The grid's external forces in the window's
  * samples act over the step and are consumed. When the box moves while the clay in the old one
- * still moves, the old box keeps being stepped (after the window, with the window's
- * coefficients held) until it rests; one such region at a time, the newest. Writes the sample
+ * still moves, the part of the old box the window left keeps being stepped (after the window,
+ * with the window's coefficients within GSOLVE_SETTLE_MARGIN held) until it rests; one such
+ * region at a time, the newest. Writes the sample
  * box whose densities changed into dlo/dhi (dlo = dhi: none; the bounding box of both regions)
  * and the largest |density change|. */
 argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],

@@ -378,9 +378,11 @@ int cmd_sculpt(int argc, char **argv)
                (double)s.grid_dense_bytes_end / 1024.0);
         if (s.journal_records > 0)
             printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u checkpoints, "
-                   "%.1f ms of work; removed at this clean end\n",
+                   "%.1f ms of work (%.1f ms CPU), %.1f KiB of memory at most; removed at this "
+                   "clean end\n",
                    s.journal_records, (double)s.journal_bytes / 1024.0, s.journal_syncs,
-                   s.journal_checkpoints, s.journal_real_s * 1e3);
+                   s.journal_checkpoints, s.journal_real_s * 1e3, s.journal_cpu_s * 1e3,
+                   (double)s.journal_peak_bytes / 1024.0);
         if (s.journal_stray_records > 0)
             printf("  journal WARNING     %u edits found outside the solver's dirty box (a bug in "
                    "an edit path; journaled anyway)\n",

@@ -434,6 +434,7 @@ static void solve_bspline(peer_t *p)
             solve_error(p, e);
         } else if (hi[0] > lo[0]) {
             /* Re-meshed (and journaled) either way; a paint leaves the board's densities be. */
+            p->stats.host_tool_edits++;
             mark_dirty(p, lo, hi);
             p->field_dirty = p->field_dirty || !host_action_paints(p->host_tool.action);
         }
@@ -505,6 +506,11 @@ static void solve(peer_t *p)
         p->stats.solve_max_ms = ms;
     if (p->cfg.adaptive_region)
         peer_adapt_region(p, ms);
+}
+
+bool peer_solve_due(const peer_t *p, uint32_t dt_us)
+{
+    return p->board_seen && p->since_solve_us + dt_us >= p->cfg.solve_period_us;
 }
 
 void peer_tick(peer_t *p, uint32_t dt_us)

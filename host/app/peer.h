@@ -83,6 +83,7 @@ typedef struct {
     int32_t margin_min;               /* the smallest margin used (samples) */
     uint32_t refines;                 /* knot insertions (peer_refine) */
     float refine_max_dd;              /* the largest |density change| one of them made */
+    uint32_t host_tool_edits;         /* host tool applications that changed the model */
 } peer_stats_t;
 
 typedef struct {
@@ -153,6 +154,9 @@ void peer_request_arm(peer_t *p);
 
 /* Advances the host by dt_us: heartbeats, tool, global solve and carving, windows. */
 void peer_tick(peer_t *p, uint32_t dt_us);
+
+/* peer_tick(p, dt_us) will run a global solve step (the model may be written). */
+bool peer_solve_due(const peer_t *p, uint32_t dt_us);
 
 /* Material channels a session can paint and show. */
 typedef enum { PEER_MAT_STIFFNESS, PEER_MAT_MASS } peer_material_t;

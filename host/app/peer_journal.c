@@ -31,6 +31,7 @@ argil_err_t peer_journal_step(journal_t *j, peer_journal_t *pj, const peer_t *p,
         return ARGIL_OK;
     pj->solves_seen = p->stats.solves;
     const double real0_s = clock_now_s(CLOCK_MONOTONIC);
+    const double cpu0_s = clock_now_s(CLOCK_THREAD_CPUTIME_ID);
     const uint64_t wall_ms = (uint64_t)(clock_now_s(CLOCK_REALTIME) * 1e3);
     journal_box_t box;
     for (int a = 0; a < 3; a++) {
@@ -56,5 +57,9 @@ argil_err_t peer_journal_step(journal_t *j, peer_journal_t *pj, const peer_t *p,
     if (e == ARGIL_OK)
         e = journal_tick(j, t_s, real0_s, err, err_len);
     pj->real_s += clock_now_s(CLOCK_MONOTONIC) - real0_s;
+    pj->cpu_s += clock_now_s(CLOCK_THREAD_CPUTIME_ID) - cpu0_s;
+    const size_t held = journal_bytes(j);
+    if (held > pj->peak_bytes)
+        pj->peak_bytes = held;
     return e;
 }

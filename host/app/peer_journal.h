@@ -15,6 +15,8 @@ typedef struct {
     uint32_t solves_seen;         /* peer solves already looked at */
     uint32_t stray_records;       /* changes found outside the peer's dirty box (should be 0) */
     double real_s;                /* wall time spent diffing, appending and syncing */
+    double cpu_s;                 /* CPU time of the same work (the calling thread's) */
+    size_t peak_bytes;            /* most memory the journal held after a step (journal_bytes) */
     uint32_t dump_record;         /* tests: at record N (1-based; 0 = never) write the model as */
     const char *dump_path;        /* of it to this .argil and ask the session to stop */
 } peer_journal_t;

@@ -393,7 +393,8 @@ static void update_iso2(live_t *L, const grid_t *g, bool empty, const int32_t lo
                         const int32_t hi[3])
 {
     if (L->mcb2_ready && (!L->iso2_on || L->mcb2.iso != L->iso2_level ||
-                          grid_mesh_view_stale(&L->mcb2_view, g))) {
+                          (grid_mesh_view_stale(&L->mcb2_view, g) &&
+                           grid_mesh_grow(&L->mcb2, &L->mcb2_view, g) != ARGIL_OK))) {
         mc_blocks_free(&L->mcb2);
         L->mcb2_ready = false;
     }
@@ -454,8 +455,10 @@ static void publish(live_t *L, session_frame_t *f)
 {
     peer_t *p = f->peer;
     const grid_t *g = p->grid;
-    if (L->mcb_ready && grid_mesh_view_stale(&L->mcb_view, g)) {
-        /* The clay grew past the mesher's box: set it up again over the new bounds. */
+    if (L->mcb_ready && grid_mesh_view_stale(&L->mcb_view, g) &&
+        grid_mesh_grow(&L->mcb, &L->mcb_view, g) != ARGIL_OK) {
+        /* The clay grew past what the mesher can span: set it up again over the new bounds
+         * (growth itself re-meshes nothing: the written samples are in the dirty box). */
         mc_blocks_free(&L->mcb);
         L->mcb_ready = false;
     }

@@ -79,6 +79,10 @@ typedef struct {
     bool journaling;
     peer_journal_t journal_steps;      /* what the journal has looked at, and its costs */
     uint32_t compact_solves;           /* peer solves at the last grid_compact */
+    uint8_t *final_rgb;                /* painted colour over the final grid's bounds, or NULL */
+    bool paint_chosen;                 /* a paint action ran or a colour was picked */
+    uint8_t paint_rgb[3];              /* the paint colour chosen last (model.argil TOOL) */
+    float soft_paint_per_s;            /* the soft-paint rate chosen last (model.argil PNTS) */
 } session_t;
 
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
@@ -130,15 +134,32 @@ static void tool_from_player(const session_t *s, msg_tool_t *tool)
     tool->model_offset_m[2] = s->model_offset_m.z;
 }
 
-/* Meshes the whole field and returns its volume; fills the mesh for the caller. */
-static argil_err_t mesh_field(const grid_t *g, mesh_t *m, double *volume_m3)
+/* Meshes the whole field and returns its volume; fills the mesh for the caller. With rgb (the
+ * painted colour over the grid's bounds) the vertices take it as `argil mesh` colours them. */
+static argil_err_t mesh_field(const grid_t *g, const uint8_t *rgb, mesh_t *m, double *volume_m3)
 {
     mesh_free(m);
     mesh_init(m);
-    const argil_err_t e = grid_mesh_extract(g, g->iso, m);
+    const argil_err_t e =
+        rgb != NULL ? grid_mesh_region(g, rgb, g->iso, m) : grid_mesh_extract(g, g->iso, m);
     if (e == ARGIL_OK)
         *volume_m3 = mesh_volume_m3(m);
     return e;
+}
+
+/* The paint settings model.argil keeps: a paint action's colour (and soft paint's rate), or a
+ * colour picked (in the window) while another action is on; a script's other actions leave
+ * them be. */
+static void track_paint(session_t *s, const host_tool_t *t)
+{
+    const bool picked =
+        t->rgb[0] != HOST_PAINT_R || t->rgb[1] != HOST_PAINT_G || t->rgb[2] != HOST_PAINT_B;
+    if (!host_action_paints(t->action) && !picked)
+        return;
+    s->paint_chosen = true;
+    memcpy(s->paint_rgb, t->rgb, 3);
+    if (t->action == HOST_ACT_SOFT_PAINT)
+        s->soft_paint_per_s = t->strength;
 }
 
 static int make_dir(const char *path)
@@ -262,6 +283,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     /* Touch every page now, as the board daemon does with mlockall: no page faults inside
      * ticks (explicit_bzero, because a plain memset after calloc may be optimised away). */
     explicit_bzero(s, sizeof(*s));
+    s->soft_paint_per_s = host_action_default_strength(HOST_ACT_SOFT_PAINT);
     argil_err_t rc = ARGIL_OK;
     mesh_t mesh;
     mesh_init(&mesh);
@@ -367,7 +389,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
                  rc == ARGIL_ERR_NOMEM ? "out of memory" : "the model refused the grid");
         goto done;
     }
-    rc = mesh_field(&s->grid, &mesh, &sum->volume_before_m3);
+    rc = mesh_field(&s->grid, NULL, &mesh, &sum->volume_before_m3);
     if (rc != ARGIL_OK) {
         snprintf(err, err_len, "meshing the initial clay failed");
         goto done;
@@ -497,6 +519,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             peer_set_tool(&s->peer, &tool);
             /* Refused only with the springs solve (the live window keeps its own in step). */
             (void)peer_set_host_tool(&s->peer, &s->player.host_tool);
+            track_paint(s, &s->player.host_tool);
             s->grid.material.stiffness = s->player.params[PARAM_CLAY_STIFFNESS];
             s->grid.material.damping = s->player.params[PARAM_CLAY_DAMPING];
             s->grid.material.plastic_rate_hz = s->player.params[PARAM_PLASTIC_RATE_HZ];
@@ -519,7 +542,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
         const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
-        session_undo_observe(&s->undo, &s->peer); /* button 1 down at the host: a new stroke */
+        session_undo_observe(&s->undo, &s->peer, dt_us); /* a new stroke; its diff a slice a tick */
         peer_tick(&s->peer, dt_us);
         undo_requests(s, opts);
         if (s->peer.stats.solves != s->compact_solves &&
@@ -595,7 +618,15 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     grid_bounds(&s->grid, sum->grid_lo, sum->grid_hi);
     sum->grid_dense_bytes_end = grid_count(&s->grid) * GRID_CH_N * sizeof(float);
     {
-        const argil_err_t me = mesh_field(&s->grid, &mesh, &sum->volume_after_m3);
+        /* painted colour (over the grid's bounds, as the GRID box; none when nothing shows
+         * paint): the final mesh's vertex colours and model.argil's COLR */
+        int32_t rlo[3], rn[3];
+        const bool painted = grid_rgb_painted(&s->grid);
+        s->final_rgb = painted ? grid_dense_copy_rgb(&s->grid, rlo, rn) : NULL;
+        const argil_err_t me = painted && s->final_rgb == NULL
+                                   ? ARGIL_ERR_NOMEM
+                                   : mesh_field(&s->grid, s->final_rgb, &mesh,
+                                                &sum->volume_after_m3);
         if (me != ARGIL_OK && rc == ARGIL_OK) {
             snprintf(err, err_len, "meshing the final clay failed");
             rc = me;
@@ -636,10 +667,12 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         argil_doc_t doc;
         argil_doc_init(&doc);
         doc.grid = s->grid; /* borrowed: the document is not freed */
-        /* painted colour (COLR over the grid's bounds, as the GRID box; none when nothing shows
-         * paint, as a recovery writes it) */
-        int32_t rlo[3], rn[3];
-        doc.rgb = grid_rgb_painted(&s->grid) ? grid_dense_copy_rgb(&s->grid, rlo, rn) : NULL;
+        doc.rgb = s->final_rgb; /* borrowed, as the final mesh's colours */
+        if (s->paint_chosen) { /* the paint settings; an unpainted session's file as before */
+            doc.tool.paint_chosen = true;
+            memcpy(doc.tool.paint_rgb, s->paint_rgb, 3);
+            doc.tool.soft_paint_per_s = s->soft_paint_per_s;
+        }
         doc.state.device_offset_m = s->model_offset_m;
         doc.state.edits = s->journaling ? s->journal.seq : 0u;
         snprintf(path, sizeof(path), "%s/model.argil", opts->out_dir);
@@ -653,7 +686,6 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
             snprintf(err, err_len, "%s", ferr);
             rc = ARGIL_ERR_IO;
         }
-        free(doc.rgb);
     }
 
     /* A clean end: the outputs are whole, so the journal is no longer needed. */
@@ -664,6 +696,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         sum->journal_bytes = s->journal.stats.bytes;
         sum->journal_stray_records = s->journal_steps.stray_records;
         sum->journal_real_s = s->journal_steps.real_s;
+        sum->journal_cpu_s = s->journal_steps.cpu_s;
+        sum->journal_peak_bytes = s->journal_steps.peak_bytes;
         if (rc == ARGIL_OK || rc == ARGIL_ERR_STATE) {
             char jerr[512];
             if (journal_finish(&s->journal, jerr, sizeof(jerr)) != ARGIL_OK && rc == ARGIL_OK) {
@@ -681,6 +715,7 @@ done:
         unlink(csv_tmp);
     }
     mesh_free(&mesh);
+    free(s->final_rgb);
     session_undo_free(&s->undo);
     peer_free(&s->peer);
     grid_free(&s->grid);

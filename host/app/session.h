@@ -92,6 +92,8 @@ typedef struct {
     uint64_t journal_bytes;       /* record bytes appended */
     uint32_t journal_stray_records; /* changes found outside the peer's dirty box (should be 0) */
     double journal_real_s;        /* wall time spent diffing, appending and syncing */
+    double journal_cpu_s;         /* CPU time of the same work */
+    size_t journal_peak_bytes;    /* most memory the journal held (journal_bytes) */
     uint32_t solves;              /* global solve steps */
     double solve_median_ms;       /* thread CPU time per solve step (10 µs resolution) */
     double solve_p99_ms;

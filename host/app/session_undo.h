@@ -8,7 +8,16 @@
  * are not part of a state). Every writer of the field marks the blocks it changes dirty
  * (sparse_t.dirty; nothing else in the session takes those flags), so at a boundary only the
  * dirty blocks are compared with the shadow, each difference noted (undo_note), the step
- * committed and the shadow brought up to date. An undo or redo writes the field back, the
+ * committed and the shadow brought up to date. That diff does not stall the session: at a press
+ * the dirty blocks only go on a pending list (their flags cleared) and are diffed a slice per
+ * session tick (session_undo_observe: at most SESSION_UNDO_SLICE_VALUES changes noted); before
+ * the field is next written (a solve step is due, an edit) the blocks not yet diffed are copied
+ * aside (one memcpy each) and the slices go on from the copies, so the step holds exactly the
+ * field at the press. An undo or redo, a new boundary or a knot insertion finishes the pending
+ * diff first. A press that changes nothing (no impulse from the board, no host tool edit until
+ * the next boundary: a press in the air) is no step: what changed meanwhile (the last stroke's
+ * settling) is joined to the last stroke's step (undo_commit_joined), or stays drift after an
+ * undo or redo. An undo or redo writes the field back, the
  * shadow follows, and every coefficient velocity is zeroed: a restored state is at rest.
  * Changes after an undo or redo (or the start) that are no stroke (the solver's round-off as
  * the window reopens) are dropped by the next undo or redo, so undo, redo gives the redone state
@@ -44,14 +53,31 @@
 /* Sample channels a state holds: FS_D … FS_RESTLEN, the first ones of a sample block (not
  * FS_FORCE, the step's external force). */
 #define SESSION_UNDO_SAMP_CH (FS_RESTLEN + 1)
+/* One slice of a pending step (a session tick) first copies aside at most
+ * SESSION_UNDO_SLICE_COPY_BYTES of its blocks, then, all copied, diffs: it notes at most about
+ * SESSION_UNDO_SLICE_VALUES changes (a block new to the shadow counts half that; a block is
+ * never split, so one block's up to 4608 more) over at most SESSION_UNDO_SLICE_BLOCKS blocks
+ * (docs/model.md has the times). */
+#define SESSION_UNDO_SLICE_VALUES 2048u
+#define SESSION_UNDO_SLICE_BLOCKS 48u
+#define SESSION_UNDO_SLICE_COPY_BYTES (2u << 20) /* copied aside per slice before the diff */
+#define SESSION_UNDO_HIST_BINS 256u   /* per-tick work histogram, 10 us bins */
+
+/* A block of a sealed step still to diff: its key, its store (0: coefficients, 1: samples)
+ * and where its copy is in the pool (+1; 0: not copied, the field still holds it). */
+typedef struct {
+    int32_t key[3];
+    uint32_t store;
+    size_t copy;
+} session_undo_pend_t;
 
 typedef enum { SESSION_UNDO_OP_UNDO = 1, SESSION_UNDO_OP_REDO = 2 } session_undo_op_t;
 
 /* What one queued request came to (session_undo_process). */
 typedef enum {
     SESSION_UNDO_NONE = 0,            /* no request queued */
-    SESSION_UNDO_WAIT,                /* not yet: button 1 still down at the host, or no solve
-                                       * step this tick */
+    SESSION_UNDO_WAIT,                /* not yet: button 1 still down at the host, no solve
+                                       * step this tick, or the stroke's diff still pending */
     SESSION_UNDO_DONE,                /* the model is the earlier (later) state */
     SESSION_UNDO_REFUSED              /* nothing changed; the message says why */
 } session_undo_result_t;
@@ -63,7 +89,13 @@ typedef struct {
     uint32_t resets;                  /* histories lost (out of memory while recording) */
     size_t last_step_bytes, max_step_bytes; /* journal bytes of one step */
     size_t last_step_changes;         /* values it holds */
-    double max_work_ms;               /* thread CPU time of the slowest boundary or undo / redo */
+    double max_work_ms;               /* thread CPU time of the most recording work one session
+                                       * tick did (a press, a slice, copying aside) */
+    double max_request_ms;            /* ... of the slowest undo / redo (its diff finished first) */
+    uint32_t work_ticks;              /* ticks that did recording work */
+    uint32_t work_hist_10us[SESSION_UNDO_HIST_BINS]; /* their thread CPU time */
+    uint32_t slices, copied_blocks;   /* slices run; blocks copied aside before a write */
+    uint32_t air_presses;             /* presses that changed nothing (no step) */
 } session_undo_stats_t;
 
 typedef struct {
@@ -77,7 +109,21 @@ typedef struct {
     bool stroke_open;                 /* a stroke began since the last undo / redo (or the
                                        * start): what changed since the last boundary is its;
                                        * else it is drift (the solver's round-off) */
+    bool stroke_real;                 /* ... and changed the clay (an edit, or touched) */
+    bool stroke_after_drift;          /* ... and began with none open (its base holds drift) */
     bool pressed;                     /* button 1 at the host, as last observed */
+    double press_impulse_ns;          /* the peer's Σ|J| and host tool edits at the press */
+    uint32_t press_host_edits;
+    /* the sealed step being diffed, a slice per tick */
+    bool pend_open;                   /* its undo_t step is open */
+    bool pend_joined;                 /* it joins the step before it (a press in the air) */
+    session_undo_pend_t *pend;
+    size_t npend, pend_next, pend_cap;
+    size_t pend_copied;               /* pend[0, pend_copied) are diffed or copied aside */
+    float *pool;                      /* copies of blocks set aside (mapped, grows) */
+    size_t pool_cap, pool_used;       /* floats */
+    size_t pool_pf;                   /* floats of the pool written ahead (prefault) */
+    argil_err_t pend_err;
     struct {
         int op;                       /* session_undo_op_t */
         int line;                     /* script line, 0 for a key */
@@ -96,11 +142,31 @@ typedef struct {
 argil_err_t session_undo_init(session_undo_t *su, const field_t *f, size_t budget_bytes);
 void session_undo_free(session_undo_t *su);
 
-/* A stroke begins (button 1 pressed, a paint): the open stroke (what changed since the last
- * boundary) becomes one step; with none open (the start, after an undo or redo) instead the redo
- * steps go and the drift joins the new stroke. ARGIL_ERR_NOMEM: the history is lost
- * (stats.resets), recording goes on. */
+/* An edit begins (a paint, a script's or a test's stroke) and writes the field at once: the open
+ * stroke (what changed since the last boundary) is sealed as one step (joined to the step before
+ * when it changed nothing), its blocks copied aside, diffed by later slices; with none open (the
+ * start, after an undo or redo) instead the redo steps go and the drift joins the new stroke.
+ * ARGIL_ERR_NOMEM: the history is lost (stats.resets), recording goes on. */
 argil_err_t session_undo_edit_start(session_undo_t *su, field_t *f);
+
+/* Button 1 went down: as session_undo_edit_start, but nothing is copied (call
+ * session_undo_before_write before the field is written) and the new stroke counts only once
+ * session_undo_touched says it changed the clay; an open stroke that never did is no boundary
+ * (after an undo or redo) or is joined to the last step. */
+argil_err_t session_undo_press(session_undo_t *su, field_t *f);
+
+/* The open stroke changed the clay (the board's impulses, the host tool). */
+void session_undo_touched(session_undo_t *su);
+
+/* The field is about to be written: the pending blocks not yet diffed are copied aside. */
+void session_undo_before_write(session_undo_t *su, field_t *f);
+
+/* One slice of the pending diff (the step is committed after its last); true while some is
+ * left. */
+bool session_undo_slice(session_undo_t *su, field_t *f);
+
+/* The pending diff to its end now. ARGIL_ERR_NOMEM: the history is lost. */
+argil_err_t session_undo_finish(session_undo_t *su, field_t *f);
 
 /* Undo (redo false) or redo one step on f: the open stroke is recorded first (or, after an
  * undo or redo, the drift dropped); then f holds exactly the earlier (later) state, coefficient
@@ -114,26 +180,53 @@ argil_err_t session_undo_step(session_undo_t *su, field_t *f, bool redo, int32_t
 size_t session_undo_undo_count(const session_undo_t *su);
 size_t session_undo_redo_count(const session_undo_t *su);
 
+/* The median thread CPU time of the ticks that did recording work (10 us bins, the bin's low
+ * end), ms; 0 with none. */
+double session_undo_work_median_ms(const session_undo_t *su);
+
 /* Bytes held: the steps, and the shadow. */
 size_t session_undo_bytes(const session_undo_t *su);
 size_t session_undo_shadow_bytes(const session_undo_t *su);
 
 /* ---- the session (host/app/session.c, the live window through session_frame_t) ---- */
 
+/* Command lines typed to `argil connect` (its standard input): "undo" or "redo", blanks around
+ * them ignored, one per line of at most SESSION_UNDO_LINE_MAX bytes. */
+#define SESSION_UNDO_LINE_MAX 64
+typedef enum {
+    SESSION_UNDO_CMD_BAD = -1,        /* a line naming no command: bad holds it (printable) */
+    SESSION_UNDO_CMD_NONE = 0,        /* no line ended yet, or it was blank */
+    SESSION_UNDO_CMD_UNDO = SESSION_UNDO_OP_UNDO,
+    SESSION_UNDO_CMD_REDO = SESSION_UNDO_OP_REDO
+} session_undo_cmd_t;
+typedef struct {
+    char buf[SESSION_UNDO_LINE_MAX];
+    size_t len;
+    bool overlong;                    /* the line being read went past SESSION_UNDO_LINE_MAX */
+    char bad[SESSION_UNDO_LINE_MAX + 8]; /* the last bad line, non-printable bytes as '?' */
+} session_undo_lines_t;
+
+/* Takes one byte of the command stream; at a line's end says what it asked for. */
+session_undo_cmd_t session_undo_feed(session_undo_lines_t *l, char c);
+
 /* Queues an undo or redo (line: the script line, 0 from a key); false when the queue is full
  * (the note says so). */
 bool session_undo_request(session_undo_t *su, session_undo_op_t op, int line);
 
-/* After the peer took in the board's frames (before its tick): notices a knot insertion (the
- * shadow is taken again) and button 1 going down at the host (a stroke begins). */
-void session_undo_observe(session_undo_t *su, peer_t *p);
+/* After the peer took in the board's frames, before peer_tick(p, dt_us): notices a knot
+ * insertion (the shadow is taken again), the open stroke touching the clay, button 1 going down
+ * at the host (a stroke begins); then copies aside what is pending when the tick's solve step
+ * will write the field (peer_solve_due), else diffs one slice. */
+void session_undo_observe(session_undo_t *su, peer_t *p, uint32_t dt_us);
 
 /* A paint (or any edit not made with button 1) begins. */
 void session_undo_peer_edit_start(session_undo_t *su, peer_t *p);
 
 /* Works on the oldest queued request: refused at once while hand_pressed (the hand holds
  * button 1) or when undo is off; waits while the host still sees button 1 down or no solve
- * step ran this tick (solved false); else undone or redone, and then the grid view, the
+ * step ran this tick (solved false), and while the open stroke, sealed at the first tick that
+ * got this far, is diffed (a slice per tick: session_undo_observe; what the solver changes
+ * meanwhile is drift and dropped); else undone or redone, and then the grid view, the
  * board's window (re-sent), the re-mesh box and (through the peer's dirty box) the journal
  * follow. *line gets the request's script line; msg a one-line message (what was done, or
  * why not). */

@@ -188,12 +188,16 @@ static const char *af_write_body(FILE *f, const void *vctx)
     const grid_t *g = &d->grid;
     af_out_t o = {f, 0, 0, false};
     const bool mtls = af_mtls_channels(c) > 0;
-    uint32_t n_sec = 4 + (d->rgb != NULL) + (d->has_rbf != 0) + (d->has_octree != 0) + mtls;
+    const bool pnts = d->tool.paint_chosen;
+    uint32_t n_sec =
+        4 + (d->rgb != NULL) + (d->has_rbf != 0) + (d->has_octree != 0) + mtls + pnts;
     uint64_t total = ARGIL_FILE_HEADER_BYTES + 4;
     total += AF_SEC_OVERHEAD + af_grid_bytes(c->n);
     total += AF_SEC_OVERHEAD + 20 + AF_SEC_OVERHEAD + 16 + AF_SEC_OVERHEAD + 20;
     if (d->rgb != NULL)
         total += AF_SEC_OVERHEAD + 3u * (uint64_t)c->n;
+    if (pnts)
+        total += AF_SEC_OVERHEAD + 4;
     if (d->has_rbf)
         total += AF_SEC_OVERHEAD + 28u + 16u * (uint64_t)d->rbf.n;
     if (d->has_octree)
@@ -243,6 +247,13 @@ static const char *af_write_body(FILE *f, const void *vctx)
     io_put_u32le(b + 16, d->state.edits);
     af_put(&o, b, 20);
     af_end(&o);
+
+    if (pnts) { /* the paint settings a session chose (its colour is TOOL's paint rgb) */
+        af_begin(&o, "PNTS", 4);
+        io_put_f32le(b, d->tool.soft_paint_per_s);
+        af_put(&o, b, 4);
+        af_end(&o);
+    }
 
     if (d->rgb != NULL) {
         af_begin(&o, "COLR", 3u * (uint64_t)c->n);
@@ -367,6 +378,12 @@ static argil_err_t af_write_ctx(const char *path, af_wctx_t *cp, char *err, size
             io_err(err, err_len, "argil_file_write: %s: octree fit holds NaN, Inf or no nodes", path);
             return ARGIL_ERR_NONFINITE;
         }
+    }
+    const float rate = d->tool.soft_paint_per_s;
+    if (d->tool.paint_chosen && !(isfinite(rate) && rate >= 0 && rate <= ARGIL_FILE_PAINT_RATE_MAX)) {
+        io_err(err, err_len, "argil_file_write: %s: soft-paint rate %g not in 0..%g per second",
+               path, (double)rate, (double)ARGIL_FILE_PAINT_RATE_MAX);
+        return ARGIL_ERR_NONFINITE;
     }
     if (d->has_rbf && d->rbf.n > RBF_CENTRES_MAX) {
         io_err(err, err_len, "argil_file_write: %s: RBF has too many centres", path);
@@ -678,6 +695,14 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
             d->state.device_offset_m = vec3(sf[0], sf[1], sf[2]);
             d->state.device_scale = sf[3];
             d->state.edits = io_get_u32le(p + 16);
+        } else if (strcmp(tag, "PNTS") == 0) {
+            if (d->tool.paint_chosen || sl != 4)
+                return af_fail(c, pos, "PNTS section repeated or not 4 bytes");
+            const float rate = io_get_f32le(p);
+            if (!isfinite(rate) || rate < 0 || rate > ARGIL_FILE_PAINT_RATE_MAX)
+                return af_fail(c, off, "PNTS soft-paint rate not in 0..100 per second");
+            d->tool.paint_chosen = true;
+            d->tool.soft_paint_per_s = rate;
         } else if (strcmp(tag, "COLR") == 0) {
             if (colr != NULL)
                 return af_fail(c, pos, "second COLR section");

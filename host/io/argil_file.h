@@ -23,11 +23,16 @@
 #define ARGIL_FILE_HEADER_BYTES 32u
 #define ARGIL_FILE_SECTIONS_MAX 64u
 
+#define ARGIL_FILE_PAINT_RATE_MAX 100.0f /* soft paint's blend rate, per second held */
+
 typedef struct {
     uint32_t tool_kind;     /* the active tool (an app-level enum; 0 = none) */
     float radius_m;         /* tool radius */
     float strength;         /* 0..1 */
     uint8_t paint_rgb[3];   /* colour the paint tool lays down */
+    bool paint_chosen;      /* the session chose its paint settings: paint_rgb is that colour and
+                             * soft_paint_per_s that rate (section PNTS); false: the defaults */
+    float soft_paint_per_s; /* soft paint's blend rate, 0..ARGIL_FILE_PAINT_RATE_MAX */
 } argil_tool_settings_t;
 
 typedef struct {
@@ -56,7 +61,8 @@ void argil_doc_init(argil_doc_t *d);
 void argil_doc_free(argil_doc_t *d);
 
 /* Writes d to path atomically (path.tmp + fsync + rename). ARGIL_ERR_ARG (no grid),
- * ARGIL_ERR_NONFINITE (NaN or Inf, or a painted material value out of grid_mat_valid's range),
+ * ARGIL_ERR_NONFINITE (NaN or Inf, a painted material value out of grid_mat_valid's range, or a
+ * chosen soft-paint rate out of 0..ARGIL_FILE_PAINT_RATE_MAX),
  * IO / NOMEM with err naming the path and the failing call. Painted channels are stored as runs
  * of their painted samples only. */
 argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, size_t err_len);

@@ -275,26 +275,333 @@ static void writer_info(const journal_t *j, uint32_t edits, journal_info_t *info
     info->edits = edits;
 }
 
-argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
-                                const char *path, char *err, size_t err_len)
+/* ---- the writer's copy of the model: grid blocks in a hash (journal_shadow_t) ---- */
+
+#define SHADOW_CAP0 64u /* hash slots of a new shadow */
+
+/* What a record compares: densities, painted channel KIND_MAT0 + ch, or the colour. */
+enum { KIND_DENS = 0, KIND_MAT0 = 1, KIND_RGB = KIND_MAT0 + GRID_MAT_N };
+
+/* Bytes per sample of kind. */
+static size_t kind_bytes(int kind)
 {
-    if ((g == NULL && j->shadow == NULL) || (g != NULL && !journal_fits(j, g))) {
-        io_err(err, err_len, "%s: the journal holds no model (or not this grid's)", path);
-        return ARGIL_ERR_STATE;
+    return kind == KIND_RGB ? 3u : 4u;
+}
+
+static size_t sh_slot(const int32_t k[3], size_t cap)
+{
+    uint64_t h = (uint64_t)(uint32_t)k[0] * 0xD6E8FEB86659FD93ull +
+                 (uint64_t)(uint32_t)k[1] * 0xA0761D6478BD642Full +
+                 (uint64_t)(uint32_t)k[2] * 0xE7037ED1A0B428DBull;
+    h ^= h >> 32;
+    return (size_t)h & (cap - 1);
+}
+
+static journal_block_t *sh_find(const journal_shadow_t *s, const int32_t k[3])
+{
+    if (s->slots == NULL)
+        return NULL;
+    for (size_t i = sh_slot(k, s->cap), n = 0; n < s->cap; i = (i + 1) & (s->cap - 1), n++) {
+        journal_block_t *b = &s->slots[i];
+        if (!b->used)
+            return NULL;
+        if (b->key[0] == k[0] && b->key[1] == k[1] && b->key[2] == k[2])
+            return b;
     }
+    return NULL;
+}
+
+static bool sh_grow(journal_shadow_t *s)
+{
+    const size_t cap = s->cap > 0 ? 2 * s->cap : SHADOW_CAP0;
+    journal_block_t *t = calloc(cap, sizeof(*t));
+    if (t == NULL)
+        return false;
+    for (size_t i = 0; i < s->cap; i++) {
+        if (!s->slots[i].used)
+            continue;
+        size_t k = sh_slot(s->slots[i].key, cap);
+        while (t[k].used)
+            k = (k + 1) & (cap - 1);
+        t[k] = s->slots[i];
+    }
+    free(s->slots);
+    s->slots = t;
+    s->cap = cap;
+    return true;
+}
+
+/* Block k, added (density 0, no arrays) when absent; NULL when out of memory. Adding may move
+ * every other block (pointers to them go stale). */
+static journal_block_t *sh_touch(journal_shadow_t *s, const int32_t k[3])
+{
+    journal_block_t *b = sh_find(s, k);
+    if (b != NULL)
+        return b;
+    if ((s->count + 1) * 2 > s->cap && !sh_grow(s))
+        return NULL;
+    size_t i = sh_slot(k, s->cap);
+    while (s->slots[i].used)
+        i = (i + 1) & (s->cap - 1);
+    b = &s->slots[i];
+    memset(b, 0, sizeof(*b));
+    memcpy(b->key, k, sizeof(b->key));
+    b->used = true;
+    s->count++;
+    return b;
+}
+
+static void sh_free(journal_shadow_t *s)
+{
+    for (size_t i = 0; s->slots != NULL && i < s->cap; i++) {
+        journal_block_t *b = &s->slots[i];
+        free(b->dens);
+        free(b->rgb);
+        for (int ch = 0; ch < GRID_MAT_N; ch++)
+            free(b->mat[ch]);
+    }
+    free(s->slots);
+    memset(s, 0, sizeof(*s));
+}
+
+/* Block b's samples of kind (b NULL: an absent block): its array, or NULL when every sample
+ * holds the value written to cst. */
+static uint8_t *sh_arr(const journal_block_t *b, int kind, uint8_t cst[4])
+{
+    if (kind == KIND_DENS) {
+        const float u = b != NULL ? b->uniform : 0.0f;
+        memcpy(cst, &u, 4);
+        return b != NULL ? (uint8_t *)b->dens : NULL;
+    }
+    if (kind == KIND_RGB) {
+        memset(cst, (int)GRID_RGB_DEFAULT, 3);
+        return b != NULL ? b->rgb : NULL;
+    }
+    const float def = grid_mat_default((grid_mat_t)(kind - KIND_MAT0));
+    memcpy(cst, &def, 4);
+    return b != NULL ? (uint8_t *)b->mat[kind - KIND_MAT0] : NULL;
+}
+
+/* The same for the grid's block v (a channel never painted reads its default everywhere). */
+static const uint8_t *live_arr(const grid_t *g, const grid_block_view_t *v, int kind,
+                               uint8_t cst[4])
+{
+    if (kind == KIND_DENS) {
+        memcpy(cst, &v->uniform, 4);
+        return (const uint8_t *)v->density;
+    }
+    if (kind == KIND_RGB) {
+        memset(cst, (int)GRID_RGB_DEFAULT, 3);
+        return v->rgb;
+    }
+    const grid_mat_t ch = (grid_mat_t)(kind - KIND_MAT0);
+    const float def = grid_mat_default(ch);
+    memcpy(cst, &def, 4);
+    return grid_mat_painted(g, ch) && v->mat != NULL ? (const uint8_t *)(v->mat + ch * GRID_BN)
+                                                      : NULL;
+}
+
+/* True when every one of the GRID_BN samples of arr (es bytes each) holds the bytes of v. */
+static bool arr_all(const uint8_t *arr, size_t es, const uint8_t *v)
+{
+    for (size_t i = 0; i < GRID_BN; i++)
+        if (memcmp(arr + es * i, v, es) != 0)
+            return false;
+    return true;
+}
+
+/* Gives b an array for kind holding what b reads now; false when out of memory. */
+static bool sh_arr_make(journal_shadow_t *s, journal_block_t *b, int kind)
+{
+    uint8_t cst[4];
+    if (sh_arr(b, kind, cst) != NULL)
+        return true;
+    const size_t es = kind_bytes(kind);
+    uint8_t *a = malloc(es * GRID_BN);
+    if (a == NULL)
+        return false;
+    for (size_t i = 0; i < GRID_BN; i++)
+        memcpy(a + es * i, cst, es);
+    if (kind == KIND_DENS)
+        b->dens = (float *)(void *)a;
+    else if (kind == KIND_RGB)
+        b->rgb = a;
+    else
+        b->mat[kind - KIND_MAT0] = (float *)(void *)a;
+    s->arrays_bytes += es * GRID_BN;
+    return true;
+}
+
+/* Drops b's array for kind when it says nothing more than no array would: densities all one
+ * value (which becomes b's uniform), a channel or the colour all its default. */
+static void sh_arr_compact(journal_shadow_t *s, journal_block_t *b, int kind)
+{
+    uint8_t cst[4];
+    uint8_t *a = sh_arr(b, kind, cst);
+    const size_t es = kind_bytes(kind);
+    if (a == NULL || !arr_all(a, es, kind == KIND_DENS ? a : cst))
+        return;
+    if (kind == KIND_DENS) {
+        memcpy(&b->uniform, a, 4);
+        b->dens = NULL;
+    } else if (kind == KIND_RGB) {
+        b->rgb = NULL;
+    } else {
+        b->mat[kind - KIND_MAT0] = NULL;
+    }
+    free(a);
+    s->arrays_bytes -= es * GRID_BN;
+}
+
+/* The block box of v clipped to the sample box [gl, gh) into [a0, a1); false when empty. */
+static bool block_clip(const int32_t key[3], const int32_t gl[3], const int32_t gh[3],
+                       int32_t a0[3], int32_t a1[3])
+{
+    for (int a = 0; a < 3; a++) {
+        const int64_t b0 = (int64_t)key[a] * GRID_B, b1 = b0 + GRID_B;
+        a0[a] = (int32_t)(b0 > gl[a] ? b0 : gl[a]);
+        a1[a] = (int32_t)(b1 < gh[a] ? b1 : gh[a]);
+        if (a1[a] <= a0[a])
+            return false;
+    }
+    return true;
+}
+
+/* Index within a block of global sample (x, y, z) of block key. */
+static size_t block_local(const int32_t key[3], int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)(x - key[0] * GRID_B) +
+           GRID_B * ((size_t)(y - key[1] * GRID_B) + GRID_B * (size_t)(z - key[2] * GRID_B));
+}
+
+/* Copies the grid's block v into s: its densities, each painted channel and the colour, arrays
+ * only where they hold more than one value (a default). false when out of memory. */
+static bool sh_copy_block(journal_shadow_t *s, const grid_t *g, const grid_block_view_t *v)
+{
+    const uint8_t *arr[KIND_RGB + 1];
+    bool need = false;
+    float uniform = v->uniform;
+    for (int kind = 0; kind <= KIND_RGB; kind++) {
+        uint8_t cst[4];
+        const size_t es = kind_bytes(kind);
+        arr[kind] = live_arr(g, v, kind, cst);
+        if (arr[kind] != NULL && arr_all(arr[kind], es, kind == KIND_DENS ? arr[kind] : cst)) {
+            if (kind == KIND_DENS)
+                memcpy(&uniform, arr[kind], 4);
+            arr[kind] = NULL;
+        }
+        need = need || arr[kind] != NULL;
+    }
+    const float zero = 0.0f;
+    if (!need && same_bits(&uniform, &zero, sizeof(float)))
+        return true; /* reads as an absent block */
+    journal_block_t *b = sh_touch(s, v->key);
+    if (b == NULL)
+        return false;
+    b->uniform = uniform;
+    for (int kind = 0; kind <= KIND_RGB; kind++) {
+        if (arr[kind] == NULL)
+            continue;
+        if (!sh_arr_make(s, b, kind))
+            return false;
+        uint8_t cst[4];
+        memcpy(sh_arr(b, kind, cst), arr[kind], kind_bytes(kind) * GRID_BN);
+    }
+    return true;
+}
+
+/* s (empty) becomes a copy of the grid's blocks that meet the sample box [gl, gh); false when
+ * out of memory (s then holds part: sh_free it). */
+static bool shadow_take(journal_shadow_t *s, const grid_t *g, const int32_t gl[3],
+                        const int32_t gh[3])
+{
+    if (!sh_grow(s))
+        return false;
+    size_t slot = 0;
+    grid_block_view_t v;
+    while (grid_block_next(g, &slot, &v)) {
+        int32_t a0[3], a1[3];
+        if (block_clip(v.key, gl, gh, a0, a1) && !sh_copy_block(s, g, &v))
+            return false;
+    }
+    return true;
+}
+
+/* Dense copies over the journal's box of its shadow: densities, each channel the journal has
+ * seen painted (the others NULL) and the colour once seen (else NULL). */
+static argil_err_t shadow_dense(const journal_t *j, float **dens, float *mat[GRID_MAT_N],
+                                uint8_t **rgb)
+{
+    const size_t n = j->n;
+    *rgb = NULL;
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        mat[ch] = NULL;
+    *dens = malloc(n * sizeof(float));
+    bool ok = *dens != NULL;
+    for (int ch = 0; ok && ch < GRID_MAT_N; ch++) {
+        if (!j->mat_seen[ch])
+            continue;
+        mat[ch] = malloc(n * sizeof(float));
+        ok = mat[ch] != NULL;
+        const float def = grid_mat_default((grid_mat_t)ch);
+        for (size_t i = 0; ok && i < n; i++)
+            mat[ch][i] = def;
+    }
+    if (ok && j->rgb_seen) {
+        *rgb = malloc(3 * n);
+        ok = *rgb != NULL;
+        if (ok)
+            memset(*rgb, (int)GRID_RGB_DEFAULT, 3 * n);
+    }
+    if (!ok) {
+        dense_all_free(dens, mat, rgb);
+        return ARGIL_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++)
+        (*dens)[i] = 0.0f;
+    const int32_t gh[3] = {j->lo[0] + j->dims[0], j->lo[1] + j->dims[1], j->lo[2] + j->dims[2]};
+    const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
+    for (size_t s = 0; j->shadow.slots != NULL && s < j->shadow.cap; s++) {
+        const journal_block_t *b = &j->shadow.slots[s];
+        int32_t a0[3], a1[3];
+        if (!b->used || !block_clip(b->key, j->lo, gh, a0, a1))
+            continue;
+        for (int32_t z = a0[2]; z < a1[2]; z++)
+            for (int32_t y = a0[1]; y < a1[1]; y++)
+                for (int32_t x = a0[0]; x < a1[0]; x++) {
+                    const size_t li = block_local(b->key, x, y, z);
+                    const size_t i = (size_t)(x - j->lo[0]) +
+                                     nx * ((size_t)(y - j->lo[1]) + ny * (size_t)(z - j->lo[2]));
+                    (*dens)[i] = b->dens != NULL ? b->dens[li] : b->uniform;
+                    for (int ch = 0; ch < GRID_MAT_N; ch++)
+                        if (mat[ch] != NULL && b->mat[ch] != NULL)
+                            mat[ch][i] = b->mat[ch][li];
+                    if (*rgb != NULL && b->rgb != NULL)
+                        memcpy(*rgb + 3 * i, b->rgb + 3 * li, 3);
+                }
+    }
+    return ARGIL_OK;
+}
+
+size_t journal_bytes(const journal_t *j)
+{
+    return j->shadow.cap * sizeof(journal_block_t) + j->shadow.arrays_bytes + j->buf_cap +
+           j->views_cap * sizeof(grid_block_view_t);
+}
+
+/* Writes the model given densely over the journal's box (densities, painted channels, colour),
+ * with the journal's grid, material and edits, to path as .argil. */
+static argil_err_t write_dense_model(const journal_t *j, uint32_t edits, const float *dens,
+                                     float *const mat[GRID_MAT_N], const uint8_t *rgb,
+                                     const char *path, char *err, size_t err_len)
+{
     journal_info_t info;
     writer_info(j, edits, &info);
     argil_doc_t doc;
     argil_doc_init(&doc);
-    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
-    uint8_t *rgb = NULL;
-    argil_err_t e = g != NULL ? grid_dense_all(g, j->lo, j->dims, &dens, mat, &rgb) : ARGIL_OK;
-    if (e == ARGIL_OK)
-        e = g != NULL ? journal_model_doc(&info, dens, mat, &doc)
-                      : journal_model_doc(&info, j->shadow, j->mat_shadow, &doc);
-    if (e == ARGIL_OK && !doc_set_rgb(&doc, g != NULL ? rgb : j->rgb_shadow, j->n))
+    argil_err_t e = journal_model_doc(&info, dens, mat, &doc);
+    if (e == ARGIL_OK && !doc_set_rgb(&doc, rgb, j->n))
         e = ARGIL_ERR_NOMEM;
-    dense_all_free(&dens, mat, &rgb);
     if (e != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", path);
         argil_doc_free(&doc);
@@ -302,6 +609,25 @@ argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t ed
     }
     e = argil_file_write(path, &doc, err, err_len);
     argil_doc_free(&doc);
+    return e;
+}
+
+argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
+                                const char *path, char *err, size_t err_len)
+{
+    if ((g == NULL && !j->ready) || (g != NULL && !journal_fits(j, g))) {
+        io_err(err, err_len, "%s: the journal holds no model (or not this grid's)", path);
+        return ARGIL_ERR_STATE;
+    }
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
+    argil_err_t e = g != NULL ? grid_dense_all(g, j->lo, j->dims, &dens, mat, &rgb)
+                              : shadow_dense(j, &dens, mat, &rgb);
+    if (e != ARGIL_OK)
+        io_err(err, err_len, "%s: out of memory for the model", path);
+    else
+        e = write_dense_model(j, edits, dens, mat, rgb, path, err, err_len);
+    dense_all_free(&dens, mat, &rgb);
     return e;
 }
 
@@ -333,7 +659,8 @@ static void encode_header(const journal_t *j, const char *base, uint64_t base_le
 }
 
 /* Writes base snapshot number j->checkpoint from the shadow, then a new journal.log (via
- * journal.log.tmp + rename) that starts on it; leaves the new file open in j->fd. */
+ * journal.log.tmp + rename) that starts on it; leaves the new file open in j->fd. The model is
+ * made dense over the journal's box for the while (the .argil and the base CRC need it). */
 static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t err_len)
 {
     char base[JOURNAL_BASE_NAME_MAX + 1];
@@ -341,15 +668,20 @@ static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t er
     char *base_path = path_join(j->dir, base);
     char *log_path = path_join(j->dir, JOURNAL_FILE);
     char *tmp_path = path_join(j->dir, JOURNAL_FILE ".tmp");
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
     argil_err_t e = ARGIL_ERR_NOMEM;
     int fd = -1;
-    if (base_path == NULL || log_path == NULL || tmp_path == NULL) {
+    if (base_path == NULL || log_path == NULL || tmp_path == NULL ||
+        shadow_dense(j, &dens, mat, &rgb) != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the journal", j->dir);
         goto out;
     }
-    e = journal_write_model(j, NULL, edits, base_path, err, err_len);
+    e = write_dense_model(j, edits, dens, mat, rgb, base_path, err, err_len);
     if (e != ARGIL_OK)
         goto out;
+    const uint32_t crc = model_crc(dens, mat, rgb, j->n);
+    dense_all_free(&dens, mat, &rgb);
     struct stat st;
     if (stat(base_path, &st) != 0) {
         io_err(err, err_len, "%s: cannot stat: %s", base_path, strerror(errno));
@@ -357,8 +689,7 @@ static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t er
         goto out;
     }
     uint8_t h[JOURNAL_HEADER_BYTES];
-    encode_header(j, base, (uint64_t)st.st_size,
-                  model_crc(j->shadow, j->mat_shadow, j->rgb_shadow, j->n), edits, h);
+    encode_header(j, base, (uint64_t)st.st_size, crc, edits, h);
     fd = open(tmp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     e = ARGIL_ERR_IO;
     if (fd < 0) {
@@ -381,6 +712,7 @@ static argil_err_t start_file(journal_t *j, uint32_t edits, char *err, size_t er
     j->file_bytes = JOURNAL_HEADER_BYTES;
     e = ARGIL_OK;
 out:
+    dense_all_free(&dens, mat, &rgb);
     if (fd >= 0) {
         (void)close(fd);
         (void)unlink(tmp_path);
@@ -415,35 +747,16 @@ argil_err_t journal_open(journal_t *j, const char *dir, const grid_t *g, const j
     j->material = g->material;
     j->n = (size_t)j->dims[0] * (size_t)j->dims[1] * (size_t)j->dims[2];
     j->dir = strdup(dir);
-    j->shadow = malloc(j->n * sizeof(float));
-    j->cur = malloc(j->n * sizeof(float));
-    if (j->dir == NULL || j->shadow == NULL || j->cur == NULL || !journal_fits(j, g)) {
+    if (j->dir == NULL || !journal_fits(j, g) || !shadow_take(&j->shadow, g, glo, ghi)) {
         io_err(err, err_len, "%s: out of memory for the journal", dir);
         journal_close(j);
         return ARGIL_ERR_NOMEM;
     }
-    grid_read_box(g, GRID_DENSITY, j->lo, j->dims, j->shadow);
-    for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (!grid_mat_painted(g, (grid_mat_t)ch))
-            continue;
-        j->mat_shadow[ch] = malloc(j->n * sizeof(float));
-        if (j->mat_shadow[ch] == NULL) {
-            io_err(err, err_len, "%s: out of memory for the journal", dir);
-            journal_close(j);
-            return ARGIL_ERR_NOMEM;
-        }
-        grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->mat_shadow[ch]);
-    }
+    j->ready = true;
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        j->mat_seen[ch] = grid_mat_painted(g, (grid_mat_t)ch);
     j->mat_writes = g->mat_writes;
-    if (grid_rgb_any(g)) {
-        j->rgb_shadow = malloc(3 * j->n);
-        if (j->rgb_shadow == NULL) {
-            io_err(err, err_len, "%s: out of memory for the journal", dir);
-            journal_close(j);
-            return ARGIL_ERR_NOMEM;
-        }
-        grid_rgb_read_box(g, j->lo, j->dims, j->rgb_shadow);
-    }
+    j->rgb_seen = grid_rgb_any(g);
     j->rgb_writes = g->rgb_writes;
     if (journal_exists(dir)) {
         io_err(err, err_len, "%s holds an unfinished session's journal: run 'argil recover %s' "
@@ -477,191 +790,288 @@ static bool reserve(journal_t *j, size_t more)
     return true;
 }
 
-/* Appends the run [start, end) of density to the open record and to the shadow. */
-static bool put_run(journal_t *j, const float *density, size_t start, size_t end)
+/* Room in j->views for n blocks; false when out of memory. */
+static bool views_reserve(journal_t *j, size_t n)
 {
-    const size_t count = end - start;
-    if (!reserve(j, 8 + 4 * count))
-        return false;
-    uint8_t *p = j->buf + j->buf_len;
-    io_put_u32le(p, (uint32_t)start);
-    io_put_u32le(p + 4, (uint32_t)count);
-    for (size_t i = 0; i < count; i++)
-        io_put_f32le(p + 8 + 4 * i, density[start + i]);
-    memcpy(j->shadow + start, density + start, count * sizeof(float));
-    j->buf_len += 8 + 4 * count;
-    j->stats.samples += count;
-    return true;
-}
-
-/* Appends the run [start, end) of channel ch (gm: the grid's, NULL = the default everywhere) to
- * the open record and to the channel's shadow. */
-static bool put_mat_run(journal_t *j, grid_mat_t ch, const float *gm, size_t start, size_t end)
-{
-    const size_t count = end - start;
-    if (!reserve(j, 8 + 4 * count))
-        return false;
-    uint8_t *p = j->buf + j->buf_len;
-    io_put_u32le(p, (uint32_t)start);
-    io_put_u32le(p + 4, (uint32_t)count);
-    const float def = grid_mat_default(ch);
-    float *sh = j->mat_shadow[ch];
-    for (size_t i = 0; i < count; i++) {
-        const float v = gm != NULL ? gm[start + i] : def;
-        io_put_f32le(p + 8 + 4 * i, v);
-        sh[start + i] = v;
-    }
-    j->buf_len += 8 + 4 * count;
-    j->stats.mat_samples += count;
-    return true;
-}
-
-/* Appends channel ch's changes since the last record as one material block (id, runs, runs),
- * nothing when it did not change. false when out of memory. */
-static bool put_mat_block(journal_t *j, grid_mat_t ch, const float *gm, uint32_t *blocks)
-{
-    if (gm == NULL && j->mat_shadow[ch] == NULL)
+    if (n <= j->views_cap)
         return true;
-    const float def = grid_mat_default(ch);
-    if (j->mat_shadow[ch] == NULL) {
-        float *sh = malloc(j->n * sizeof(float));
-        if (sh == NULL)
-            return false;
-        for (size_t i = 0; i < j->n; i++)
-            sh[i] = def;
-        j->mat_shadow[ch] = sh;
-    }
-    const float *sh = j->mat_shadow[ch];
-    const size_t at = j->buf_len;
-    if (!reserve(j, 8))
+    size_t cap = j->views_cap > 0 ? j->views_cap : 64;
+    while (cap < n)
+        cap *= 2;
+    grid_block_view_t *v = realloc(j->views, cap * sizeof(*v));
+    if (v == NULL)
         return false;
-    j->buf_len += 8;
-    uint32_t runs = 0;
-    bool open_run = false;
-    size_t run_start = 0, run_end = 0;
-    const size_t chunk = 256;
-    for (size_t i0 = 0; i0 < j->n; i0 += chunk) {
-        const size_t i1 = j->n - i0 < chunk ? j->n : i0 + chunk;
-        if (gm != NULL && same_bits(gm + i0, sh + i0, (i1 - i0) * sizeof(float)))
-            continue;
-        for (size_t i = i0; i < i1; i++) {
-            const float v = gm != NULL ? gm[i] : def;
-            if (same_bits(&v, &sh[i], sizeof(float)))
-                continue;
-            if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
-                run_end = i + 1;
+    j->views = v;
+    j->views_cap = cap;
+    return true;
+}
+
+/* True when the grid's block v and the shadow's block b (NULL: absent) differ in kind inside
+ * the sample box [gl, gh); two blocks without arrays compare in one step. */
+static bool block_differs(const grid_t *g, const grid_block_view_t *v, const journal_block_t *b,
+                          int kind, const int32_t gl[3], const int32_t gh[3])
+{
+    int32_t a0[3], a1[3];
+    if (!block_clip(v->key, gl, gh, a0, a1))
+        return false;
+    uint8_t lc[4], sc[4];
+    const uint8_t *la = live_arr(g, v, kind, lc), *sa = sh_arr(b, kind, sc);
+    const size_t es = kind_bytes(kind), w = (size_t)(a1[0] - a0[0]);
+    if (la == NULL && sa == NULL)
+        return memcmp(lc, sc, es) != 0;
+    for (int32_t z = a0[2]; z < a1[2]; z++)
+        for (int32_t y = a0[1]; y < a1[1]; y++) {
+            const size_t li = block_local(v->key, a0[0], y, z);
+            if (la != NULL && sa != NULL) {
+                if (memcmp(la + es * li, sa + es * li, es * w) != 0)
+                    return true;
                 continue;
             }
-            if (open_run) {
-                if (!put_mat_run(j, ch, gm, run_start, run_end))
-                    return false;
-                runs++;
-            }
-            open_run = true;
-            run_start = i;
-            run_end = i + 1;
+            const uint8_t *arr = (la != NULL ? la : sa) + es * li, *c = la != NULL ? sc : lc;
+            for (size_t x = 0; x < w; x++)
+                if (memcmp(arr + es * x, c, es) != 0)
+                    return true;
+        }
+    return false;
+}
+
+/* Orders blocks as their samples come in the journal's sample order: z, then y, then x. */
+static int view_order(const void *pa, const void *pb)
+{
+    const grid_block_view_t *a = pa, *b = pb;
+    for (int q = 2; q >= 0; q--)
+        if (a->key[q] != b->key[q])
+            return a->key[q] < b->key[q] ? -1 : 1;
+    return 0;
+}
+
+/* The blocks meeting the sample box [gl, gh) whose kind differs between the grid and the
+ * shadow, in sample order, into j->views[0, *count). Looks only at blocks one of them holds
+ * (a block neither holds reads the same in both). false when out of memory. */
+static bool changed_blocks(journal_t *j, const grid_t *g, int kind, const int32_t gl[3],
+                           const int32_t gh[3], size_t *count)
+{
+    *count = 0;
+    int32_t k0[3], k1[3];
+    uint64_t nk = 1;
+    for (int a = 0; a < 3; a++) {
+        if (gh[a] <= gl[a])
+            return true;
+        k0[a] = grid_block_index(gl[a]);
+        k1[a] = grid_block_index(gh[a] - 1);
+        nk *= (uint64_t)(k1[a] - k0[a] + 1);
+    }
+    const size_t held = g->count + j->shadow.count;
+    if (!views_reserve(j, nk < (uint64_t)held ? (size_t)nk : held))
+        return false;
+    size_t n = 0;
+    grid_block_view_t v;
+    if (nk <= (uint64_t)held) { /* every block index of the box, already in order */
+        int32_t k[3];
+        for (k[2] = k0[2]; k[2] <= k1[2]; k[2]++)
+            for (k[1] = k0[1]; k[1] <= k1[1]; k[1]++)
+                for (k[0] = k0[0]; k[0] <= k1[0]; k[0]++) {
+                    (void)grid_block_view(g, k, &v);
+                    if (block_differs(g, &v, sh_find(&j->shadow, k), kind, gl, gh))
+                        j->views[n++] = v;
+                }
+        *count = n;
+        return true;
+    }
+    /* The blocks either side holds for kind, sorted, each once. */
+    int32_t a0[3], a1[3];
+    uint8_t cst[4];
+    for (size_t slot = 0; grid_block_next(g, &slot, &v);)
+        if (block_clip(v.key, gl, gh, a0, a1) &&
+            (kind == KIND_DENS || live_arr(g, &v, kind, cst) != NULL))
+            j->views[n++] = v;
+    for (size_t s = 0; j->shadow.slots != NULL && s < j->shadow.cap; s++) {
+        const journal_block_t *b = &j->shadow.slots[s];
+        if (b->used && block_clip(b->key, gl, gh, a0, a1) &&
+            (kind == KIND_DENS || sh_arr(b, kind, cst) != NULL)) {
+            (void)grid_block_view(g, b->key, &v);
+            j->views[n++] = v;
         }
     }
-    if (open_run) {
-        if (!put_mat_run(j, ch, gm, run_start, run_end))
-            return false;
-        runs++;
+    if (n > 1)
+        qsort(j->views, n, sizeof(*j->views), view_order);
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0 && view_order(&j->views[i], &j->views[i - 1]) == 0)
+            continue;
+        if (block_differs(g, &j->views[i], sh_find(&j->shadow, j->views[i].key), kind, gl, gh))
+            j->views[m++] = j->views[i];
     }
-    if (runs == 0) {
-        j->buf_len = at;
-        return true;
-    }
-    io_put_u32le(j->buf + at, (uint32_t)ch);
-    io_put_u32le(j->buf + at + 4, runs);
-    (*blocks)++;
+    *count = m;
     return true;
 }
 
-/* Appends the colour run [start, end) (rgb: the grid's, NULL = the default everywhere) to the
- * open record and to the colour shadow. */
-static bool put_rgb_run(journal_t *j, const uint8_t *rgb, size_t start, size_t end)
+/* A record's runs of one kind being made. */
+typedef struct {
+    journal_t *j;
+    const grid_t *g;
+    int kind;
+    bool open;                /* a run [start, end) is open */
+    size_t start, end;        /* journal sample indices */
+    uint32_t runs;            /* written */
+    grid_block_view_t lv;     /* the grid block last read */
+    bool lv_ok;
+    journal_block_t *sb;      /* the shadow block last written (NULL: absent) */
+    int32_t sb_key[3];
+    bool sb_ok;
+} emit_t;
+
+/* Appends the run [start, end) of the grid's current values to the open record and to the
+ * shadow; false when out of memory. */
+static bool put_run(emit_t *e, size_t start, size_t end)
 {
-    const size_t count = end - start;
-    if (!reserve(j, 8 + 3 * count))
+    journal_t *j = e->j;
+    const size_t count = end - start, es = kind_bytes(e->kind);
+    if (!reserve(j, 8 + es * count))
         return false;
     uint8_t *p = j->buf + j->buf_len;
     io_put_u32le(p, (uint32_t)start);
     io_put_u32le(p + 4, (uint32_t)count);
-    if (rgb != NULL)
-        memcpy(p + 8, rgb + 3 * start, 3 * count);
-    else
-        memset(p + 8, (int)GRID_RGB_DEFAULT, 3 * count);
-    memcpy(j->rgb_shadow + 3 * start, p + 8, 3 * count);
-    j->buf_len += 8 + 3 * count;
-    j->stats.rgb_samples += count;
-    return true;
-}
-
-/* Appends the colour's changes since the last record as runs; *runs counts them (0: no change).
- * false when out of memory. */
-static bool put_rgb_runs(journal_t *j, const uint8_t *rgb, uint32_t *runs)
-{
-    *runs = 0;
-    if (rgb == NULL && j->rgb_shadow == NULL)
-        return true;
-    if (j->rgb_shadow == NULL) {
-        j->rgb_shadow = malloc(3 * j->n);
-        if (j->rgb_shadow == NULL)
-            return false;
-        memset(j->rgb_shadow, (int)GRID_RGB_DEFAULT, 3 * j->n);
-    }
-    const uint8_t *sh = j->rgb_shadow;
-    static const uint8_t def[3] = {GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT};
-    bool open_run = false;
-    size_t run_start = 0, run_end = 0;
-    const size_t chunk = 256;
-    for (size_t i0 = 0; i0 < j->n; i0 += chunk) {
-        const size_t i1 = j->n - i0 < chunk ? j->n : i0 + chunk;
-        if (rgb != NULL && same_bits(rgb + 3 * i0, sh + 3 * i0, 3 * (i1 - i0)))
-            continue;
-        for (size_t i = i0; i < i1; i++) {
-            if (same_bits(rgb != NULL ? rgb + 3 * i : def, sh + 3 * i, 3))
-                continue;
-            if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
-                run_end = i + 1;
-                continue;
-            }
-            if (open_run) {
-                if (!put_rgb_run(j, rgb, run_start, run_end))
-                    return false;
-                (*runs)++;
-            }
-            open_run = true;
-            run_start = i;
-            run_end = i + 1;
-        }
-    }
-    if (open_run) {
-        if (!put_rgb_run(j, rgb, run_start, run_end))
-            return false;
-        (*runs)++;
-    }
-    return true;
-}
-
-/* Fetches into cur the grid's current values of the samples [from, to) (journal indices) that
- * lie outside the box [lo, hi) read for a record (a run bridges them). */
-static void bridge_outside(journal_t *j, const grid_t *g, const int32_t lo[3], const int32_t hi[3],
-                           size_t from, size_t to)
-{
     const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
-    for (size_t i = from; i < to; i++) {
-        const int32_t s[3] = {(int32_t)(i % nx), (int32_t)(i / nx % ny), (int32_t)(i / (nx * ny))};
-        bool in = true;
-        for (int a = 0; a < 3; a++)
-            in = in && s[a] >= lo[a] && s[a] < hi[a];
-        if (!in)
-            j->cur[i] =
-                grid_get(g, GRID_DENSITY, j->lo[0] + s[0], j->lo[1] + s[1], j->lo[2] + s[2]);
+    for (size_t i = start; i < end; i++) {
+        const int32_t x = j->lo[0] + (int32_t)(i % nx), y = j->lo[1] + (int32_t)(i / nx % ny),
+                      z = j->lo[2] + (int32_t)(i / (nx * ny));
+        const int32_t k[3] = {grid_block_index(x), grid_block_index(y), grid_block_index(z)};
+        const size_t li = block_local(k, x, y, z);
+        if (!e->lv_ok || memcmp(e->lv.key, k, sizeof(k)) != 0) {
+            (void)grid_block_view(e->g, k, &e->lv);
+            e->lv_ok = true;
+        }
+        uint8_t lc[4], sc[4];
+        const uint8_t *la = live_arr(e->g, &e->lv, e->kind, lc);
+        const uint8_t *val = la != NULL ? la + es * li : lc;
+        uint8_t *out = p + 8 + es * (i - start);
+        if (es == 4) {
+            float f;
+            memcpy(&f, val, 4);
+            io_put_f32le(out, f);
+        } else {
+            memcpy(out, val, es);
+        }
+        if (!e->sb_ok || memcmp(e->sb_key, k, sizeof(k)) != 0) {
+            e->sb = sh_find(&j->shadow, k);
+            memcpy(e->sb_key, k, sizeof(k));
+            e->sb_ok = true;
+        }
+        uint8_t *sa = sh_arr(e->sb, e->kind, sc);
+        if (sa == NULL) {
+            if (memcmp(val, sc, es) == 0)
+                continue;
+            if (e->sb == NULL && (e->sb = sh_touch(&j->shadow, k)) == NULL)
+                return false;
+            if (!sh_arr_make(&j->shadow, e->sb, e->kind))
+                return false;
+            sa = sh_arr(e->sb, e->kind, sc);
+        }
+        memcpy(sa + es * li, val, es);
     }
+    j->buf_len += 8 + es * count;
+    if (e->kind == KIND_DENS)
+        j->stats.samples += count;
+    else if (e->kind == KIND_RGB)
+        j->stats.rgb_samples += count;
+    else
+        j->stats.mat_samples += count;
+    return true;
 }
 
-/* The clay grew past the journal's box: everything buffered is written, the shadows take the
+/* Sample i (journal index, increasing) differs: it joins the open run when at most
+ * JOURNAL_RUN_GAP unchanged samples lie between (they are written too), else the open run is
+ * written and a new one starts. false when out of memory. */
+static bool emit_sample(emit_t *e, size_t i)
+{
+    if (e->open && i - e->end <= JOURNAL_RUN_GAP) {
+        e->end = i + 1;
+        return true;
+    }
+    if (e->open) {
+        if (!put_run(e, e->start, e->end))
+            return false;
+        e->runs++;
+    }
+    e->open = true;
+    e->start = i;
+    e->end = i + 1;
+    return true;
+}
+
+/* Appends as runs, in sample order, the samples of kind inside [gl, gh) that differ between the
+ * grid and the shadow, over the changed blocks j->views[0, nviews), and brings the shadow up to
+ * date; then drops the shadow arrays that became uniform. *runs counts the runs. false when out
+ * of memory. */
+static bool put_changes(journal_t *j, const grid_t *g, int kind, const int32_t gl[3],
+                        const int32_t gh[3], size_t nviews, uint32_t *runs)
+{
+    emit_t e;
+    memset(&e, 0, sizeof(e));
+    e.j = j;
+    e.g = g;
+    e.kind = kind;
+    const size_t es = kind_bytes(kind), nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
+    const grid_block_view_t *vs = j->views;
+    for (size_t a = 0; a < nviews;) {
+        size_t b = a; /* [a, b): one slab of blocks (same z index) */
+        while (b < nviews && vs[b].key[2] == vs[a].key[2])
+            b++;
+        const int32_t bz = vs[a].key[2] * GRID_B;
+        const int32_t z0 = bz > gl[2] ? bz : gl[2], z1 = bz + GRID_B < gh[2] ? bz + GRID_B : gh[2];
+        for (int32_t z = z0; z < z1; z++)
+            for (size_t c = a; c < b;) {
+                size_t d = c; /* [c, d): one row of blocks (same y index) */
+                while (d < b && vs[d].key[1] == vs[c].key[1])
+                    d++;
+                const int32_t by = vs[c].key[1] * GRID_B;
+                const int32_t y0 = by > gl[1] ? by : gl[1];
+                const int32_t y1 = by + GRID_B < gh[1] ? by + GRID_B : gh[1];
+                for (int32_t y = y0; y < y1; y++)
+                    for (size_t q = c; q < d; q++) {
+                        const int32_t bx = vs[q].key[0] * GRID_B;
+                        const int32_t x0 = bx > gl[0] ? bx : gl[0];
+                        const int32_t x1 = bx + GRID_B < gh[0] ? bx + GRID_B : gh[0];
+                        /* This row's samples of both, copied before a run may write the
+                         * shadow (only samples before the current one). */
+                        uint8_t lc[4], sc[4], lrow[4 * GRID_B], srow[4 * GRID_B];
+                        const uint8_t *la = live_arr(g, &vs[q], kind, lc);
+                        const uint8_t *sa = sh_arr(sh_find(&j->shadow, vs[q].key), kind, sc);
+                        const size_t li = block_local(vs[q].key, x0, y, z);
+                        const size_t w = (size_t)(x1 - x0);
+                        for (size_t x = 0; x < w; x++) {
+                            memcpy(lrow + es * x, la != NULL ? la + es * (li + x) : lc, es);
+                            memcpy(srow + es * x, sa != NULL ? sa + es * (li + x) : sc, es);
+                        }
+                        if (memcmp(lrow, srow, es * w) == 0)
+                            continue;
+                        const size_t i0 = (size_t)(x0 - j->lo[0]) +
+                                          nx * ((size_t)(y - j->lo[1]) + ny * (size_t)(z - j->lo[2]));
+                        for (size_t x = 0; x < w; x++)
+                            if (memcmp(lrow + es * x, srow + es * x, es) != 0 &&
+                                !emit_sample(&e, i0 + x))
+                                return false;
+                    }
+                c = d;
+            }
+        a = b;
+    }
+    if (e.open) {
+        if (!put_run(&e, e.start, e.end))
+            return false;
+        e.runs++;
+    }
+    for (size_t q = 0; q < nviews; q++) {
+        journal_block_t *sb = sh_find(&j->shadow, vs[q].key);
+        if (sb != NULL)
+            sh_arr_compact(&j->shadow, sb, kind);
+    }
+    *runs = e.runs;
+    return true;
+}
+
+/* The clay grew past the journal's box: everything buffered is written, the shadow takes the
  * whole grid over its new bounds and a checkpoint makes that the new base (header and base file
  * with the new box). */
 static argil_err_t journal_rebase(journal_t *j, const grid_t *g, uint32_t edits, double sim_s,
@@ -680,46 +1090,24 @@ static argil_err_t journal_rebase(journal_t *j, const grid_t *g, uint32_t edits,
         ghi[a] = ghi[a] > ohi ? ghi[a] + JOURNAL_GROW_SAMPLES : ohi;
         dims[a] = ghi[a] - glo[a];
     }
-    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
-    float *sh = malloc(n * sizeof(float)), *cur = malloc(n * sizeof(float));
-    float *msh[GRID_MAT_N] = {NULL};
-    uint8_t *rsh = grid_rgb_any(g) ? malloc(3 * n) : NULL;
-    bool ok = sh != NULL && cur != NULL && (rsh != NULL || !grid_rgb_any(g));
-    for (int ch = 0; ok && ch < GRID_MAT_N; ch++)
-        if (grid_mat_painted(g, (grid_mat_t)ch)) {
-            msh[ch] = malloc(n * sizeof(float));
-            ok = msh[ch] != NULL;
-        }
-    if (!ok) {
-        free(sh);
-        free(cur);
-        free(rsh);
-        for (int ch = 0; ch < GRID_MAT_N; ch++)
-            free(msh[ch]);
+    journal_shadow_t sh;
+    memset(&sh, 0, sizeof(sh));
+    if (!shadow_take(&sh, g, glo, ghi)) {
+        sh_free(&sh);
         io_err(err, err_len, "%s: out of memory for the journal of the grown clay", j->dir);
         return ARGIL_ERR_NOMEM;
     }
-    grid_read_box(g, GRID_DENSITY, glo, dims, sh);
-    for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (msh[ch] != NULL)
-            grid_mat_read_box(g, (grid_mat_t)ch, glo, dims, msh[ch]);
-        free(j->mat_shadow[ch]);
-        j->mat_shadow[ch] = msh[ch];
-    }
-    if (rsh != NULL)
-        grid_rgb_read_box(g, glo, dims, rsh);
-    free(j->rgb_shadow);
-    j->rgb_shadow = rsh;
-    j->rgb_writes = g->rgb_writes;
-    free(j->shadow);
-    free(j->cur);
+    sh_free(&j->shadow);
     j->shadow = sh;
-    j->cur = cur;
+    for (int ch = 0; ch < GRID_MAT_N; ch++)
+        j->mat_seen[ch] = grid_mat_painted(g, (grid_mat_t)ch);
+    j->rgb_seen = grid_rgb_any(g);
+    j->rgb_writes = g->rgb_writes;
     for (int a = 0; a < 3; a++) {
         j->lo[a] = glo[a];
         j->dims[a] = dims[a];
     }
-    j->n = n;
+    j->n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
     j->origin_m = grid_box_origin(g, glo);
     j->material = g->material;
     j->mat_writes = g->mat_writes;
@@ -733,7 +1121,7 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
                            bool *appended, char *err, size_t err_len)
 {
     *appended = false;
-    if (j->shadow == NULL) {
+    if (!j->ready) {
         io_err(err, err_len, "journal: not open (or stopped by an earlier failure)");
         return ARGIL_ERR_STATE;
     }
@@ -747,76 +1135,30 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         return re;
     }
     const bool material_changed = !same_bits(&g->material, &j->material, sizeof(j->material));
-    /* The box to compare, clipped to the grid. */
-    int32_t lo[3] = {0, 0, 0}, hi[3] = {j->dims[0], j->dims[1], j->dims[2]};
+    /* The box to compare (grid sample indices), clipped to the journal's. */
+    const int32_t jl[3] = {j->lo[0], j->lo[1], j->lo[2]};
+    const int32_t jh[3] = {j->lo[0] + j->dims[0], j->lo[1] + j->dims[1], j->lo[2] + j->dims[2]};
+    int32_t gl[3] = {jl[0], jl[1], jl[2]}, gh[3] = {jh[0], jh[1], jh[2]};
     if (box != NULL) {
-        for (int a = 0; a < 3; a++) { /* into the journal's own indices */
-            const int64_t bl = (int64_t)box->lo[a] - j->lo[a], bh = (int64_t)box->hi[a] - j->lo[a];
-            lo[a] = bl < 0 ? 0 : (bl > j->dims[a] ? j->dims[a] : (int32_t)bl);
-            hi[a] = bh < lo[a] ? lo[a] : (bh > j->dims[a] ? j->dims[a] : (int32_t)bh);
+        for (int a = 0; a < 3; a++) {
+            gl[a] = box->lo[a] < jl[a] ? jl[a] : (box->lo[a] > jh[a] ? jh[a] : box->lo[a]);
+            gh[a] = box->hi[a] < gl[a] ? gl[a] : (box->hi[a] > jh[a] ? jh[a] : box->hi[a]);
         }
     }
-    const size_t x0 = (size_t)lo[0], x1 = (size_t)hi[0];
-    /* The grid's densities in the box, read in one go and laid into cur row by row (the
-     * samples a run bridges outside the box are fetched when bridged: bridge_outside). */
-    if (x1 > x0 && hi[1] > lo[1] && hi[2] > lo[2]) {
-        const int32_t blo[3] = {j->lo[0] + lo[0], j->lo[1] + lo[1], j->lo[2] + lo[2]};
-        const int32_t bn[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-        float *box_d = malloc((size_t)bn[0] * (size_t)bn[1] * (size_t)bn[2] * sizeof(float));
-        if (box_d == NULL) {
-            io_err(err, err_len, "%s: out of memory for journal records", j->dir);
-            return ARGIL_ERR_NOMEM; /* nothing written yet: the journal goes on */
-        }
-        grid_read_box(g, GRID_DENSITY, blo, bn, box_d);
-        const float *src = box_d;
-        for (int32_t z = lo[2]; z < hi[2]; z++)
-            for (int32_t y = lo[1]; y < hi[1]; y++, src += bn[0])
-                memcpy(j->cur + (size_t)j->dims[0] * ((size_t)y + (size_t)j->dims[1] * (size_t)z) + x0,
-                       src, (size_t)bn[0] * sizeof(float));
-        free(box_d);
-    }
-    const float *gd = j->cur;
     const size_t rec_at = j->buf_len;
-    if (!reserve(j, 4 + JOURNAL_RECORD_HEAD_BYTES))
-        goto nomem;
+    size_t nviews = 0;
+    if (!changed_blocks(j, g, KIND_DENS, gl, gh, &nviews) ||
+        !reserve(j, 4 + JOURNAL_RECORD_HEAD_BYTES)) {
+        io_err(err, err_len, "%s: out of memory for journal records", j->dir);
+        return ARGIL_ERR_NOMEM; /* nothing written yet: the journal goes on */
+    }
     j->buf_len += 4 + JOURNAL_RECORD_HEAD_BYTES;
     uint32_t runs = 0;
-    bool open_run = false;
-    size_t run_start = 0, run_end = 0;
-    for (int32_t z = lo[2]; z < hi[2] && x1 > x0; z++) {
-        for (int32_t y = lo[1]; y < hi[1]; y++) {
-            const size_t r0 = ((size_t)y + (size_t)j->dims[1] * (size_t)z) * (size_t)j->dims[0];
-            const float *d = gd + r0, *s = j->shadow + r0;
-            if (same_bits(d + x0, s + x0, (x1 - x0) * sizeof(float)))
-                continue;
-            for (size_t x = x0; x < x1; x++) {
-                if (same_bits(d + x, s + x, sizeof(float)))
-                    continue;
-                const size_t i = r0 + x;
-                if (open_run && i - run_end <= JOURNAL_RUN_GAP) {
-                    /* bridged samples are written with their current values */
-                    bridge_outside(j, g, lo, hi, run_end, i);
-                    run_end = i + 1;
-                    continue;
-                }
-                if (open_run) {
-                    if (!put_run(j, gd, run_start, run_end))
-                        goto nomem;
-                    runs++;
-                }
-                open_run = true;
-                run_start = i;
-                run_end = i + 1;
-            }
-        }
-    }
-    if (open_run) {
-        if (!put_run(j, gd, run_start, run_end))
-            goto nomem;
-        runs++;
-    }
-    /* Painted channels: whole, when they may have changed (record type 2); then the painted
-     * colour likewise (type 3: the material block count, maybe 0, always precedes it). */
+    if (!put_changes(j, g, KIND_DENS, gl, gh, nviews, &runs))
+        goto nomem;
+    /* Painted channels: over the whole box, when they may have changed (record type 2); then
+     * the painted colour likewise (type 3: the material block count, maybe 0, always precedes
+     * it). */
     uint32_t blocks = 0, rgb_runs = 0;
     const bool look_mat = box == NULL || g->mat_writes != j->mat_writes;
     const bool look_rgb = box == NULL || g->rgb_writes != j->rgb_writes;
@@ -826,32 +1168,36 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
             goto nomem;
         j->buf_len += 4;
     }
-    if (look_mat) {
-        for (int ch = 0; ch < GRID_MAT_N; ch++) {
-            const bool painted = grid_mat_painted(g, (grid_mat_t)ch);
-            if (painted) /* the density runs are written: cur is free again */
-                grid_mat_read_box(g, (grid_mat_t)ch, j->lo, j->dims, j->cur);
-            if (!put_mat_block(j, (grid_mat_t)ch, painted ? j->cur : NULL, &blocks))
-                goto nomem;
+    for (int ch = 0; look_mat && ch < GRID_MAT_N; ch++) {
+        if (grid_mat_painted(g, (grid_mat_t)ch))
+            j->mat_seen[ch] = true;
+        if (!j->mat_seen[ch])
+            continue;
+        const size_t at = j->buf_len;
+        uint32_t mruns = 0;
+        if (!reserve(j, 8) || !changed_blocks(j, g, KIND_MAT0 + ch, jl, jh, &nviews))
+            goto nomem;
+        j->buf_len += 8;
+        if (!put_changes(j, g, KIND_MAT0 + ch, jl, jh, nviews, &mruns))
+            goto nomem;
+        if (mruns == 0) {
+            j->buf_len = at;
+            continue;
         }
-        j->mat_writes = g->mat_writes;
+        io_put_u32le(j->buf + at, (uint32_t)ch);
+        io_put_u32le(j->buf + at + 4, mruns);
+        blocks++;
     }
+    if (look_mat)
+        j->mat_writes = g->mat_writes;
     if (look_rgb) {
+        if (grid_rgb_any(g))
+            j->rgb_seen = true;
         const size_t rgb_at = j->buf_len;
-        if (!reserve(j, 4))
+        if (!reserve(j, 4) || !changed_blocks(j, g, KIND_RGB, jl, jh, &nviews))
             goto nomem;
         j->buf_len += 4;
-        /* The grid's colour over the journal's box (NULL: never painted, the default). */
-        uint8_t *rgb = NULL;
-        if (grid_rgb_any(g)) {
-            rgb = malloc(3 * j->n);
-            if (rgb == NULL)
-                goto nomem;
-            grid_rgb_read_box(g, j->lo, j->dims, rgb);
-        }
-        const bool ok = put_rgb_runs(j, rgb, &rgb_runs);
-        free(rgb);
-        if (!ok)
+        if (!put_changes(j, g, KIND_RGB, jl, jh, nviews, &rgb_runs))
             goto nomem;
         if (rgb_runs == 0)
             j->buf_len = rgb_at;
@@ -902,9 +1248,8 @@ nomem:
      * The whole records before this one stay buffered and can still be synced. */
     j->buf_len = rec_at;
     io_err(err, err_len, "%s: out of memory for journal records", j->dir);
-    /* The material shadows may be part-written too. */
-    free(j->shadow);
-    j->shadow = NULL;
+    sh_free(&j->shadow);
+    j->ready = false;
     return ARGIL_ERR_NOMEM;
 }
 
@@ -974,18 +1319,13 @@ void journal_close(journal_t *j)
         (void)close(j->fd);
     j->fd = -1;
     free(j->dir);
-    free(j->shadow);
-    free(j->cur);
-    j->cur = NULL;
-    free(j->buf);
-    for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        free(j->mat_shadow[ch]);
-        j->mat_shadow[ch] = NULL;
-    }
-    free(j->rgb_shadow);
-    j->rgb_shadow = NULL;
     j->dir = NULL;
-    j->shadow = NULL;
+    sh_free(&j->shadow);
+    j->ready = false;
+    free(j->views);
+    j->views = NULL;
+    j->views_cap = 0;
+    free(j->buf);
     j->buf = NULL;
     j->buf_len = j->buf_cap = 0;
 }

@@ -44,6 +44,25 @@ typedef struct {
     uint64_t rgb_samples;     /* painted colour samples (3 bytes each) journaled */
 } journal_stats_t;
 
+/* One grid block of the writer's copy of the model as of the last record (host/io/journal.c):
+ * only blocks the grid holds cost memory, and a block at one density holds no array. */
+typedef struct {
+    int32_t key[3];           /* block index, as the grid's (grid_block_index) */
+    bool used;                /* hash slot taken */
+    float uniform;            /* the density of every sample when dens is NULL */
+    float *dens;              /* GRID_BN densities (x fastest), or NULL */
+    float *mat[GRID_MAT_N];   /* GRID_BN values of a painted channel; NULL: its default */
+    uint8_t *rgb;             /* 3 GRID_BN bytes; NULL: GRID_RGB_DEFAULT */
+} journal_block_t;
+
+/* The writer's copy of the model: an open-addressing hash of blocks by block index; a block
+ * not in it reads density 0, the painted defaults and GRID_RGB_DEFAULT. */
+typedef struct {
+    journal_block_t *slots;   /* NULL: none */
+    size_t cap, count;        /* slots, slots used */
+    size_t arrays_bytes;      /* bytes of the blocks' arrays */
+} journal_shadow_t;
+
 /* The open journal of a running session (writer side). */
 typedef struct {
     journal_cfg_t cfg;
@@ -54,13 +73,14 @@ typedef struct {
     float spacing_m, iso, band_m;
     vec3_t origin_m;          /* model-space position of sample lo */
     size_t n;                 /* samples */
-    float *shadow;            /* density as of the last record */
-    float *cur;               /* scratch: the grid's samples read for a record (n floats) */
-    float *mat_shadow[GRID_MAT_N]; /* painted channels as of the last record (NULL: never
-                               * painted, all grid_mat_default) */
+    bool ready;               /* open, and the shadow whole (false after a failed record) */
+    journal_shadow_t shadow;  /* densities, painted channels and colour as of the last record */
+    bool mat_seen[GRID_MAT_N]; /* channel painted in the grid when last compared (the base
+                               * snapshot then carries it) */
+    bool rgb_seen;            /* likewise the colour */
+    grid_block_view_t *views; /* scratch: the blocks a record compares sample by sample */
+    size_t views_cap;
     uint32_t mat_writes;      /* the grid's mat_writes when its channels were last compared */
-    uint8_t *rgb_shadow;      /* painted colour as of the last record (NULL: never painted, all
-                               * GRID_RGB_DEFAULT) */
     uint32_t rgb_writes;      /* the grid's rgb_writes when its colour was last compared */
     spring_material_t material; /* as of the last record */
     uint8_t *buf;             /* records not yet written to the file */
@@ -142,6 +162,10 @@ argil_err_t journal_checkpoint(journal_t *j, double sim_s, char *err, size_t err
  * exactly the form argil recover writes, so a model and its recovery compare byte for byte. */
 argil_err_t journal_write_model(const journal_t *j, const grid_t *g, uint32_t edits,
                                 const char *path, char *err, size_t err_len);
+
+/* Bytes of memory the journal holds: its copy of the model (block arrays and hash), record
+ * buffer and scratch. Grows with the clay's surface, not with the journal's box. */
+size_t journal_bytes(const journal_t *j);
 
 /* Releases the journal and keeps its files (the session did not end cleanly). */
 void journal_close(journal_t *j);

@@ -1,11 +1,10 @@
-/* Binary little-endian PLY: atomic export of meshes and a strict reader of the same layout.
- * Fields are encoded byte by byte, never by copying structs. */
+/* Binary little-endian PLY: atomic export of meshes (through mesh_export, the one PLY writer) and
+ * a strict reader of the same layout. Fields are decoded byte by byte, never by copying structs. */
 #include "host/io/ply.h"
 
-#include "host/io/io_util.h"
+#include "host/io/mesh_export.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -17,11 +16,13 @@
 #include <unistd.h>
 
 #define PLY_VERT_BYTES 24u  /* 6 floats */
+#define PLY_VERT_RGB_BYTES 27u /* 6 floats + uchar red green blue */
 #define PLY_FACE_BYTES 13u  /* uchar count + 3 int32 */
-#define PLY_CHUNK_BYTES 65520u /* multiple of 24 and 13 */
+#define PLY_CHUNK_BYTES 65520u /* read buffer: whole records of 24, 27 or 13 bytes at a time */
 #define PLY_VERT_MAX ((uint64_t)INT32_MAX) /* indices are signed int in the file */
 
 static const char *const ply_prop_names[6] = {"x", "y", "z", "nx", "ny", "nz"};
+static const char *const ply_rgb_names[3] = {"red", "green", "blue"};
 
 /* Writes a formatted message into err (when there is room). */
 static void ply_err(char *err, size_t err_len, const char *fmt, ...)
@@ -36,24 +37,9 @@ static void ply_err(char *err, size_t err_len, const char *fmt, ...)
     va_end(ap);
 }
 
-static void put_u32_le(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
 static uint32_t get_u32_le(const uint8_t *p)
 {
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static void put_f32_le(uint8_t *p, float f)
-{
-    uint32_t v;
-    memcpy(&v, &f, sizeof(v));
-    put_u32_le(p, v);
 }
 
 static float get_f32_le(const uint8_t *p)
@@ -66,110 +52,14 @@ static float get_f32_le(const uint8_t *p)
 
 /* ---------------------------------------------------------------- writer */
 
-/* Checks that m can be written; fills err otherwise. */
-static argil_err_t ply_check_mesh(const char *path, const mesh_t *m, char *err, size_t err_len)
-{
-    if ((uint64_t)m->n_vert > PLY_VERT_MAX) {
-        ply_err(err, err_len, "ply_write: %s: %zu vertices exceed the format's int indices",
-                path, m->n_vert);
-        return ARGIL_ERR_ARG;
-    }
-    if ((m->n_vert > 0 && m->pos == NULL) || (m->n_tri > 0 && m->tri == NULL)) {
-        ply_err(err, err_len, "ply_write: %s: mesh arrays missing", path);
-        return ARGIL_ERR_ARG;
-    }
-    for (size_t i = 0; i < 3 * m->n_vert; i++) {
-        if (!isfinite(m->pos[i]) || (m->normal != NULL && !isfinite(m->normal[i]))) {
-            ply_err(err, err_len, "ply_write: %s: vertex %zu is not finite", path, i / 3);
-            return ARGIL_ERR_NONFINITE;
-        }
-    }
-    for (size_t i = 0; i < 3 * m->n_tri; i++) {
-        if (m->tri[i] >= m->n_vert) {
-            ply_err(err, err_len, "ply_write: %s: triangle %zu names vertex %u of %zu", path,
-                    i / 3, (unsigned)m->tri[i], m->n_vert);
-            return ARGIL_ERR_ARG;
-        }
-    }
-    return ARGIL_OK;
-}
-
-/* Writes header and body to f; returns the name of the failing call or NULL. */
-static const char *ply_write_stream(FILE *f, const mesh_t *m, uint8_t *buf)
-{
-    if (fprintf(f,
-                "ply\nformat binary_little_endian 1.0\ncomment argil mesh, model space, metres\n"
-                "element vertex %zu\n",
-                m->n_vert) < 0)
-        return "fprintf";
-    for (int k = 0; k < 6; k++) {
-        if (fprintf(f, "property float %s\n", ply_prop_names[k]) < 0)
-            return "fprintf";
-    }
-    if (fprintf(f, "element face %zu\nproperty list uchar int vertex_indices\nend_header\n",
-                m->n_tri) < 0)
-        return "fprintf";
-    size_t used = 0;
-    for (size_t v = 0; v < m->n_vert; v++) {
-        if (used + PLY_VERT_BYTES > PLY_CHUNK_BYTES) {
-            if (fwrite(buf, 1, used, f) != used)
-                return "fwrite";
-            used = 0;
-        }
-        for (int k = 0; k < 3; k++) {
-            put_f32_le(buf + used + 4 * (size_t)k, m->pos[3 * v + (size_t)k]);
-            put_f32_le(buf + used + 12 + 4 * (size_t)k,
-                       m->normal != NULL ? m->normal[3 * v + (size_t)k] : 0.0f);
-        }
-        used += PLY_VERT_BYTES;
-    }
-    for (size_t t = 0; t < m->n_tri; t++) {
-        if (used + PLY_FACE_BYTES > PLY_CHUNK_BYTES) {
-            if (fwrite(buf, 1, used, f) != used)
-                return "fwrite";
-            used = 0;
-        }
-        buf[used] = 3;
-        for (int k = 0; k < 3; k++)
-            put_u32_le(buf + used + 1 + 4 * (size_t)k, m->tri[3 * t + (size_t)k]);
-        used += PLY_FACE_BYTES;
-    }
-    if (used > 0 && fwrite(buf, 1, used, f) != used)
-        return "fwrite";
-    return NULL;
-}
-
-typedef struct {
-    const mesh_t *mesh;
-    uint8_t *buf;
-} ply_write_ctx_t;
-
-/* io_write_atomic's callback: the whole file into f. */
-static const char *ply_write_cb(FILE *f, const void *ctx)
-{
-    const ply_write_ctx_t *c = ctx;
-    return ply_write_stream(f, c->mesh, c->buf);
-}
-
 argil_err_t ply_write(const char *path, const mesh_t *m, char *err, size_t err_len)
 {
     if (path == NULL || m == NULL) {
         ply_err(err, err_len, "ply_write: no path or no mesh");
         return ARGIL_ERR_ARG;
     }
-    argil_err_t e = ply_check_mesh(path, m, err, err_len);
-    if (e != ARGIL_OK)
-        return e;
-    uint8_t *buf = malloc(PLY_CHUNK_BYTES);
-    if (buf == NULL) {
-        ply_err(err, err_len, "ply_write: %s: out of memory", path);
-        return ARGIL_ERR_NOMEM;
-    }
-    /* Temp file, fsync, rename, directory sync: a crash never leaves a half file. */
-    const ply_write_ctx_t ctx = {m, buf};
-    e = io_write_atomic(path, ply_write_cb, &ctx, "ply_write", err, err_len);
-    free(buf);
-    return e;
+    /* One PLY writer: argil mesh's (vertex colours when the mesh has them). */
+    return mesh_export(path, m, EXPORT_PLY_BINARY, err, err_len);
 }
 
 /* ---------------------------------------------------------------- reader */
@@ -178,6 +68,8 @@ typedef struct {
     const char *path;
     char *err;
     size_t err_len;
+    bool rgb;          /* the header declared red green blue after the normal */
+    size_t vert_bytes; /* PLY_VERT_BYTES, or PLY_VERT_RGB_BYTES with colour */
 } ply_ctx_t;
 
 /* Splits line (NUL-terminated, modified) at spaces and tabs into at most max tokens; returns
@@ -230,7 +122,8 @@ enum {
     PLY_H_FORMAT,
     PLY_H_VERTEX,
     PLY_H_PROP0, /* .. PLY_H_PROP0 + 5 */
-    PLY_H_FACE = PLY_H_PROP0 + 6,
+    PLY_H_RGB0 = PLY_H_PROP0 + 6, /* optional: .. PLY_H_RGB0 + 2 */
+    PLY_H_FACE = PLY_H_RGB0 + 3,
     PLY_H_LIST,
     PLY_H_END,
     PLY_H_DONE
@@ -248,6 +141,9 @@ static const char *ply_expected(int state)
     case PLY_H_FACE: return "element face <count>";
     case PLY_H_LIST: return "property list uchar int vertex_indices";
     case PLY_H_END: return "end_header";
+    case PLY_H_RGB0: return "property uchar red' or 'element face <count>";
+    case PLY_H_RGB0 + 1: return "property uchar green";
+    case PLY_H_RGB0 + 2: return "property uchar blue";
     default: return props[state - PLY_H_PROP0];
     }
 }
@@ -260,6 +156,9 @@ static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *s
     const int n = ply_tokens(line, tok, 5);
     if (*state != PLY_H_MAGIC && n >= 1 && (ply_is(tok[0], "comment", "obj_info")))
         return ARGIL_OK;
+    /* The colour is optional: the face element may follow the normal directly. */
+    if (*state == PLY_H_RGB0 && n >= 1 && strcmp(tok[0], "element") == 0)
+        *state = PLY_H_FACE;
     bool ok = false;
     switch (*state) {
     case PLY_H_MAGIC:
@@ -294,6 +193,16 @@ static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *s
         break;
     case PLY_H_END:
         ok = n == 1 && strcmp(tok[0], "end_header") == 0;
+        break;
+    case PLY_H_RGB0:
+    case PLY_H_RGB0 + 1:
+    case PLY_H_RGB0 + 2:
+        ok = n == 3 && strcmp(tok[0], "property") == 0 && ply_is(tok[1], "uchar", "uint8") &&
+             strcmp(tok[2], ply_rgb_names[*state - PLY_H_RGB0]) == 0;
+        if (ok && *state == PLY_H_RGB0 + 2) {
+            c->rgb = true;
+            c->vert_bytes = PLY_VERT_RGB_BYTES;
+        }
         break;
     default:
         ok = n == 3 && strcmp(tok[0], "property") == 0 && ply_is(tok[1], "float", "float32") &&
@@ -374,15 +283,16 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
     uint64_t done = 0;
     while (done < n_vert) {
         uint64_t batch = n_vert - done;
-        if (batch > PLY_CHUNK_BYTES / PLY_VERT_BYTES)
-            batch = PLY_CHUNK_BYTES / PLY_VERT_BYTES;
-        e = ply_read_exact(c, f, buf, (size_t)batch * PLY_VERT_BYTES, offset);
+        if (batch > PLY_CHUNK_BYTES / c->vert_bytes)
+            batch = PLY_CHUNK_BYTES / c->vert_bytes;
+        e = ply_read_exact(c, f, buf, (size_t)batch * c->vert_bytes, offset);
         if (e != ARGIL_OK)
             return e;
-        for (uint64_t i = 0; i < batch; i++, done++, offset += PLY_VERT_BYTES) {
+        for (uint64_t i = 0; i < batch; i++, done++, offset += c->vert_bytes) {
+            const uint8_t *r = buf + i * c->vert_bytes;
             float v[6];
             for (int k = 0; k < 6; k++) {
-                v[k] = get_f32_le(buf + i * PLY_VERT_BYTES + 4 * (size_t)k);
+                v[k] = get_f32_le(r + 4 * (size_t)k);
                 if (!isfinite(v[k])) {
                     ply_err(c->err, c->err_len,
                             "ply_read_mesh: %s: byte %llu: vertex %llu has a non-finite %s",
@@ -391,7 +301,10 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
                     return ARGIL_ERR_PARSE;
                 }
             }
-            e = mesh_add_vertex(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]), NULL);
+            e = c->rgb ? mesh_add_vertex_rgb(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]),
+                                             r + PLY_VERT_BYTES, NULL)
+                       : mesh_add_vertex(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]),
+                                         NULL);
             if (e != ARGIL_OK)
                 return e;
         }
@@ -463,7 +376,7 @@ static argil_err_t ply_read_file(ply_ctx_t *c, FILE *f, mesh_t *out, uint8_t *bu
     /* The declared records must fill the rest of the file exactly: no count drives an
      * allocation beyond what the file holds. */
     const uint64_t avail = file_size - header_len;
-    const uint64_t vbytes = n_vert * PLY_VERT_BYTES;
+    const uint64_t vbytes = n_vert * c->vert_bytes;
     const bool fits = vbytes <= avail && n_face <= (avail - vbytes) / PLY_FACE_BYTES;
     const uint64_t need = fits ? vbytes + n_face * PLY_FACE_BYTES : 0;
     if (!fits || need != avail) {
@@ -474,7 +387,14 @@ static argil_err_t ply_read_file(ply_ctx_t *c, FILE *f, mesh_t *out, uint8_t *bu
                 (unsigned long long)avail, fits ? "trailing bytes" : "file too short");
         return ARGIL_ERR_PARSE;
     }
+    if (out->has_rgb && !c->rgb) { /* a colour array left from an earlier use of out */
+        free(out->rgb);
+        out->rgb = NULL;
+        out->has_rgb = 0;
+    }
     e = mesh_reserve(out, (size_t)n_vert, (size_t)n_face);
+    if (e == ARGIL_OK && c->rgb)
+        e = mesh_enable_rgb(out);
     if (e != ARGIL_OK) {
         ply_err(c->err, c->err_len, "ply_read_mesh: %s: out of memory for %llu vertices",
                 c->path, (unsigned long long)n_vert);
@@ -495,7 +415,7 @@ argil_err_t ply_read_mesh(const char *path, mesh_t *out, char *err, size_t err_l
         return ARGIL_ERR_ARG;
     }
     mesh_clear(out);
-    ply_ctx_t c = {path, err, err_len};
+    ply_ctx_t c = {path, err, err_len, false, PLY_VERT_BYTES};
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
         ply_err(err, err_len, "ply_read_mesh: fopen(\"%s\") failed: %s", path, strerror(errno));

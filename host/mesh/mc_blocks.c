@@ -15,6 +15,9 @@
 #define MCB_L (MC_BLOCK_CELLS + 3) /* scratch samples per axis: cells + 1 corners + 2 halo */
 #define MCB_C (MC_BLOCK_CELLS + 1) /* corners per axis */
 
+#define MCB_HASH_MIN 64    /* initial slots of the block hash */
+#define MCB_KEY_BITS 20     /* bits per axis of an edge id */
+
 static void mcb_block_free(mc_block_mesh_t *k)
 {
     free(k->pos);
@@ -27,11 +30,13 @@ static void mcb_block_free(mc_block_mesh_t *k)
 
 void mc_blocks_free(mc_blocks_t *b)
 {
-    if (b->blocks != NULL)
-        for (size_t i = 0; i < b->n_blocks; i++)
-            mcb_block_free(&b->blocks[i]);
-    free(b->blocks);
-    free(b->dirty);
+    if (b->slots != NULL)
+        for (size_t i = 0; i < b->cap; i++)
+            if (b->slots[i].used)
+                mcb_block_free(&b->slots[i].mesh);
+    free(b->slots);
+    mcb_block_free(&b->spare);
+    free(b->keys);
     free(b->tab);
     free(b->val);
     free(b->rd);
@@ -42,33 +47,129 @@ void mc_blocks_free(mc_blocks_t *b)
     memset(b, 0, sizeof(*b));
 }
 
-argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_m,
-                           vec3_t origin_m, float iso)
+/* Block key of padded cell c: floor(c / MC_BLOCK_CELLS) for any sign. */
+static int32_t mcb_block_of(int64_t c)
+{
+    return (int32_t)(c >= 0 ? c / MC_BLOCK_CELLS : -((-c + MC_BLOCK_CELLS - 1) / MC_BLOCK_CELLS));
+}
+
+/* Home slot of block key k in a table of cap (a power of two) slots. */
+static size_t mcb_home(const int32_t k[3], size_t cap)
+{
+    uint64_t h = (uint64_t)(uint32_t)k[0] * 0x9E3779B97F4A7C15ull;
+    h ^= (uint64_t)(uint32_t)k[1] * 0xC2B2AE3D27D4EB4Full;
+    h ^= (uint64_t)(uint32_t)k[2] * 0x165667B19E3779F9ull;
+    h ^= h >> 29;
+    return (size_t)(h & (cap - 1));
+}
+
+static bool mcb_same_key(const int32_t a[3], const int32_t b[3])
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+/* The slot of block k, or NULL when the hash holds none. */
+static mc_block_t *mcb_find(const mc_blocks_t *b, const int32_t k[3])
+{
+    const size_t mask = b->cap - 1;
+    for (size_t i = mcb_home(k, b->cap), n = 0; n < b->cap; i = (i + 1) & mask, n++) {
+        mc_block_t *e = &b->slots[i];
+        if (!e->used)
+            return NULL;
+        if (mcb_same_key(e->key, k))
+            return e;
+    }
+    return NULL;
+}
+
+/* Doubles the hash; false (hash unchanged) when out of memory. */
+static bool mcb_rehash(mc_blocks_t *b)
+{
+    const size_t cap = b->cap * 2;
+    mc_block_t *s = calloc(cap, sizeof(*s));
+    if (s == NULL)
+        return false;
+    for (size_t i = 0; i < b->cap; i++) {
+        if (!b->slots[i].used)
+            continue;
+        size_t h = mcb_home(b->slots[i].key, cap);
+        while (s[h].used)
+            h = (h + 1) & (cap - 1);
+        s[h] = b->slots[i];
+    }
+    free(b->slots);
+    b->slots = s;
+    b->cap = cap;
+    return true;
+}
+
+/* The slot of block k, taken (clean, no triangles) when new; NULL when out of memory. */
+static mc_block_t *mcb_insert(mc_blocks_t *b, const int32_t k[3])
+{
+    mc_block_t *e = mcb_find(b, k);
+    if (e != NULL)
+        return e;
+    if (2 * (b->n_blocks + 1) > b->cap && !mcb_rehash(b))
+        return NULL;
+    size_t i = mcb_home(k, b->cap);
+    while (b->slots[i].used)
+        i = (i + 1) & (b->cap - 1);
+    e = &b->slots[i];
+    memset(e, 0, sizeof(*e));
+    memcpy(e->key, k, sizeof(e->key));
+    e->used = 1;
+    b->n_blocks++;
+    return e;
+}
+
+/* Frees slot e's arrays and gives the slot up (backward-shift deletion keeps probing exact). */
+static void mcb_remove(mc_blocks_t *b, mc_block_t *e)
+{
+    const size_t mask = b->cap - 1;
+    size_t i = (size_t)(e - b->slots);
+    mcb_block_free(&e->mesh);
+    for (size_t j = (i + 1) & mask, n = 0; n < b->cap && b->slots[j].used;
+         j = (j + 1) & mask, n++) {
+        const size_t h = mcb_home(b->slots[j].key, b->cap);
+        /* slot j stays when its home lies cyclically in (i, j] */
+        const bool stays = i <= j ? (i < h && h <= j) : (i < h || h <= j);
+        if (!stays) {
+            b->slots[i] = b->slots[j];
+            i = j;
+        }
+    }
+    memset(&b->slots[i], 0, sizeof(b->slots[i]));
+    b->n_blocks--;
+}
+
+/* True when [lo, hi) is a non-empty box within the indices and span a mesher can hold. */
+static bool mcb_box_ok(const int32_t lo[3], const int32_t hi[3])
+{
+    for (int a = 0; a < 3; a++)
+        if (lo[a] >= hi[a] || lo[a] < -MC_BLOCKS_INDEX_MAX || hi[a] > MC_BLOCKS_INDEX_MAX ||
+            (int64_t)hi[a] - lo[a] > MC_BLOCKS_SPAN_MAX)
+            return false;
+    return true;
+}
+
+argil_err_t mc_blocks_init_box(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3],
+                               float spacing_m, vec3_t origin_m, float iso)
 {
     memset(b, 0, sizeof(*b));
-    if (dims == NULL)
+    if (lo == NULL || hi == NULL || !mcb_box_ok(lo, hi))
         return ARGIL_ERR_ARG;
-    int64_t n = 1;
-    for (int a = 0; a < 3; a++) {
-        if (dims[a] < 1 || dims[a] > INT32_MAX - 2)
-            return ARGIL_ERR_ARG;
-        n *= dims[a];
-        if (n > ((int64_t)1 << 31))
-            return ARGIL_ERR_ARG;
-    }
     if (!isfinite(spacing_m) || !(spacing_m > 0.0f) || !isfinite(iso) || !vec3_isfinite(origin_m))
         return ARGIL_ERR_ARG;
-    b->n_blocks = 1;
     for (int a = 0; a < 3; a++) {
-        b->dims[a] = dims[a];
-        b->nblk[a] = (dims[a] + 1 + MC_BLOCK_CELLS - 1) / MC_BLOCK_CELLS;
-        b->n_blocks *= (size_t)b->nblk[a];
+        b->lo[a] = lo[a];
+        b->hi[a] = hi[a];
+        b->dims[a] = hi[a] - lo[a];
     }
     b->spacing_m = spacing_m;
     b->origin_m = origin_m;
     b->iso = iso;
-    b->blocks = calloc(b->n_blocks, sizeof(*b->blocks));
-    b->dirty = malloc(b->n_blocks);
+    b->cap = MCB_HASH_MIN;
+    b->slots = calloc(b->cap, sizeof(*b->slots));
     b->tab = malloc(sizeof(*b->tab));
     b->val = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
     b->rd = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
@@ -76,8 +177,7 @@ argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_
     b->ins = malloc(MCB_L * MCB_L * MCB_L);
     b->col = malloc(3 * MCB_L * MCB_L * MCB_L);
     b->cache = malloc(sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C);
-    if (b->blocks == NULL || b->dirty == NULL || b->tab == NULL || b->val == NULL ||
-        b->rd == NULL || b->rdc == NULL ||
+    if (b->slots == NULL || b->tab == NULL || b->val == NULL || b->rd == NULL || b->rdc == NULL ||
         b->ins == NULL || b->col == NULL || b->cache == NULL) {
         mc_blocks_free(b);
         return ARGIL_ERR_NOMEM;
@@ -87,31 +187,111 @@ argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_
     return ARGIL_OK;
 }
 
+argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_m,
+                           vec3_t origin_m, float iso)
+{
+    memset(b, 0, sizeof(*b));
+    if (dims == NULL)
+        return ARGIL_ERR_ARG;
+    const int32_t zero[3] = {0, 0, 0};
+    return mc_blocks_init_box(b, zero, dims, spacing_m, origin_m, iso);
+}
+
+argil_err_t mc_blocks_grow(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
+{
+    if (b == NULL || b->slots == NULL || lo == NULL || hi == NULL)
+        return ARGIL_ERR_ARG;
+    for (int a = 0; a < 3; a++)
+        if (lo[a] >= hi[a] || lo[a] < -MC_BLOCKS_INDEX_MAX || hi[a] > MC_BLOCKS_INDEX_MAX)
+            return ARGIL_ERR_ARG;
+    int32_t nlo[3], nhi[3];
+    bool changed = false;
+    for (int a = 0; a < 3; a++) {
+        nlo[a] = lo[a] < b->lo[a] ? lo[a] : b->lo[a];
+        nhi[a] = hi[a] > b->hi[a] ? hi[a] : b->hi[a];
+        if ((int64_t)nhi[a] - nlo[a] > MC_BLOCKS_SPAN_MAX)
+            return ARGIL_ERR_FULL;
+        changed |= nlo[a] != b->lo[a] || nhi[a] != b->hi[a];
+    }
+    if (!changed)
+        return ARGIL_OK;
+    memcpy(b->lo, nlo, sizeof(nlo));
+    memcpy(b->hi, nhi, sizeof(nhi));
+    if (!(b->iso >= 0.0f))
+        mc_blocks_mark_all(b); /* density 0 is inside: the box's faces were surface */
+    return ARGIL_OK;
+}
+
+/* First and one-past-last block key per axis over the meshed box's padded cells
+ * [lo, hi + 1). */
+static void mcb_box_keys(const mc_blocks_t *b, int32_t klo[3], int32_t khi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        klo[a] = mcb_block_of(b->lo[a]);
+        khi[a] = mcb_block_of(b->hi[a]) + 1;
+    }
+}
+
+size_t mc_blocks_box_blocks(const mc_blocks_t *b)
+{
+    int32_t klo[3], khi[3];
+    mcb_box_keys(b, klo, khi);
+    return (size_t)(khi[0] - klo[0]) * (size_t)(khi[1] - klo[1]) * (size_t)(khi[2] - klo[2]);
+}
+
+static size_t mcb_block_bytes(const mc_block_mesh_t *k)
+{
+    return (size_t)k->cap_vert * (6 * sizeof(float) + sizeof(uint64_t) + (k->rgb != NULL ? 3 : 0)) +
+           (size_t)k->cap_tri * 3 * sizeof(uint32_t);
+}
+
+size_t mc_blocks_bytes(const mc_blocks_t *b)
+{
+    if (b == NULL || b->slots == NULL)
+        return 0;
+    size_t n = sizeof(*b) + b->cap * sizeof(mc_block_t) + b->keys_cap * 3 * sizeof(int32_t) +
+               sizeof(*b->tab) + (2 * sizeof(float) + 2 + 2 * 3) * MCB_L * MCB_L * MCB_L +
+               sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C + mcb_block_bytes(&b->spare);
+    for (size_t i = 0; i < b->cap; i++)
+        if (b->slots[i].used)
+            n += mcb_block_bytes(&b->slots[i].mesh);
+    return n;
+}
+
 void mc_blocks_mark_all(mc_blocks_t *b)
 {
-    memset(b->dirty, 1, b->n_blocks);
+    b->all_dirty = true;
 }
 
 void mc_blocks_mark(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
 {
+    if (b->all_dirty)
+        return;
     /* Sample s (padded s + 1) is a corner of padded cells s, s + 1 and enters the normals of
      * vertices on edges with an end within one sample: padded cells [s - 1, s + 2]. */
     int32_t blo[3], bhi[3];
     for (int a = 0; a < 3; a++) {
         int64_t l = (int64_t)lo[a] - 1, h = (int64_t)hi[a] + 2; /* padded cells [l, h) */
-        if (l < 0)
-            l = 0;
-        if (h > (int64_t)b->dims[a] + 1)
-            h = (int64_t)b->dims[a] + 1;
+        if (l < b->lo[a])
+            l = b->lo[a];
+        if (h > (int64_t)b->hi[a] + 1)
+            h = (int64_t)b->hi[a] + 1;
         if (l >= h)
             return;
-        blo[a] = (int32_t)(l / MC_BLOCK_CELLS);
-        bhi[a] = (int32_t)((h - 1) / MC_BLOCK_CELLS) + 1;
+        blo[a] = mcb_block_of(l);
+        bhi[a] = mcb_block_of(h - 1) + 1;
     }
     for (int32_t z = blo[2]; z < bhi[2]; z++)
         for (int32_t y = blo[1]; y < bhi[1]; y++)
-            for (int32_t x = blo[0]; x < bhi[0]; x++)
-                b->dirty[(size_t)x + (size_t)b->nblk[0] * ((size_t)y + (size_t)b->nblk[1] * (size_t)z)] = 1;
+            for (int32_t x = blo[0]; x < bhi[0]; x++) {
+                const int32_t k[3] = {x, y, z};
+                mc_block_t *e = mcb_insert(b, k);
+                if (e == NULL) {
+                    mc_blocks_mark_all(b); /* no room for the slot: mesh everything instead */
+                    return;
+                }
+                e->dirty = 1;
+            }
 }
 
 /* Grows a block's arrays to hold one more vertex / triangle. */
@@ -182,7 +362,7 @@ static size_t mcb_l(const mcb_job_t *j, int32_t px, int32_t py, int32_t pz)
 static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
 {
     mc_blocks_t *b = j->b;
-    const int32_t *d = b->dims;
+    const int32_t *d = b->dims, *blo = b->lo, *bhi = b->hi; /* d: the dense array's (= box) */
     memset(b->val, 0, sizeof(float) * MCB_L * MCB_L * MCB_L);
     memset(b->ins, 0, MCB_L * MCB_L * MCB_L);
     const bool colour = j->rgb != NULL || j->read_rgb != NULL;
@@ -191,15 +371,15 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
     /* original sample o = padded - 1; scratch index l = padded - c0 + 1 */
     const int32_t o0[3] = {j->c0[0] - 2, j->c0[1] - 2, j->c0[2] - 2};
     const int32_t n_l[3] = {j->nc[0] + 3, j->nc[1] + 3, j->nc[2] + 3};
-    int32_t xlo = o0[0] < 0 ? 0 : o0[0];
-    int32_t xhi = o0[0] + n_l[0] > d[0] ? d[0] : o0[0] + n_l[0];
+    int32_t xlo = o0[0] < blo[0] ? blo[0] : o0[0];
+    int32_t xhi = o0[0] + n_l[0] > bhi[0] ? bhi[0] : o0[0] + n_l[0];
     unsigned seen_in = 0, seen_out = 0;
     /* Through a reader: the box of the field the scratch covers, read once, then rows of it. */
     int32_t rlo[3] = {xlo, 0, 0}, rn[3] = {xhi - xlo, 0, 0};
     if (j->read != NULL) {
         for (int a = 1; a < 3; a++) {
-            const int32_t l = o0[a] < 0 ? 0 : o0[a];
-            const int32_t h = o0[a] + n_l[a] > d[a] ? d[a] : o0[a] + n_l[a];
+            const int32_t l = o0[a] < blo[a] ? blo[a] : o0[a];
+            const int32_t h = o0[a] + n_l[a] > bhi[a] ? bhi[a] : o0[a] + n_l[a];
             rlo[a] = l;
             rn[a] = h - l;
         }
@@ -213,13 +393,15 @@ static bool mcb_load(mcb_job_t *j, const float *density, bool *mixed)
     }
     for (int32_t lz = 0; lz < n_l[2]; lz++) {
         const int32_t oz = o0[2] + lz;
-        if (oz < 0 || oz >= d[2])
+        if (oz < blo[2] || oz >= bhi[2])
             continue;
         for (int32_t ly = 0; ly < n_l[1]; ly++) {
             const int32_t oy = o0[1] + ly;
-            if (oy < 0 || oy >= d[1] || xlo >= xhi)
+            if (oy < blo[1] || oy >= bhi[1] || xlo >= xhi)
                 continue;
-            const size_t src = (size_t)d[0] * ((size_t)oy + (size_t)d[1] * (size_t)oz);
+            /* the dense array's row (only read when the box is [0, dims)) */
+            const size_t src =
+                j->read != NULL ? 0 : (size_t)d[0] * ((size_t)oy + (size_t)d[1] * (size_t)oz);
             const size_t dst = MCB_L * ((size_t)ly + MCB_L * (size_t)lz);
             const float *row =
                 j->read != NULL
@@ -294,8 +476,12 @@ static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint
         const uint8_t *c = b->col + 3 * (d0 > b->iso ? i0 : i1); /* the inside end's paint */
         memcpy(k->rgb + 3 * (size_t)v, c, 3);
     }
-    const uint64_t P0 = (uint64_t)b->dims[0] + 2, P1 = (uint64_t)b->dims[1] + 2;
-    k->key[v] = ((((uint64_t)p[2] * P1 + (uint64_t)p[1]) * P0 + (uint64_t)p[0]) * 3) + (uint64_t)a;
+    /* The box spans under 2^20 samples per axis, so the low 20 bits of each index tell edges
+     * apart; the top bits stay below UINT64_MAX, the assembly's empty mark. */
+    const uint64_t m = ((uint64_t)1 << MCB_KEY_BITS) - 1;
+    k->key[v] = ((uint64_t)(uint32_t)p[2] & m) << (2 * MCB_KEY_BITS + 2) |
+                ((uint64_t)(uint32_t)p[1] & m) << (MCB_KEY_BITS + 2) |
+                ((uint64_t)(uint32_t)p[0] & m) << 2 | (uint64_t)a;
     *id = v;
     return ARGIL_OK;
 }
@@ -379,56 +565,133 @@ argil_err_t mc_blocks_update_read_rgb(mc_blocks_t *b, mc_read_fn read, mc_read_r
     return mcb_update(b, NULL, NULL, read, read_rgb, ctx);
 }
 
+/* Meshes block k (in its slot, or in the spare then moved into a new slot when it has
+ * triangles); a block left without triangles gives its slot up. */
+static argil_err_t mcb_mesh_block(mc_blocks_t *b, const int32_t key[3], const float *density,
+                                  const uint8_t *rgb, mc_read_fn read, mc_read_rgb_fn read_rgb,
+                                  const void *ctx)
+{
+    mc_block_t *e = mcb_find(b, key);
+    mcb_job_t j = {b, e != NULL ? &e->mesh : &b->spare, {0}, {0}, rgb, read, read_rgb, ctx};
+    for (int a = 0; a < 3; a++) {
+        /* the block's padded cells clipped to the box's [lo, hi + 1) */
+        const int64_t c0 = (int64_t)key[a] * MC_BLOCK_CELLS, end = c0 + MC_BLOCK_CELLS;
+        const int64_t l = c0 < b->lo[a] ? b->lo[a] : c0;
+        const int64_t h = end > (int64_t)b->hi[a] + 1 ? (int64_t)b->hi[a] + 1 : end;
+        j.c0[a] = (int32_t)l;
+        j.nc[a] = (int32_t)(h - l);
+    }
+    mc_block_mesh_t *k = j.k;
+    k->n_vert = 0;
+    k->n_tri = 0;
+    const bool colour = rgb != NULL || read_rgb != NULL;
+    if (!colour) {
+        free(k->rgb);
+        k->rgb = NULL;
+    } else if (k->rgb == NULL && k->cap_vert > 0) {
+        k->rgb = malloc((size_t)k->cap_vert * 3);
+        if (k->rgb == NULL)
+            return ARGIL_ERR_NOMEM;
+    }
+    bool mixed = false, skip = false;
+    if (read != NULL && b->outside != NULL) {
+        /* the block's corners: samples [c0 - 1, c0 + nc) within the box */
+        int32_t slo[3], sn[3];
+        for (int a = 0; a < 3; a++) {
+            const int32_t l = j.c0[a] - 1 < b->lo[a] ? b->lo[a] : j.c0[a] - 1;
+            const int32_t h = j.c0[a] + j.nc[a] > b->hi[a] ? b->hi[a] : j.c0[a] + j.nc[a];
+            slo[a] = l;
+            sn[a] = h > l ? h - l : 0;
+        }
+        skip = sn[0] == 0 || sn[1] == 0 || sn[2] == 0 || b->outside(ctx, slo, sn, b->iso);
+    }
+    if (!skip && j.nc[0] > 0 && j.nc[1] > 0 && j.nc[2] > 0) {
+        b->blocks_read++;
+        if (!mcb_load(&j, density, &mixed))
+            return ARGIL_ERR_NONFINITE;
+        if (mixed) {
+            const argil_err_t err = mcb_cells(&j);
+            if (err != ARGIL_OK) {
+                k->n_vert = 0;
+                k->n_tri = 0;
+                return err;
+            }
+            b->cells_meshed += (uint64_t)j.nc[0] * (uint64_t)j.nc[1] * (uint64_t)j.nc[2];
+        }
+    }
+    b->blocks_meshed++;
+    if (k->n_tri == 0) {
+        if (e != NULL)
+            mcb_remove(b, e);
+        return ARGIL_OK;
+    }
+    if (e == NULL) {
+        e = mcb_insert(b, key);
+        if (e == NULL) {
+            b->spare.n_vert = 0;
+            b->spare.n_tri = 0;
+            return ARGIL_ERR_NOMEM;
+        }
+        e->mesh = b->spare;
+        memset(&b->spare, 0, sizeof(b->spare));
+    }
+    e->dirty = 0;
+    return ARGIL_OK;
+}
+
 static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_t *rgb,
                               mc_read_fn read, mc_read_rgb_fn read_rgb, const void *ctx)
 {
-    if (b == NULL || b->blocks == NULL)
+    if (b == NULL || b->slots == NULL)
         return ARGIL_ERR_ARG;
+    if (density != NULL)
+        for (int a = 0; a < 3; a++)
+            if (b->lo[a] != 0 || b->hi[a] != b->dims[a])
+                return ARGIL_ERR_ARG; /* grown past the array */
     const bool colour = rgb != NULL || read_rgb != NULL;
     if (colour != (b->has_rgb != 0)) {
         mc_blocks_mark_all(b);
         b->has_rgb = colour;
     }
     b->blocks_meshed = 0;
+    b->blocks_read = 0;
     b->cells_meshed = 0;
-    size_t bi = 0;
-    for (int32_t bz = 0; bz < b->nblk[2]; bz++)
-        for (int32_t by = 0; by < b->nblk[1]; by++)
-            for (int32_t bx = 0; bx < b->nblk[0]; bx++, bi++) {
-                if (!b->dirty[bi])
-                    continue;
-                mcb_job_t j = {b, &b->blocks[bi], {0}, {0}, rgb, read, read_rgb, ctx};
-                const int32_t bc[3] = {bx, by, bz};
-                for (int a = 0; a < 3; a++) {
-                    j.c0[a] = bc[a] * MC_BLOCK_CELLS;
-                    const int32_t end = b->dims[a] + 1;
-                    j.nc[a] = end - j.c0[a] < MC_BLOCK_CELLS ? end - j.c0[a] : MC_BLOCK_CELLS;
+    if (b->all_dirty) {
+        int32_t klo[3], khi[3];
+        mcb_box_keys(b, klo, khi);
+        for (int32_t z = klo[2]; z < khi[2]; z++)
+            for (int32_t y = klo[1]; y < khi[1]; y++)
+                for (int32_t x = klo[0]; x < khi[0]; x++) {
+                    const int32_t key[3] = {x, y, z};
+                    const argil_err_t e = mcb_mesh_block(b, key, density, rgb, read, read_rgb, ctx);
+                    if (e != ARGIL_OK)
+                        return e; /* still all dirty */
                 }
-                j.k->n_vert = 0;
-                j.k->n_tri = 0;
-                if (!colour) {
-                    free(j.k->rgb);
-                    j.k->rgb = NULL;
-                } else if (j.k->rgb == NULL && j.k->cap_vert > 0) {
-                    j.k->rgb = malloc((size_t)j.k->cap_vert * 3);
-                    if (j.k->rgb == NULL)
-                        return ARGIL_ERR_NOMEM;
-                }
-                bool mixed = false;
-                if (!mcb_load(&j, density, &mixed))
-                    return ARGIL_ERR_NONFINITE;
-                if (mixed) {
-                    argil_err_t e = mcb_cells(&j);
-                    if (e != ARGIL_OK) {
-                        j.k->n_vert = 0;
-                        j.k->n_tri = 0;
-                        return e;
-                    }
-                    b->cells_meshed += (uint64_t)j.nc[0] * (uint64_t)j.nc[1] * (uint64_t)j.nc[2];
-                }
-                b->blocks_meshed++;
-                b->dirty[bi] = 0;
-            }
+        b->all_dirty = false;
+        for (size_t i = 0; i < b->cap; i++)
+            b->slots[i].dirty = 0; /* every slot lies in the box and was meshed */
+        return ARGIL_OK;
+    }
+    /* The dirty keys first: meshing moves slots (a block may give its slot up). */
+    size_t n = 0;
+    for (size_t i = 0; i < b->cap; i++)
+        n += b->slots[i].used && b->slots[i].dirty;
+    if (n > b->keys_cap) {
+        int32_t *k = realloc(b->keys, n * 3 * sizeof(int32_t));
+        if (k == NULL)
+            return ARGIL_ERR_NOMEM;
+        b->keys = k;
+        b->keys_cap = n;
+    }
+    n = 0;
+    for (size_t i = 0; i < b->cap; i++)
+        if (b->slots[i].used && b->slots[i].dirty)
+            memcpy(b->keys + 3 * n++, b->slots[i].key, 3 * sizeof(int32_t));
+    for (size_t i = 0; i < n; i++) {
+        const argil_err_t e = mcb_mesh_block(b, b->keys + 3 * i, density, rgb, read, read_rgb, ctx);
+        if (e != ARGIL_OK)
+            return e;
+    }
     return ARGIL_OK;
 }
 
@@ -438,17 +701,31 @@ static size_t mcb_hash(uint64_t key, int bits)
     return (size_t)((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
 }
 
+/* Orders slots by block key: z, then y, then x. */
+static int mcb_cmp_key(const void *pa, const void *pb)
+{
+    const mc_block_t *a = *(const mc_block_t *const *)pa, *b = *(const mc_block_t *const *)pb;
+    for (int ax = 2; ax >= 0; ax--)
+        if (a->key[ax] != b->key[ax])
+            return a->key[ax] < b->key[ax] ? -1 : 1;
+    return 0;
+}
+
 argil_err_t mc_blocks_assemble(const mc_blocks_t *b, mesh_t *out)
 {
-    if (b == NULL || out == NULL || b->blocks == NULL)
+    if (b == NULL || out == NULL || b->slots == NULL)
         return ARGIL_ERR_ARG;
     mesh_clear(out);
-    size_t total_v = 0, total_t = 0, max_v = 0;
-    for (size_t i = 0; i < b->n_blocks; i++) {
-        total_v += b->blocks[i].n_vert;
-        total_t += b->blocks[i].n_tri;
-        if (b->blocks[i].n_vert > max_v)
-            max_v = b->blocks[i].n_vert;
+    size_t total_v = 0, total_t = 0, max_v = 0, n_blk = 0;
+    for (size_t i = 0; i < b->cap; i++) {
+        const mc_block_mesh_t *k = &b->slots[i].mesh;
+        if (!b->slots[i].used || k->n_tri == 0)
+            continue;
+        n_blk++;
+        total_v += k->n_vert;
+        total_t += k->n_tri;
+        if (k->n_vert > max_v)
+            max_v = k->n_vert;
     }
     if (b->has_rgb && !out->has_rgb && mesh_enable_rgb(out) != ARGIL_OK)
         return ARGIL_ERR_NOMEM;
@@ -464,15 +741,21 @@ argil_err_t mc_blocks_assemble(const mc_blocks_t *b, mesh_t *out)
     uint64_t *keys = malloc(slots * sizeof(uint64_t));
     uint32_t *vals = malloc(slots * sizeof(uint32_t));
     uint32_t *remap = malloc((max_v + 1) * sizeof(uint32_t));
+    const mc_block_t **order = malloc((n_blk + 1) * sizeof(*order));
     argil_err_t e = ARGIL_ERR_NOMEM;
-    if (keys == NULL || vals == NULL || remap == NULL)
+    if (keys == NULL || vals == NULL || remap == NULL || order == NULL)
         goto done;
+    n_blk = 0;
+    for (size_t i = 0; i < b->cap; i++)
+        if (b->slots[i].used && b->slots[i].mesh.n_tri > 0)
+            order[n_blk++] = &b->slots[i];
+    qsort(order, n_blk, sizeof(*order), mcb_cmp_key);
     memset(keys, 0xff, slots * sizeof(uint64_t)); /* UINT64_MAX = empty; no edge id reaches it */
     e = mesh_reserve(out, total_v, total_t);
     if (e != ARGIL_OK)
         goto done;
-    for (size_t bi = 0; bi < b->n_blocks; bi++) {
-        const mc_block_mesh_t *k = &b->blocks[bi];
+    for (size_t bi = 0; bi < n_blk; bi++) {
+        const mc_block_mesh_t *k = &order[bi]->mesh;
         for (uint32_t v = 0; v < k->n_vert; v++) {
             size_t h = mcb_hash(k->key[v], bits);
             while (keys[h] != UINT64_MAX && keys[h] != k->key[v])
@@ -497,6 +780,7 @@ done:
     free(keys);
     free(vals);
     free(remap);
+    free(order);
     if (e != ARGIL_OK)
         mesh_clear(out);
     return e;

@@ -1148,3 +1148,80 @@ bool grid_add_force(grid_t *g, int32_t x, int32_t y, int32_t z, float force)
         return false;
     return grid_set(g, GRID_FORCE, x, y, z, sum) == ARGIL_OK;
 }
+
+/* ---- Block access, for copies of the grid kept per block (the autosave journal's) ---- */
+
+static void block_view_fill(const grid_block_t *b, const int32_t k[3], grid_block_view_t *v)
+{
+    memcpy(v->key, k, sizeof(v->key));
+    v->density = b != NULL && b->data != NULL ? b->data + GRID_DENSITY * GRID_BN : NULL;
+    v->uniform = uniform_of(b, GRID_DENSITY);
+    v->mat = b != NULL ? b->mat : NULL;
+    v->rgb = b != NULL ? b->rgb : NULL;
+}
+
+int32_t grid_block_index(int32_t i)
+{
+    return block_of(i);
+}
+
+bool grid_block_view(const grid_t *g, const int32_t k[3], grid_block_view_t *v)
+{
+    const grid_block_t *b = block_find(g, k);
+    block_view_fill(b, k, v);
+    return b != NULL;
+}
+
+bool grid_block_next(const grid_t *g, size_t *slot, grid_block_view_t *v)
+{
+    for (; g->slots != NULL && *slot < g->cap; (*slot)++) {
+        const grid_block_t *b = &g->slots[*slot];
+        if (!b->used)
+            continue;
+        block_view_fill(b, b->key, v);
+        (*slot)++;
+        return true;
+    }
+    return false;
+}
+
+/* ---- Queries for the live mesher (host/mesh/grid_mesh.c) ---- */
+
+bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_t hi[3], float v)
+{
+    if (!(v >= 0.0f))
+        return false; /* blocks not held read 0 */
+    int32_t klo[3], khi[3];
+    for (int a = 0; a < 3; a++) {
+        if (lo[a] >= hi[a])
+            return true;
+        klo[a] = block_of(lo[a]);
+        khi[a] = block_of(hi[a] - 1);
+    }
+    int32_t k[3];
+    for (k[2] = klo[2]; k[2] <= khi[2]; k[2]++)
+        for (k[1] = klo[1]; k[1] <= khi[1]; k[1]++)
+            for (k[0] = klo[0]; k[0] <= khi[0]; k[0]++) {
+                const grid_block_t *b = block_find(g, k);
+                if (b == NULL)
+                    continue;
+                if (b->data == NULL) {
+                    if (!(b->uniform <= v))
+                        return false;
+                    continue;
+                }
+                int32_t a0[3], a1[3]; /* the box's part of this block, block-local */
+                for (int a = 0; a < 3; a++) {
+                    const int32_t base = k[a] * GRID_B;
+                    a0[a] = lo[a] > base ? lo[a] - base : 0;
+                    a1[a] = hi[a] < base + GRID_B ? hi[a] - base : GRID_B;
+                }
+                const float *d = b->data + GRID_DENSITY * GRID_BN;
+                for (int32_t z = a0[2]; z < a1[2]; z++)
+                    for (int32_t y = a0[1]; y < a1[1]; y++)
+                        for (int32_t x = a0[0]; x < a1[0]; x++)
+                            if (!(d[x + GRID_B * (y + GRID_B * z)] <= v))
+                                return false;
+            }
+    return true;
+}

@@ -224,4 +224,33 @@ void grid_extract(const grid_t *g, const int32_t corner[3], const int32_t win_di
 /* Adds force to sample (x,y,z); false (no effect) outside the grid or for a non-finite force. */
 bool grid_add_force(grid_t *g, int32_t x, int32_t y, int32_t z, float force);
 
+/* ---- Block access, for copies of the grid kept per block (the autosave journal's) ---- */
+
+/* What one block holds, read-only; valid until the grid next changes. */
+typedef struct {
+    int32_t key[3];             /* block index: sample index / GRID_B, rounded down */
+    const float *density;       /* GRID_BN densities (x fastest); NULL: every one is uniform */
+    float uniform;
+    const float *mat;           /* GRID_MAT_N * GRID_BN painted values, channel-major; NULL:
+                                 * every channel the default */
+    const uint8_t *rgb;         /* 3 * GRID_BN bytes; NULL: GRID_RGB_DEFAULT */
+} grid_block_view_t;
+
+/* The index of the block holding sample index i (i / GRID_B rounded down). */
+int32_t grid_block_index(int32_t i);
+
+/* Block k into v; false when the grid holds no block there (v then reads as empty clay:
+ * density 0, no arrays). */
+bool grid_block_view(const grid_t *g, const int32_t k[3], grid_block_view_t *v);
+
+/* The next block held at hash slot *slot or after it into v, *slot moved past it; false when
+ * none is left. Start with *slot = 0; the order is the hash's. */
+bool grid_block_next(const grid_t *g, size_t *slot, grid_block_view_t *v);
+
+/* ---- Queries for the live mesher (host/mesh/grid_mesh.c) ---- */
+
+/* True when every density sample of the box [lo, hi) is <= v (NaN is not), decided from the
+ * blocks (a block not held reads 0, a uniform block its value): the mesher skips such blocks. */
+bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_t hi[3], float v);
+
 #endif

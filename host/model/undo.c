@@ -106,8 +106,11 @@ static size_t undo_head(const undo_t *u)
     return undo_wrap(u, s->off + s->len);
 }
 
+/* Drops the oldest k steps and the steps joined to the last of them (whole units). */
 static void undo_drop_oldest(undo_t *u, size_t k)
 {
+    while (k > 0 && k < u->nsteps && u->steps[k].joined)
+        k++;
     for (size_t i = 0; i < k; i++)
         u->bytes -= u->steps[i].len;
     memmove(u->steps, u->steps + k, (u->nsteps - k) * sizeof(undo_step_t));
@@ -160,6 +163,7 @@ static argil_err_t undo_reserve(undo_t *u, size_t k)
     while (drop < u->nsteps && held + u->cur.len + k > u->ring_cap)
         held -= u->steps[drop++].len;
     undo_drop_oldest(u, drop);
+    held = u->bytes;
     return held + u->cur.len + k <= u->ring_cap ? ARGIL_OK : undo_grow(u, u->cur.len + k);
 }
 
@@ -329,6 +333,11 @@ static argil_err_t undo_diff(undo_t *u, const sparse_t *s, int store, int ch, co
 
 argil_err_t undo_commit(undo_t *u, const field_t *f)
 {
+    return undo_commit_joined(u, f, false);
+}
+
+argil_err_t undo_commit_joined(undo_t *u, const field_t *f, bool joined)
+{
     if (!u->open)
         return ARGIL_ERR_STATE;
     const size_t nc = (size_t)u->cdims[0] * u->cdims[1] * u->cdims[2];
@@ -349,6 +358,8 @@ argil_err_t undo_commit(undo_t *u, const field_t *f)
     u->open = false;
     if (err != ARGIL_OK || u->cur.n == 0)
         return err;
+    if (joined && u->done == 0)
+        return ARGIL_OK; /* nothing to join: the changes stay, with nothing to take them back */
     undo_drop_redo(u); /* a new edit clears the redo steps */
     if (u->nsteps == u->cap) {
         const size_t ncap = u->cap ? 2 * u->cap : 64;
@@ -358,12 +369,22 @@ argil_err_t undo_commit(undo_t *u, const field_t *f)
         u->steps = p;
         u->cap = ncap;
     }
+    u->cur.joined = joined;
     u->steps[u->nsteps++] = u->cur;
     u->done = u->nsteps;
     u->bytes += u->cur.len;
-    size_t drop = 0, held = u->bytes; /* oldest first, but always keep the newest step */
-    while (held > u->budget_bytes && drop + 1 < u->nsteps)
-        held -= u->steps[drop++].len;
+    /* Oldest units first (a step with the steps joined to it), but always keep the newest
+     * unit. */
+    size_t drop = 0, held = u->bytes;
+    while (held > u->budget_bytes) {
+        size_t end = drop + 1, b = u->steps[drop].len;
+        while (end < u->nsteps && u->steps[end].joined)
+            b += u->steps[end++].len;
+        if (end >= u->nsteps)
+            break;
+        held -= b;
+        drop = end;
+    }
     undo_drop_oldest(u, drop);
     return ARGIL_OK;
 }
@@ -395,18 +416,44 @@ static argil_err_t undo_apply(const undo_t *u, field_t *f, const undo_step_t *s,
     return ARGIL_OK;
 }
 
+size_t undo_units(const undo_t *u, size_t n)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n && i < u->nsteps; i++)
+        k += !u->steps[i].joined;
+    return k;
+}
+
+/* The unit holding step i: [*first, *end). */
+static void undo_unit_of(const undo_t *u, size_t i, size_t *first, size_t *end)
+{
+    size_t a = i, b = i + 1;
+    while (a > 0 && u->steps[a].joined)
+        a--;
+    while (b < u->nsteps && u->steps[b].joined)
+        b++;
+    *first = a;
+    *end = b;
+}
+
 argil_err_t undo_undo(undo_t *u, field_t *f)
 {
     if (u->open)
         return ARGIL_ERR_STATE;
     if (u->done == 0)
         return ARGIL_ERR_EMPTY;
-    if (u->steps[u->done - 1].lattice_gen != f->lattice_gen)
-        return ARGIL_ERR_STATE;
-    argil_err_t e = undo_apply(u, f, &u->steps[u->done - 1], false);
-    if (e == ARGIL_OK)
+    size_t a, b;
+    undo_unit_of(u, u->done - 1, &a, &b);
+    for (size_t i = a; i < u->done; i++)
+        if (u->steps[i].lattice_gen != f->lattice_gen)
+            return ARGIL_ERR_STATE;
+    while (u->done > a) {
+        const argil_err_t e = undo_apply(u, f, &u->steps[u->done - 1], false);
+        if (e != ARGIL_OK)
+            return e;
         u->done--;
-    return e;
+    }
+    return ARGIL_OK;
 }
 
 argil_err_t undo_redo(undo_t *u, field_t *f)
@@ -415,12 +462,18 @@ argil_err_t undo_redo(undo_t *u, field_t *f)
         return ARGIL_ERR_STATE;
     if (u->done == u->nsteps)
         return ARGIL_ERR_EMPTY;
-    if (u->steps[u->done].lattice_gen != f->lattice_gen)
-        return ARGIL_ERR_STATE;
-    argil_err_t e = undo_apply(u, f, &u->steps[u->done], true);
-    if (e == ARGIL_OK)
+    size_t a, b;
+    undo_unit_of(u, u->done, &a, &b);
+    for (size_t i = u->done; i < b; i++)
+        if (u->steps[i].lattice_gen != f->lattice_gen)
+            return ARGIL_ERR_STATE;
+    while (u->done < b) {
+        const argil_err_t e = undo_apply(u, f, &u->steps[u->done], true);
+        if (e != ARGIL_OK)
+            return e;
         u->done++;
-    return e;
+    }
+    return ARGIL_OK;
 }
 
 void undo_clear_redo(undo_t *u)

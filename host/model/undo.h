@@ -29,6 +29,8 @@ typedef struct {
     size_t off, len;
     size_t n;                 /* changes held */
     uint32_t lattice_gen;     /* the field's lattice_gen when the step was recorded */
+    bool joined;              /* undone and redone together with the step before it (one unit:
+                               * what followed a stroke without being one, e.g. a press in the air) */
 } undo_step_t;
 
 typedef struct {
@@ -82,8 +84,17 @@ argil_err_t undo_note_drest(undo_t *u, const int32_t ijk[3], float d_before, flo
  * alone is larger than the budget. Oldest steps may already be dropped while the open step
  * grows. ARGIL_ERR_STATE without undo_begin, ARGIL_ERR_NOMEM. */
 argil_err_t undo_commit(undo_t *u, const field_t *f);
+/* The same; joined: the step becomes part of the unit of the newest done step (undo_undo and
+ * undo_redo take them together; the redo steps are dropped as for any step); with no step done
+ * it is not recorded (the field keeps the changes, with nothing to take them back). */
+argil_err_t undo_commit_joined(undo_t *u, const field_t *f, bool joined);
 
-/* Reverts / re-applies one step; ARGIL_ERR_EMPTY when there is none; ARGIL_ERR_STATE (nothing
+/* Units (a step and the joined steps after it) among steps[0, n): what undo_undo can take back
+ * with n = done, what undo_redo can bring back with the difference of nsteps and done. */
+size_t undo_units(const undo_t *u, size_t n);
+
+/* Reverts / re-applies one unit (a step and the steps joined to it, newest first when
+ * reverting); ARGIL_ERR_EMPTY when there is none; ARGIL_ERR_STATE (nothing
  * changed) when the step was recorded before a knot insertion (field_refine), whose indices now
  * name other coefficients: the history cannot be crossed back over a refinement. Changed blocks
  * become dirty. */

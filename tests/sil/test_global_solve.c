@@ -100,11 +100,8 @@ typedef struct {
 
 static void measure(const char *dir, shape_t *sh)
 {
-    char path[256], err[512];
-    snprintf(path, sizeof(path), "%s/final.ply", dir);
     mesh_t m;
-    mesh_init(&m);
-    assert_int_equal(ply_read_mesh(path, &m, err, sizeof(err)), ARGIL_OK);
+    sil_read_final(dir, &m);
     sh->dent_mm = extent_along(&m, 2, 0, 0, -1);
     sh->bump_mm = extent_along(&m, 0, 0, 0, -1);
     sh->groove_mm = extent_along(&m, 1, -8.0, 8.0, 2);
@@ -174,27 +171,20 @@ static void paint_hook(void *ctx, session_frame_t *f)
 static void test_paint_in_a_session(void **st)
 {
     (void)st;
-    char dir[64] = "/tmp/argil-gpaint-XXXXXX", path[128];
-    assert_non_null(mkdtemp(dir));
-    snprintf(path, sizeof(path), "%s/paint.scn", dir);
-    FILE *fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs("set radius_mm 4\ntool touch\nmove 0 0 36 0.5\nmove 0 0 31 0.4\n"
-          "paint stiffness 4 radius 6\nwait 0.2\nmove 0 0 45 0.3\n", fp);
-    fclose(fp);
+    char dir[64], path[128];
+    const char *const parts[] = {"set radius_mm 4\ntool touch\nmove 0 0 36 0.5\nmove 0 0 31 0.4\n"
+                                 "paint stiffness 4 radius 6\nwait 0.2\nmove 0 0 45 0.3\n",
+                                 NULL};
+    assert_int_equal(sil_script_dir(dir, "argil-gpaint", "paint.scn", parts, path), 0);
     session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = path;
-    o.out_dir = NULL;
-    o.deadline_faults = false;
+    sil_opts(&o, path, NULL);
     paint_seen_t ps = {0.0f, 0.0f, 0.0f};
     const session_hook_t hook = {paint_hook, &ps, false};
     o.hook = &hook;
     session_summary_t sum;
     char err[1024] = "";
     assert_int_equal(o.global_solve, PEER_SOLVE_BSPLINE); /* argil sculpt's default */
-    if (session_run(&o, &sum, err, sizeof(err)) != ARGIL_OK)
-        fail_msg("paint session: %s", err);
+    sil_run(&o, &sum, "paint session");
     printf("# painted stiffness under the tip %.2f (mass %.2f), far side %.2f\n",
            (double)ps.max_at_tip, (double)ps.mass_at_tip, (double)ps.far);
     /* 4 at the tip; read at the nearest sample, at most 1.08 mm (half a cell's diagonal) away:
@@ -209,8 +199,7 @@ static void test_paint_in_a_session(void **st)
     assert_int_equal(session_run(&o, &sum, err, sizeof(err)), ARGIL_ERR_ARG);
     printf("# springs: %s\n", err);
     assert_non_null(strstr(err, "line 5: 'paint' needs the B-spline model"));
-    unlink(path);
-    rmdir(dir);
+    (void)sil_remove_dir(dir);
 }
 
 int main(void)

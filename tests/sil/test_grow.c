@@ -20,6 +20,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/ply.h"
 #include "host/mesh/grid_mesh.h"
+#include "tests/sil/sil_runs.h"
 
 #define OLD_EDGE_MM 54.375 /* (88 - 1) / 2 samples of 1.25 mm from the centre */
 
@@ -29,17 +30,6 @@ static const char *const STROKE =
     "move 80 0 0 0.3\n";
 
 static char g_dir[64];
-
-static void remove_run(void)
-{
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil", "s.scn"};
-    char p[256];
-    for (int i = 0; i < 5; i++) {
-        snprintf(p, sizeof(p), "%s/%s", g_dir, names[i]);
-        unlink(p);
-    }
-    rmdir(g_dir);
-}
 
 /* The largest vertex x of m, mm. */
 static double max_x_mm(const mesh_t *m)
@@ -53,27 +43,15 @@ static double max_x_mm(const mesh_t *m)
 static void test_add_past_the_old_edge(void **st)
 {
     (void)st;
-    strcpy(g_dir, "/tmp/argil-grow-XXXXXX");
-    assert_non_null(mkdtemp(g_dir));
+    const char *const parts[] = {STROKE, NULL};
     char path[128];
-    snprintf(path, sizeof(path), "%s/s.scn", g_dir);
-    FILE *fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs(STROKE, fp);
-    assert_int_equal(fclose(fp), 0);
+    assert_int_equal(sil_script_dir(g_dir, "argil-grow", "s.scn", parts, path), 0);
     session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = path;
-    o.out_dir = g_dir;
-    o.deadline_faults = false;
+    sil_opts(&o, path, g_dir);
     session_summary_t sum;
     char err[1024] = "";
-    if (session_run(&o, &sum, err, sizeof(err)) != ARGIL_OK)
-        fail_msg("session failed: %s", err);
-    assert_int_equal(sum.solve_errors, 0);
-    assert_int_equal(sum.final_state, SAFETY_ACTIVE);
-    assert_true(sum.watertight);
-    assert_int_equal(sum.journal_stray_records, 0);
+    sil_run(&o, &sum, "session failed");
+    sil_assert_clean(&sum);
     assert_true(sum.journal_checkpoints >= 1); /* rebased onto a box holding the grown clay */
 
     /* The grid grew along +x only. */
@@ -92,9 +70,7 @@ static void test_add_past_the_old_edge(void **st)
 
     /* The mesh follows the clay past the old edge. */
     mesh_t m;
-    mesh_init(&m);
-    snprintf(path, sizeof(path), "%s/final.ply", g_dir);
-    assert_int_equal(ply_read_mesh(path, &m, err, sizeof(err)), ARGIL_OK);
+    sil_read_final(g_dir, &m);
     const double x_mm = max_x_mm(&m);
     printf("# final.ply reaches x = %.2f mm (the old grid's edge: %.2f mm)\n", x_mm, OLD_EDGE_MM);
     assert_true(x_mm > OLD_EDGE_MM + 15.0); /* measured 75.5 */
@@ -113,7 +89,7 @@ static void test_add_past_the_old_edge(void **st)
     mesh_free(&fm);
     argil_doc_free(&d);
     mesh_free(&m);
-    remove_run();
+    (void)sil_remove_dir(g_dir);
 }
 
 int main(void)

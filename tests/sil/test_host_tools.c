@@ -19,6 +19,7 @@
 #include "firmware/core/safety.h"
 #include "host/app/session.h"
 #include "host/io/ply.h"
+#include "tests/sil/sil_runs.h"
 
 #define CLAY_R_MM 30.0
 
@@ -48,58 +49,20 @@ static run_t plain, explicit_default, mirrored, ridge, smoothed;
 
 static void run_script(run_t *r, const char *a, const char *b, const char *c)
 {
-    strcpy(r->dir, "/tmp/argil-hosttool-XXXXXX");
-    assert_non_null(mkdtemp(r->dir));
+    const char *const parts[] = {a, b, c, NULL};
     char path[128];
-    snprintf(path, sizeof(path), "%s/s.scn", r->dir);
-    FILE *fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs(a, fp);
-    fputs(b, fp);
-    fputs(c, fp);
-    assert_int_equal(fclose(fp), 0);
+    assert_int_equal(sil_script_dir(r->dir, "argil-hosttool", "s.scn", parts, path), 0);
     session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = path;
-    o.out_dir = r->dir;
-    o.deadline_faults = false;
-    char err[1024] = "";
-    if (session_run(&o, &r->sum, err, sizeof(err)) != ARGIL_OK)
-        fail_msg("session failed: %s", err);
-    assert_int_equal(r->sum.solve_errors, 0);
-    assert_int_equal(r->sum.final_state, SAFETY_ACTIVE);
-    assert_true(r->sum.watertight);
-    assert_int_equal(r->sum.journal_stray_records, 0); /* every change inside the dirty box */
-    snprintf(path, sizeof(path), "%s/final.ply", r->dir);
-    mesh_init(&r->mesh);
-    assert_int_equal(ply_read_mesh(path, &r->mesh, err, sizeof(err)), ARGIL_OK);
+    sil_opts(&o, path, r->dir);
+    sil_run(&o, &r->sum, "session failed");
+    sil_assert_clean(&r->sum);
+    sil_read_final(r->dir, &r->mesh);
 }
 
 static void cleanup(run_t *r)
 {
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil", "s.scn"};
-    char p[256];
-    for (int i = 0; i < 5; i++) {
-        snprintf(p, sizeof(p), "%s/%s", r->dir, names[i]);
-        unlink(p);
-    }
-    rmdir(r->dir);
+    (void)sil_remove_dir(r->dir);
     mesh_free(&r->mesh);
-}
-
-/* The farthest vertex along sign·axis among those within 2 mm of that axis line, mm. */
-static double extent_mm(const mesh_t *m, int axis, int sign)
-{
-    double best = -1e9;
-    for (size_t i = 0; i < m->n_vert; i++) {
-        const float *p = &m->pos[3 * i];
-        const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-        if (sqrt((double)p[a1] * p[a1] + (double)p[a2] * p[a2]) * 1e3 > 2.0)
-            continue;
-        const double v = sign * (double)p[axis] * 1e3;
-        best = v > best ? v : best;
-    }
-    return best;
 }
 
 static double dvol_cm3(const run_t *r)
@@ -122,22 +85,20 @@ static int setup(void **st)
 static int teardown(void **st)
 {
     (void)st;
-    cleanup(&plain);
-    cleanup(&explicit_default);
-    cleanup(&mirrored);
-    cleanup(&ridge);
-    cleanup(&smoothed);
+    run_t *const all[] = {&plain, &explicit_default, &mirrored, &ridge, &smoothed};
+    for (size_t k = 0; k < sizeof(all) / sizeof(all[0]); k++)
+        cleanup(all[k]);
     return 0;
 }
 
 static void test_default_setting_carves_as_before(void **st)
 {
     (void)st;
-    const double x = extent_mm(&plain.mesh, 0, 1);
+    const double x = sil_extent_mm(&plain.mesh, 0, 1);
     printf("# carve (default): +x surface %.2f mm, -x %.2f mm, volume %+.3f cm3\n", x,
-           extent_mm(&plain.mesh, 0, -1), dvol_cm3(&plain));
+           sil_extent_mm(&plain.mesh, 0, -1), dvol_cm3(&plain));
     assert_true(x < CLAY_R_MM - 5.0 && x > CLAY_R_MM - 9.0); /* 3 mm in with a 4 mm ball */
-    assert_true(fabs(extent_mm(&plain.mesh, 0, -1) - CLAY_R_MM) < 0.2);
+    assert_true(fabs(sil_extent_mm(&plain.mesh, 0, -1) - CLAY_R_MM) < 0.2);
     /* spelling the default out changes nothing: the same mesh, vertex for vertex */
     assert_int_equal(explicit_default.mesh.n_vert, plain.mesh.n_vert);
     assert_memory_equal(explicit_default.mesh.pos, plain.mesh.pos,
@@ -148,22 +109,24 @@ static void test_default_setting_carves_as_before(void **st)
 static void test_mirror_x_carves_both_sides(void **st)
 {
     (void)st;
-    const double px = extent_mm(&mirrored.mesh, 0, 1), nx = extent_mm(&mirrored.mesh, 0, -1);
+    const double px = sil_extent_mm(&mirrored.mesh, 0, 1);
+    const double nx = sil_extent_mm(&mirrored.mesh, 0, -1);
     printf("# mirror x: +x surface %.3f mm, -x %.3f mm (unmirrored +x %.3f); volume %+.3f cm3 "
-           "(unmirrored %+.3f)\n", px, nx, extent_mm(&plain.mesh, 0, 1), dvol_cm3(&mirrored),
+           "(unmirrored %+.3f)\n", px, nx, sil_extent_mm(&plain.mesh, 0, 1), dvol_cm3(&mirrored),
            dvol_cm3(&plain));
     assert_true(nx < CLAY_R_MM - 5.0);
     assert_true(fabs(px - nx) < 0.1);
-    assert_true(fabs(px - extent_mm(&plain.mesh, 0, 1)) < 0.1);
+    assert_true(fabs(px - sil_extent_mm(&plain.mesh, 0, 1)) < 0.1);
     /* twice the material gone, within 10 % */
     assert_true(fabs(dvol_cm3(&mirrored) - 2.0 * dvol_cm3(&plain)) < 0.1 * fabs(dvol_cm3(&plain)));
-    assert_true(fabs(extent_mm(&mirrored.mesh, 1, 1) - CLAY_R_MM) < 0.2); /* the top untouched */
+    /* the top untouched */
+    assert_true(fabs(sil_extent_mm(&mirrored.mesh, 1, 1) - CLAY_R_MM) < 0.2);
 }
 
 static void test_add_grows_a_ridge(void **st)
 {
     (void)st;
-    const double top = extent_mm(&ridge.mesh, 1, 1), dv = dvol_cm3(&ridge);
+    const double top = sil_extent_mm(&ridge.mesh, 1, 1), dv = dvol_cm3(&ridge);
     printf("# add: ridge top %.2f mm (clay %.1f), volume %+.3f cm3 (%.2f %%)\n", top, CLAY_R_MM,
            dv, dv * 1e-6 / ridge.sum.volume_before_m3 * 100.0);
     /* a 2 mm ball centred ~1 mm above the surface: the top rises ~3 mm */
@@ -171,13 +134,14 @@ static void test_add_grows_a_ridge(void **st)
     /* the ridge's part above the sphere: ~10 mm² across x 20 mm long, plus its ends and the
      * neck the overlapping ramps fill: 0.2 … 0.6 cm³ */
     assert_true(dv > 0.15 && dv < 0.6);
-    assert_true(fabs(extent_mm(&ridge.mesh, 0, 1) - CLAY_R_MM) < 0.2); /* the side untouched */
+    assert_true(fabs(sil_extent_mm(&ridge.mesh, 0, 1) - CLAY_R_MM) < 0.2); /* the side untouched */
 }
 
 static void test_smooth_lowers_the_ridge(void **st)
 {
     (void)st;
-    const double before = extent_mm(&ridge.mesh, 1, 1), after = extent_mm(&smoothed.mesh, 1, 1);
+    const double before = sil_extent_mm(&ridge.mesh, 1, 1);
+    const double after = sil_extent_mm(&smoothed.mesh, 1, 1);
     printf("# smooth: ridge top %.2f -> %.2f mm (clay %.1f), volume %+.3f -> %+.3f cm3\n", before,
            after, CLAY_R_MM, dvol_cm3(&ridge), dvol_cm3(&smoothed));
     assert_true(after < before - 1.0);
@@ -187,24 +151,11 @@ static void test_smooth_lowers_the_ridge(void **st)
 static void test_springs_refuse_host_settings(void **st)
 {
     (void)st;
-    char dir[64] = "/tmp/argil-hostspr-XXXXXX", path[128];
-    assert_non_null(mkdtemp(dir));
-    snprintf(path, sizeof(path), "%s/s.scn", dir);
-    FILE *fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs("tool carve\nwait 0.1\nmirror y\n", fp);
-    assert_int_equal(fclose(fp), 0);
-    session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = path;
-    o.global_solve = PEER_SOLVE_SPRINGS;
     session_summary_t sum;
-    char err[1024] = "";
-    assert_int_equal(session_run(&o, &sum, err, sizeof(err)), ARGIL_ERR_ARG);
-    printf("# springs: %s\n", err);
+    char err[1024];
+    sil_assert_refused("tool carve\nwait 0.1\nmirror y\n", PEER_SOLVE_SPRINGS, "springs", &sum,
+                       err, sizeof(err));
     assert_non_null(strstr(err, "line 3: host tool settings need the B-spline model"));
-    unlink(path);
-    rmdir(dir);
 }
 
 int main(void)

@@ -3,7 +3,9 @@
  * `paint rgb 230 20 20`: the final model's mesh must carry that colour on the vertices within the
  * tool's radius of where the stylus went and the clay's grey (GRID_RGB_DEFAULT) two radii away,
  * the volume must not change, and model.argil must hold every sample's colour bit for bit as the
- * session's grid had it (and a new B-spline model loaded from it the same colour). */
+ * session's grid had it (and a new B-spline model loaded from it the same colour) with the paint
+ * colour chosen in its tool settings; final.ply is that coloured mesh (red only along the
+ * stroke, grey elsewhere). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -19,7 +21,9 @@
 #include "firmware/core/safety.h"
 #include "host/app/session.h"
 #include "host/io/argil_file.h"
+#include "host/io/ply.h"
 #include "host/mesh/mc_blocks.h"
+#include "tests/sil/sil_runs.h"
 #include "tests/unit/grid_view.h"
 
 #define RADIUS_MM 4.0
@@ -86,19 +90,12 @@ static bool near_colour(const uint8_t *v, const uint8_t *want)
 static void test_paint_stroke_shows_and_persists(void **st)
 {
     (void)st;
-    char dir[64] = "/tmp/argil-pcolour-XXXXXX", script[128], model[128];
-    assert_non_null(mkdtemp(dir));
-    snprintf(script, sizeof(script), "%s/paint.scn", dir);
+    char dir[64], script[128], model[128];
+    const char *const parts[] = {SCRIPT, NULL};
+    assert_int_equal(sil_script_dir(dir, "argil-pcolour", "paint.scn", parts, script), 0);
     snprintf(model, sizeof(model), "%s/model.argil", dir);
-    FILE *fp = fopen(script, "w");
-    assert_non_null(fp);
-    fputs(SCRIPT, fp);
-    assert_int_equal(fclose(fp), 0);
     session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = script;
-    o.out_dir = dir;
-    o.deadline_faults = false;
+    sil_opts(&o, script, dir);
     capture_t cap;
     memset(&cap, 0, sizeof(cap));
     cap.path = malloc(3 * PATH_MAX_POINTS * sizeof(float));
@@ -107,8 +104,7 @@ static void test_paint_stroke_shows_and_persists(void **st)
     o.hook = &hk;
     session_summary_t sum;
     char err[1024] = "";
-    if (session_run(&o, &sum, err, sizeof(err)) != ARGIL_OK)
-        fail_msg("paint session: %s", err);
+    sil_run(&o, &sum, "paint session");
     assert_true(cap.taken);
     assert_int_equal(sum.solve_errors, 0);
     assert_true(sum.watertight);
@@ -125,6 +121,10 @@ static void test_paint_stroke_shows_and_persists(void **st)
     assert_int_equal(argil_file_read(model, &d, err, sizeof(err)), ARGIL_OK);
     assert_non_null(d.rgb);
     assert_int_equal(d.file_version, 1);
+    /* ... and the paint settings the script chose, for the next session (TOOL + PNTS) */
+    assert_true(d.tool.paint_chosen);
+    assert_memory_equal(d.tool.paint_rgb, PAINT, 3);
+    assert_float_equal(d.tool.soft_paint_per_s, 20.0f, 0); /* soft paint's default, unused */
     const grid_t *g = &d.grid;
     const size_t n = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
     assert_int_equal(n, cap.n);
@@ -165,6 +165,47 @@ static void test_paint_stroke_shows_and_persists(void **st)
     assert_true(in_n > 100);
     assert_true((double)in_paint >= 0.90 * (double)in_n);
     assert_true((double)far_base >= 0.99 * (double)far_n);
+
+    /* final.ply is that mesh with its colours, bit for bit (ply_write writes what argil mesh
+     * writes): red along the stroke, the clay's grey elsewhere. */
+    char ply[160];
+    snprintf(ply, sizeof(ply), "%s/final.ply", dir);
+    mesh_t fm;
+    mesh_init(&fm);
+    if (ply_read_mesh(ply, &fm, err, sizeof(err)) != ARGIL_OK)
+        fail_msg("%s", err);
+    assert_true(fm.has_rgb);
+    assert_int_equal(fm.n_vert, m.n_vert);
+    assert_int_equal(fm.n_tri, m.n_tri);
+    assert_memory_equal(fm.pos, m.pos, 3 * sizeof(float) * m.n_vert);
+    assert_memory_equal(fm.rgb, m.rgb, 3 * m.n_vert);
+    assert_memory_equal(fm.tri, m.tri, 3 * sizeof(uint32_t) * m.n_tri);
+    size_t red = 0, red_near = 0, grey = 0, near_n = 0, near_red = 0;
+    double red_far_mm = 0.0;
+    for (size_t v = 0; v < fm.n_vert; v++) {
+        const uint8_t *c = &fm.rgb[3 * v];
+        const double dist = path_dist_mm(&cap, &fm.pos[3 * v]);
+        const bool is_red = memcmp(c, PAINT, 3) == 0;
+        red += is_red;
+        grey += memcmp(c, base, 3) == 0;
+        if (is_red) {
+            red_near += dist < RADIUS_MM + 2.5; /* the tool's radius + 2 sample spacings */
+            red_far_mm = dist > red_far_mm ? dist : red_far_mm;
+        }
+        if (dist < RADIUS_MM - 1.0) {
+            near_n++;
+            near_red += is_red;
+        }
+    }
+    printf("# final.ply: %zu vertices, %zu red 230 20 20 (farthest %.2f mm from the path), %zu "
+           "grey 204; within 3 mm of the path %zu, %zu of them red\n",
+           fm.n_vert, red, red_far_mm, grey, near_n, near_red);
+    assert_true(red >= 100);
+    assert_int_equal(red_near, red);               /* no red off the stroke */
+    assert_int_equal(red + grey, fm.n_vert);       /* a stroke of one colour on grey clay */
+    assert_true(near_n >= 50);
+    assert_true((double)near_red >= 0.95 * (double)near_n);
+    mesh_free(&fm);
     mesh_free(&m);
 
     /* Loaded into a new session's B-spline model: the same colour comes back to the grid. */
@@ -189,13 +230,7 @@ static void test_paint_stroke_shows_and_persists(void **st)
     free(cap.rgb);
     free(cap.path);
 
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil", "paint.scn"};
-    char path[160];
-    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
-        snprintf(path, sizeof(path), "%s/%s", dir, names[i]);
-        unlink(path);
-    }
-    assert_int_equal(rmdir(dir), 0);
+    assert_int_equal(sil_remove_dir(dir), 0);
 }
 
 int main(void)

@@ -17,6 +17,7 @@
 
 #include "host/app/session.h"
 #include "host/io/argil_file.h"
+#include "tests/sil/sil_runs.h"
 #include "tests/unit/grid_view.h"
 
 /* The B-spline model's scales over the whole grid, taken once the script has finished (painting
@@ -73,29 +74,23 @@ static size_t painted(const grid_t *g, grid_mat_t ch, float *lo, float *hi)
 static void test_paint_save_load(void **st)
 {
     (void)st;
-    char dir[64] = "/tmp/argil-ppersist-XXXXXX", script[128], model[128];
-    assert_non_null(mkdtemp(dir));
-    snprintf(script, sizeof(script), "%s/paint.scn", dir);
-    snprintf(model, sizeof(model), "%s/model.argil", dir);
-    FILE *fp = fopen(script, "w");
-    assert_non_null(fp);
+    char dir[64], script[128], model[128];
     /* Touch the pole (the clay is a 30 mm sphere), paint there, push a little, leave. */
-    fputs("set radius_mm 4\ntool touch\nmove 0 0 36 0.5\nmove 0 0 31 0.4\n"
-          "paint stiffness 4 radius 10\nwait 0.1\npaint mass 0.5 radius 8\nwait 0.1\n"
-          "move 0 0 45 0.3\n", fp);
-    fclose(fp);
+    const char *const parts[] = {
+        "set radius_mm 4\ntool touch\nmove 0 0 36 0.5\nmove 0 0 31 0.4\n"
+        "paint stiffness 4 radius 10\nwait 0.1\npaint mass 0.5 radius 8\nwait 0.1\n"
+        "move 0 0 45 0.3\n",
+        NULL};
+    assert_int_equal(sil_script_dir(dir, "argil-ppersist", "paint.scn", parts, script), 0);
+    snprintf(model, sizeof(model), "%s/model.argil", dir);
     session_opts_t o;
-    session_opts_default(&o);
-    o.script_path = script;
-    o.out_dir = dir;
-    o.deadline_faults = false;
+    sil_opts(&o, script, dir);
     capture_t cap = {NULL, NULL, 0, false};
     const session_hook_t hook = {capture_hook, &cap, false};
     o.hook = &hook;
     session_summary_t sum;
     char err[1024] = "";
-    if (session_run(&o, &sum, err, sizeof(err)) != ARGIL_OK)
-        fail_msg("paint session: %s", err);
+    sil_run(&o, &sum, "paint session");
     assert_true(cap.taken);
 
     /* Saved: version 2, every sample's scales bit for bit as the model had them. */
@@ -164,13 +159,7 @@ static void test_paint_save_load(void **st)
     free(cap.stiff);
     free(cap.mass);
 
-    const char *names[] = {"final.ply", "telemetry.csv", "session.scn", "model.argil", "paint.scn"};
-    char path[160];
-    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
-        snprintf(path, sizeof(path), "%s/%s", dir, names[i]);
-        unlink(path);
-    }
-    assert_int_equal(rmdir(dir), 0);
+    assert_int_equal(sil_remove_dir(dir), 0);
 }
 
 int main(void)

@@ -11,43 +11,60 @@
 
 #include "host/model/grid.h"
 
+/* Sample (x, y, z) of linear index i over the dims box, x fastest. */
+typedef struct {
+    int32_t x, y, z;
+} gv_at_t;
+
+static inline gv_at_t gv_at(const grid_t *g, size_t i)
+{
+    const gv_at_t a = {(int32_t)(i % (size_t)g->dims[0]),
+                       (int32_t)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
+                       (int32_t)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]))};
+    return a;
+}
+
 static inline void gv_xyz(const grid_t *g, size_t i, int32_t *x, int32_t *y, int32_t *z)
 {
-    *x = (int32_t)(i % (size_t)g->dims[0]);
-    *y = (int32_t)(i / (size_t)g->dims[0] % (size_t)g->dims[1]);
-    *z = (int32_t)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]));
+    const gv_at_t a = gv_at(g, i);
+    *x = a.x;
+    *y = a.y;
+    *z = a.z;
+}
+
+/* The linear index of sample (x, y, z) over the dims box (the inverse of gv_at). */
+static inline size_t gv_idx(const grid_t *g, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
 }
 
 /* Channel ch of sample i. */
 static inline float gv_get(const grid_t *g, grid_ch_t ch, size_t i)
 {
-    int32_t x, y, z;
-    gv_xyz(g, i, &x, &y, &z);
-    return grid_get(g, ch, x, y, z);
+    const gv_at_t a = gv_at(g, i);
+    return grid_get(g, ch, a.x, a.y, a.z);
 }
 
 /* Stores v in channel ch of sample i (and returns v). */
 static inline float gv_set(grid_t *g, grid_ch_t ch, size_t i, float v)
 {
-    int32_t x, y, z;
-    gv_xyz(g, i, &x, &y, &z);
-    (void)grid_set(g, ch, x, y, z, v);
+    const gv_at_t a = gv_at(g, i);
+    (void)grid_set(g, ch, a.x, a.y, a.z, v);
     return v;
 }
 
 /* Painted channel ch of sample i. */
 static inline float gv_mat(const grid_t *g, grid_mat_t ch, size_t i)
 {
-    int32_t x, y, z;
-    gv_xyz(g, i, &x, &y, &z);
-    return grid_mat_get(g, ch, x, y, z);
+    const gv_at_t a = gv_at(g, i);
+    return grid_mat_get(g, ch, a.x, a.y, a.z);
 }
 
+/* Stores v in painted channel ch of sample i (and returns v). */
 static inline float gv_mat_set(grid_t *g, grid_mat_t ch, size_t i, float v)
 {
-    int32_t x, y, z;
-    gv_xyz(g, i, &x, &y, &z);
-    (void)grid_mat_set(g, ch, x, y, z, v);
+    const gv_at_t a = gv_at(g, i);
+    (void)grid_mat_set(g, ch, a.x, a.y, a.z, v);
     return v;
 }
 
@@ -126,9 +143,8 @@ static inline const float *gv_dense(const grid_t *g)
 /* The colour of sample i into rgb (3 bytes); returns rgb. */
 static inline uint8_t *gv_rgb(const grid_t *g, size_t i, uint8_t rgb[3])
 {
-    int32_t x, y, z;
-    gv_xyz(g, i, &x, &y, &z);
-    grid_rgb_get(g, x, y, z, rgb);
+    const gv_at_t a = gv_at(g, i);
+    grid_rgb_get(g, a.x, a.y, a.z, rgb);
     return rgb;
 }
 

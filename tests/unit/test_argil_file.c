@@ -722,6 +722,71 @@ static void test_mtls_rules(void **state)
     expect_rule(p, "byte 128", "bytes after the last MTLS channel");
 }
 
+/* The paint settings a session chose (TOOL's paint rgb + section PNTS): they come back; a
+ * document without them is written as before (no PNTS, 20 bytes less); each PNTS rule. */
+static void test_paint_settings(void **state)
+{
+    (void)state;
+    char p[128], q[128], err[256];
+    snprintf(p, sizeof(p), "%s/paint.argil", g_test_dir);
+    snprintf(q, sizeof(q), "%s/nopaint.argil", g_test_dir);
+    argil_doc_t d, r;
+    make_doc(&d, false);
+    assert_int_equal(argil_file_write(q, &d, err, sizeof(err)), ARGIL_OK);
+    d.tool.paint_chosen = true;
+    const uint8_t blue[3] = {40, 60, 220};
+    memcpy(d.tool.paint_rgb, blue, 3);
+    d.tool.soft_paint_per_s = 37.5f;
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(r.file_version, 1); /* an older argil skips PNTS: the model is whole */
+    assert_true(r.tool.paint_chosen);
+    assert_memory_equal(r.tool.paint_rgb, blue, 3);
+    assert_float_equal(r.tool.soft_paint_per_s, 37.5f, 0);
+    argil_doc_free(&r);
+    assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_OK);
+    assert_false(r.tool.paint_chosen);
+    argil_doc_free(&r);
+    struct stat sp, sq;
+    assert_int_equal(stat(p, &sp), 0);
+    assert_int_equal(stat(q, &sq), 0);
+    assert_int_equal(sp.st_size - sq.st_size, 16 + 4);
+    /* the writer refuses a rate the reader would refuse, and keeps the old file */
+    d.tool.soft_paint_per_s = 100.5f;
+    assert_int_equal(argil_file_write(p, &d, err, sizeof(err)), ARGIL_ERR_NONFINITE);
+    assert_non_null(strstr(err, "soft-paint rate"));
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    argil_doc_free(&r);
+    argil_doc_free(&d);
+
+    uint8_t g[512], v[8];
+    const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
+    char where[32];
+    const float rates[3] = {-1.0f, 101.0f, NAN};
+    for (int k = 0; k < 3; k++) {
+        build_t f;
+        b_begin(&f);
+        b_sec(&f, "GRID", g, gl);
+        io_put_f32le(v, rates[k]);
+        b_sec(&f, "PNTS", v, 4);
+        b_end(&f, p, 1);
+        snprintf(where, sizeof(where), "byte %zu", 32 + 16 + gl + 12);
+        expect_rule(p, where, "PNTS soft-paint rate not in 0..100 per second");
+    }
+    for (int k = 0; k < 2; k++) {
+        build_t f;
+        b_begin(&f);
+        b_sec(&f, "GRID", g, gl);
+        io_put_f32le(v, 5.0f);
+        b_sec(&f, "PNTS", v, k == 0 ? 8 : 4);
+        if (k == 1)
+            b_sec(&f, "PNTS", v, 4);
+        b_end(&f, p, 1);
+        snprintf(where, sizeof(where), "byte %zu", 32 + 16 + gl + (k == 0 ? 0 : 16 + 4));
+        expect_rule(p, where, "PNTS section repeated or not 4 bytes");
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -733,6 +798,7 @@ int main(void)
         cmocka_unit_test(test_painted_round_trip),
         cmocka_unit_test(test_old_version_loads),
         cmocka_unit_test(test_mtls_rules),
+        cmocka_unit_test(test_paint_settings),
     };
     return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }

@@ -16,51 +16,17 @@
 #include "host/app/script.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 48
 #define H 1.25e-3f
 #define R 0.020f
 #define DT 0.01f
 
-static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-}
-
 /* A 48³ grid at 1.25 mm centred on the origin holding a 20 mm sphere. */
 static grid_t *sphere_grid(void)
 {
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0, 0, 0), R);
-    return g;
-}
-
-static void free_grid(grid_t *g)
-{
-    grid_free(g);
-    free(g);
-}
-
-/* Where the density along +axis from the centre sample crosses 0.5 (m from the grid centre). */
-static float crossing_m(const grid_t *g, int axis)
-{
-    const int32_t c = N / 2;
-    int32_t at[3] = {c, c, c};
-    for (int32_t i = c; i + 1 < N; i++) {
-        at[axis] = i;
-        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
-        at[axis] = i + 1;
-        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
-        if (a >= 0.5f && b < 0.5f) {
-            const float pos = (float)i + (a - 0.5f) / (a - b);
-            return (pos - 0.5f * (float)(N - 1)) * H;
-        }
-    }
-    return -1.0f;
+    return sphere_grid_new(N, H, R);
 }
 
 static void test_seed_makes_the_grid_the_models_view(void **st)
@@ -68,10 +34,9 @@ static void test_seed_makes_the_grid_the_models_view(void **st)
     (void)st;
     grid_t *g = sphere_grid();
     const size_t n = (size_t)N * N * N;
-    float *orig = malloc(n * sizeof(float));
+    float *orig = gv_dup(g, GRID_DENSITY);
     assert_non_null(orig);
-    gv_copy(g, GRID_DENSITY, orig);
-    const float x0 = crossing_m(g, 0);
+    const float x0 = sphere_crossing_m(g, 0);
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     float ramp_err = 0.0f, any_err = 0.0f;
@@ -85,29 +50,26 @@ static void test_seed_makes_the_grid_the_models_view(void **st)
         assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
     }
     print_message("# seed: ramp error %.2e, largest %.2e; +x surface %.4f mm (grid %.4f mm)\n",
-                  (double)ramp_err, (double)any_err, (double)crossing_m(g, 0) * 1e3,
+                  (double)ramp_err, (double)any_err, (double)sphere_crossing_m(g, 0) * 1e3,
                   (double)x0 * 1e3);
     /* The cubic B-spline reproduces the linear ramp: only its kinks at 0 and 1 round off. */
     assert_true(ramp_err < 5e-3f);  /* measured 3.7e-3 (the ramp bends round the sphere) */
     assert_true(any_err < 0.04f);   /* measured 0.027, at the kinks */
     assert_true(any_err > 1e-3f); /* it is the model's view, not the old grid */
-    assert_true(fabsf(crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
-    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f);
+    assert_true(fabsf(sphere_crossing_m(g, 0) - x0) < 0.05e-3f); /* measured 0.026 mm */
+    assert_true(fabsf(sphere_crossing_m(g, 0) - R) < 0.1e-3f);
     gsolve_free(&gs);
     free(orig);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_field_at_rest_stays_put(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid();
     gsolve_t gs;
-    assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
-    const size_t n = (size_t)N * N * N;
-    float *before = malloc(n * sizeof(float));
+    grid_t *g = sphere_model_new(&gs, N, H, R);
+    float *before = gv_dup(g, GRID_DENSITY);
     assert_non_null(before);
-    gv_copy(g, GRID_DENSITY, before);
     const int32_t lo[3] = {10, 28, 10}, hi[3] = {34, 48, 34};
     for (int k = 0; k < 30; k++) {
         int32_t dlo[3], dhi[3];
@@ -123,8 +85,7 @@ static void test_field_at_rest_stays_put(void **st)
     assert_int_equal(gs.stats.steps, 1);       /* then at rest: not stepped */
     assert_int_equal(gs.stats.rest_skips, 29);
     free(before);
-    gsolve_free(&gs);
-    free_grid(g);
+    sphere_model_free(&gs, g);
 }
 
 /* Pushes the surface on +y with a force spread like the board's Gaussian filter (σ 1.5
@@ -138,29 +99,13 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
     if (bspline)
         assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const size_t n = (size_t)N * N * N;
-    float *before = malloc(n * sizeof(float));
+    float *before = gv_dup(g, GRID_DENSITY);
     assert_non_null(before);
-    gv_copy(g, GRID_DENSITY, before);
-    /* the surface sample on +y nearest density 0.5 */
-    const int32_t c = N / 2;
-    int32_t sy = c;
-    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
-        sy++;
+    const int32_t c = N / 2, sy = sphere_surface_y(g);
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     for (int k = 0; k < 30; k++) {
-        if (k == 0) {
-            double wsum = 0.0;
-            for (int dz = -3; dz <= 3; dz++)
-                for (int dy = -3; dy <= 3; dy++)
-                    for (int dx = -3; dx <= 3; dx++)
-                        wsum += exp(-(dx * dx + dy * dy + dz * dz) / 4.5);
-            for (int dz = -3; dz <= 3; dz++)
-                for (int dy = -3; dy <= 3; dy++)
-                    for (int dx = -3; dx <= 3; dx++)
-                        assert_true(grid_add_force(
-                            g, c + dx, sy + dy, c + dz,
-                            (float)(force_n * exp(-(dx * dx + dy * dy + dz * dz) / 4.5) / wsum)));
-        }
+        if (k == 0)
+            sphere_push_gauss(g, c, sy, c, force_n);
         if (bspline) {
             int32_t dlo[3], dhi[3];
             float change;
@@ -179,14 +124,14 @@ static void push_and_flow(bool bspline, float force_n, float *sum_moved, float *
     for (size_t i = 0; i < n; i++)
         sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
-    const size_t at = gidx(g, c, sy, c);
+    const size_t at = gv_idx(g, c, sy, c);
     *at_moved = gv_get(g, GRID_DENSITY, at) - before[at];
-    const size_t far = gidx(g, c, N - sy, c); /* the opposite pole, outside the window */
+    const size_t far = gv_idx(g, c, N - sy, c); /* the opposite pole, outside the window */
     *far_moved = gv_get(g, GRID_DENSITY, far) - before[far];
     free(before);
     if (bspline)
         gsolve_free(&gs);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_impulse_moves_as_much_clay_as_the_springs(void **st)
@@ -225,34 +170,13 @@ static void moved_window_matches_a_fresh_one(bool painted)
         assert_int_equal(gsolve_paint(&b, GSOLVE_MAT_STIFFNESS, vec3(0, R, 0), 6e-3f, 3.0f),
                          ARGIL_OK);
     }
-    const int32_t c = N / 2, sy = c + 15;
-    float largest = 0.0f;
-    for (int k = 0; k < 12; k++) {
-        const int32_t shift = k / 3; /* the box moves one sample every third step */
-        const int32_t lo[3] = {c - 8 + shift, sy - 8, c - 8}, hi[3] = {c + 8 + shift, sy + 8, c + 8};
-        if (k < 8) {
-            assert_true(grid_add_force(g1, c + shift, sy, c, -20.0f));
-            assert_true(grid_add_force(g2, c + shift, sy, c, -20.0f));
-        }
-        if (k % 3 == 0)
-            gsolve_close_window(&b);
-        int32_t dlo[3], dhi[3];
-        float ch1, ch2;
-        assert_int_equal(gsolve_step(&a, g1, lo, hi, DT, dlo, dhi, &ch1), ARGIL_OK);
-        assert_int_equal(gsolve_step(&b, g2, lo, hi, DT, dlo, dhi, &ch2), ARGIL_OK);
-        assert_true(ch1 == ch2);
-        if (ch1 > largest)
-            largest = ch1;
-    }
-    assert_int_equal(a.stats.windows_opened, 1);
-    assert_int_equal(a.stats.windows_moved, 3);
-    assert_int_equal(b.stats.windows_opened, 4);
-    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
+    /* the box moves one sample every third step */
+    const float largest = sphere_moved_vs_fresh_window(&a, g1, &b, g2, 1, DT);
     assert_true(largest > 1e-3f); /* the forces did move the clay */
     gsolve_free(&a);
     gsolve_free(&b);
-    free_grid(g1);
-    free_grid(g2);
+    sphere_grid_free(g1);
+    sphere_grid_free(g2);
 }
 
 static void test_moved_window_matches_a_fresh_one(void **st)
@@ -269,10 +193,8 @@ static void test_carve_goes_through_the_model(void **st)
     grid_t *ref = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
-    const size_t n = (size_t)N * N * N;
-    float *before = malloc(n * sizeof(float));
+    float *before = gv_dup(g, GRID_DENSITY);
     assert_non_null(before);
-    gv_copy(g, GRID_DENSITY, before);
     const vec3_t at = vec3(0, R, 0);
     const float radius = 5e-3f;
     int32_t lo[3], hi[3], rlo[3], rhi[3];
@@ -281,17 +203,17 @@ static void test_carve_goes_through_the_model(void **st)
     assert_true(hi[0] > lo[0]);
     assert_int_equal(gs.stats.carves, 1);
     /* the surface on +y moved in by the tool's radius, as the grid's own carve puts it */
-    const float y_b = crossing_m(g, 1), y_g = crossing_m(ref, 1);
+    const float y_b = sphere_crossing_m(g, 1), y_g = sphere_crossing_m(ref, 1);
     print_message("# carve: +y surface %.2f mm (grid carve %.2f mm, sphere %.1f)\n",
                   (double)y_b * 1e3, (double)y_g * 1e3, (double)R * 1e3);
     assert_true(y_b < R - 4e-3f);
     assert_true(fabsf(y_b - y_g) < 0.5e-3f);
-    assert_true(fabsf(crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
+    assert_true(fabsf(sphere_crossing_m(g, 0) - R) < 0.1e-3f); /* the side untouched */
     /* every change lies in the box reported */
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = gidx(g, x, y, z);
+                const size_t i = gv_idx(g, x, y, z);
                 if (gv_get(g, GRID_DENSITY, i) != before[i])
                     assert_true(x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] &&
                                 z >= lo[2] && z < hi[2]);
@@ -307,11 +229,11 @@ static void test_carve_goes_through_the_model(void **st)
                              ARGIL_OK);
     }
     assert_true(change < 1e-3f);
-    assert_true(crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
+    assert_true(sphere_crossing_m(g, 1) < y_b - 1.5e-3f); /* the second carve went 2 mm deeper */
     free(before);
     gsolve_free(&gs);
-    free_grid(ref);
-    free_grid(g);
+    sphere_grid_free(ref);
+    sphere_grid_free(g);
 }
 
 static void test_painted_material(void **st)
@@ -351,7 +273,7 @@ static void test_painted_material(void **st)
     peer_free(springs);
     free(bs);
     free(springs);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 /* Elastic clay pushed in: where the stiffness is painted 50x it springs back sooner. */
@@ -363,12 +285,12 @@ static float springback_left(bool painted)
     assert_int_equal(gsolve_init(&gs, g), ARGIL_OK);
     const int32_t c = N / 2;
     int32_t sy = c;
-    while (gv_get(g, GRID_DENSITY, gidx(g, c, sy + 1, c)) >= 0.5f)
+    while (gv_get(g, GRID_DENSITY, gv_idx(g, c, sy + 1, c)) >= 0.5f)
         sy++;
     const vec3_t at = vec3(0.5f * H, (float)(sy - c) * H + 0.5f * H, 0.5f * H);
     if (painted)
         assert_int_equal(gsolve_paint(&gs, GSOLVE_MAT_STIFFNESS, at, 8e-3f, 50.0f), ARGIL_OK);
-    const size_t i = gidx(g, c, sy, c);
+    const size_t i = gv_idx(g, c, sy, c);
     const float d0 = gv_get(g, GRID_DENSITY, i);
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     float deepest = 0.0f;
@@ -386,7 +308,7 @@ static float springback_left(bool painted)
     assert_true(deepest > 5e-3f);
     const float left = (d0 - gv_get(g, GRID_DENSITY, i)) / deepest;
     gsolve_free(&gs);
-    free_grid(g);
+    sphere_grid_free(g);
     return left;
 }
 

@@ -12,6 +12,7 @@
 
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 64
 #define H 1.25e-3f
@@ -20,24 +21,7 @@
 /* A 64³ grid at 1.25 mm, centred on the origin, holding a 30 mm sphere. */
 static grid_t *sphere_grid(void)
 {
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0.0f, 0.0f, 0.0f), R);
-    return g;
-}
-
-static void drop_grid(grid_t *g)
-{
-    grid_free(g);
-    free(g);
-}
-
-static size_t idx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+    return sphere_grid_new(N, H, R);
 }
 
 static vec3_t sample_pos(const grid_t *g, int32_t x, int32_t y, int32_t z)
@@ -107,7 +91,7 @@ static void test_sphere_profile(void **state)
     assert_float_equal(grid_density_at(g, vec3(1.0f, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(grid_density_at(g, vec3(NAN, 0, 0)), 0.0f, 0.0f);
     assert_float_equal(vec3_norm(grid_gradient_at(g, vec3(0, -1.0f, 0))), 0.0f, 0.0f);
-    drop_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_gradient_matches_finite_differences(void **state)
@@ -137,7 +121,7 @@ static void test_gradient_matches_finite_differences(void **state)
         /* |grad| is 100 /m; float differences over 1.25 µm carry ~1 /m of rounding. */
         assert_true(vec3_norm(vec3_sub(grad, fd)) < 2.0f);
     }
-    drop_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_carve_sphere(void **state)
@@ -162,7 +146,7 @@ static void test_carve_sphere(void **state)
     for (int32_t z = 0; z < N; z++)
         for (int32_t y = 0; y < N; y++)
             for (int32_t x = 0; x < N; x++) {
-                const size_t i = idx(g, x, y, z);
+                const size_t i = gv_idx(g, x, y, z);
                 const float dist = vec3_norm(vec3_sub(sample_pos(g, x, y, z), c));
                 if (dist < rc - g->band_m)
                     assert_true(gv_get(g, GRID_DENSITY, i) == 0.0f &&
@@ -205,7 +189,7 @@ static void test_carve_sphere(void **state)
         assert_true(lo[a] == 0 && hi[a] == 0);
     free(before);
     free(rest_before);
-    drop_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_window_corner_and_extract(void **state)
@@ -234,7 +218,7 @@ static void test_window_corner_and_extract(void **state)
                     assert_true(out[o] == 0.0f);
                     zeros_outside++;
                 } else {
-                    assert_true(gv_bits(out[o], gv_get(g, GRID_DENSITY, idx(g, gx, gy, gz))));
+                    assert_true(gv_bits(out[o], gv_get(g, GRID_DENSITY, gv_idx(g, gx, gy, gz))));
                 }
             }
     assert_int_equal(zeros_outside, 32 * 5 * 8 - 27 * 5 * 7);
@@ -248,7 +232,7 @@ static void test_window_corner_and_extract(void **state)
 
     grid_window_corner(g, vec3(INFINITY, 0, 0), win, corner);
     assert_int_equal(corner[0], 0);
-    drop_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_add_force(void **state)
@@ -264,8 +248,8 @@ static void test_add_force(void **state)
     assert_false(grid_add_force(g, 1, 1, 1, INFINITY));
     assert_true(grid_add_force(g, 1, 2, 3, 1.5f));
     assert_true(grid_add_force(g, 1, 2, 3, 1.0f));
-    assert_float_equal(gv_get(g, GRID_FORCE, idx(g, 1, 2, 3)), 2.5f, 0.0f);
-    drop_grid(g);
+    assert_float_equal(gv_get(g, GRID_FORCE, gv_idx(g, 1, 2, 3)), 2.5f, 0.0f);
+    sphere_grid_free(g);
 }
 
 static void test_springs_push_lowers_density(void **state)
@@ -274,10 +258,10 @@ static void test_springs_push_lowers_density(void **state)
     grid_t *g = sphere_grid();
     /* The sample on the +x surface of the sphere: 30 mm = 24 spacings from the centre. */
     const int32_t x = 31 + 24, y = 31, z = 31;
-    const size_t i = idx(g, x, y, z);
+    const size_t i = gv_idx(g, x, y, z);
     const float d0 = gv_get(g, GRID_DENSITY, i);
     assert_true(d0 > 0.2f && d0 < 0.8f);
-    const float far0 = gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5));
+    const float far0 = gv_get(g, GRID_DENSITY, gv_idx(g, 5, 5, 5));
     assert_true(grid_add_force(g, x, y, z, -50.0f));
 
     const int32_t lo[3] = {0, 0, 0}, hi[3] = {N, N, N};
@@ -286,8 +270,8 @@ static void test_springs_push_lowers_density(void **state)
     /* a = F/m = -50 /s²; after one step of ~21 ms the density falls by a*dt² ≈ 0.02. */
     assert_true(gv_get(g, GRID_DENSITY, i) < d0 - 0.01f);
     assert_float_equal(gv_get(g, GRID_FORCE, i), 0.0f, 0.0f); /* consumed */
-    assert_float_equal(gv_get(g, GRID_DENSITY, idx(g, 5, 5, 5)), far0, 0.0f);
-    drop_grid(g);
+    assert_float_equal(gv_get(g, GRID_DENSITY, gv_idx(g, 5, 5, 5)), far0, 0.0f);
+    sphere_grid_free(g);
 }
 
 

@@ -16,30 +16,12 @@
 #include "host/app/global_solve.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 40
 #define H 1.25e-3f
 #define R 0.018f
 #define DT 0.01f
-
-static grid_t *sphere_grid(gsolve_t *gs)
-{
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0, 0, 0), R);
-    assert_int_equal(gsolve_init(gs, g), ARGIL_OK);
-    return g;
-}
-
-static void free_all(gsolve_t *gs, grid_t *g)
-{
-    gsolve_free(gs);
-    grid_free(g);
-    free(g);
-}
 
 static vec3_t sample_pos(const grid_t *g, size_t i)
 {
@@ -64,7 +46,7 @@ static void test_paint_colours_the_ball_only(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     assert_false(grid_rgb_any(g));
     const size_t n = (size_t)N * N * N;
     float *d0 = malloc(n * sizeof(float)), *d1 = malloc(n * sizeof(float));
@@ -123,14 +105,14 @@ static void test_paint_colours_the_ball_only(void **st)
     free(d0);
     free(d1);
     free(col);
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 static void test_soft_paint_blends_in(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     const uint8_t blue[3] = {0, 0, 255};
     /* the sample at the tool centre, 10.6 mm inside the +x surface (density 1) */
     const size_t c = (size_t)(N / 2 + 8) + (size_t)N * ((size_t)(N / 2) + (size_t)N * (N / 2));
@@ -156,14 +138,14 @@ static void test_soft_paint_blends_in(void **st)
                   "%.1f)\n", w, cc[0], cc[1], cc[2], r_want, b_want);
     /* 0.82^10 = 0.137 of the way left */
     assert_true(cc[0] < 32 && cc[2] > 245);
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 static void test_carve_leaves_no_colour_and_round_trip(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     host_tool_t t;
     host_tool_default(&t);
     int32_t lo[3], hi[3];
@@ -197,7 +179,7 @@ static void test_carve_leaves_no_colour_and_round_trip(void **st)
     assert_true(grid_rgb_painted(g));
     free(keep);
     free(rgb);
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 int main(void)

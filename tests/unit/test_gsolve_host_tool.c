@@ -17,37 +17,12 @@
 #include "host/app/peer.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 48
 #define H 1.25e-3f
 #define R 0.020f
 #define DT 0.01f
-
-static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-}
-
-/* A 48³ grid at 1.25 mm centred on the origin (symmetric about every origin plane) holding a
- * 20 mm sphere, and its model. */
-static grid_t *sphere_grid(gsolve_t *gs)
-{
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0, 0, 0), R);
-    assert_int_equal(gsolve_init(gs, g), ARGIL_OK);
-    return g;
-}
-
-static void free_all(gsolve_t *gs, grid_t *g)
-{
-    gsolve_free(gs);
-    grid_free(g);
-    free(g);
-}
 
 /* Where the density along the ray from the grid centre in direction dir (unit axis, sign)
  * crosses 0.5, offset `off` samples along the next axis: distance from the centre line, m. */
@@ -59,9 +34,9 @@ static float crossing_m(const grid_t *g, int axis, int sign, int32_t off)
     const int32_t start = sign > 0 ? c1 : c0;
     for (int32_t k = 0; k + 1 < N / 2; k++) {
         at[axis] = start + sign * k;
-        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        const float a = gv_get(g, GRID_DENSITY, gv_idx(g, at[0], at[1], at[2]));
         at[axis] = start + sign * (k + 1);
-        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
+        const float b = gv_get(g, GRID_DENSITY, gv_idx(g, at[0], at[1], at[2]));
         if (a >= 0.5f && b < 0.5f) {
             const float pos = (float)(start + sign * k) + (float)sign * (a - 0.5f) / (a - b);
             return fabsf(pos - 0.5f * (float)(N - 1)) * H;
@@ -95,7 +70,7 @@ static void test_add_grows_the_clay_at_the_tool(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     const double v0 = volume_m3(g);
     const float x0 = crossing_m(g, 0, 1, 0);
     /* a 4 mm ball centred 2 mm outside the +x surface: the surface moves out to ~26 mm */
@@ -111,14 +86,14 @@ static void test_add_grows_the_clay_at_the_tool(void **st)
     assert_true(fabsf(x1 - (R + 6e-3f)) < 0.5e-3f);
     assert_true(dv > 231e-9 && dv < 400e-9);
     assert_true(fabsf(crossing_m(g, 0, -1, 0) - R) < 0.1e-3f); /* the far side untouched */
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 static void test_mirror_carves_both_sides_alike(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     assert_int_equal(apply(&gs, g, HOST_ACT_CARVE, HOST_SHAPE_SPHERE, HOST_MIRROR_X, 0.0f, 5e-3f,
                            vec3(R, 1e-3f, 0), DT), ARGIL_OK);
     const float px = crossing_m(g, 0, 1, 0), nx = crossing_m(g, 0, -1, 0);
@@ -131,13 +106,13 @@ static void test_mirror_carves_both_sides_alike(void **st)
     assert_true(fabsf(crossing_m(g, 2, -1, 0) - R) < 0.1e-3f);
     /* without the mirror only +x moves */
     gsolve_t gs2;
-    grid_t *g2 = sphere_grid(&gs2);
+    grid_t *g2 = sphere_model_new(&gs2, N, H, R);
     assert_int_equal(apply(&gs2, g2, HOST_ACT_CARVE, HOST_SHAPE_SPHERE, 0, 0.0f, 5e-3f,
                            vec3(R, 1e-3f, 0), DT), ARGIL_OK);
     assert_true(fabsf(crossing_m(g2, 0, 1, 0) - px) < 1e-6f);
     assert_true(fabsf(crossing_m(g2, 0, -1, 0) - R) < 0.1e-3f);
-    free_all(&gs2, g2);
-    free_all(&gs, g);
+    sphere_model_free(&gs2, g2);
+    sphere_model_free(&gs, g);
 }
 
 /* A ridge made with add, then smoothed: its top comes down. */
@@ -145,7 +120,7 @@ static void test_smooth_lowers_a_bump(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     assert_int_equal(apply(&gs, g, HOST_ACT_ADD, HOST_SHAPE_SPHERE, 0, 0.0f, 2.5e-3f,
                            vec3(0, R + 1e-3f, 0), DT), ARGIL_OK);
     const float top0 = crossing_m(g, 1, 1, 0);
@@ -159,7 +134,7 @@ static void test_smooth_lowers_a_bump(void **st)
     assert_true(top0 > R + 3e-3f);
     assert_true(top1 < top0 - 1e-3f);
     assert_true(top1 > R - 1e-3f); /* smoothed, not carved */
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 /* Toothpaste's strength is per second: twice the period, twice the density per application. */
@@ -169,16 +144,16 @@ static void test_strength_is_per_second(void **st)
     float rise[2];
     for (int k = 0; k < 2; k++) {
         gsolve_t gs;
-        grid_t *g = sphere_grid(&gs);
+        grid_t *g = sphere_model_new(&gs, N, H, R);
         const int32_t c = N / 2, x = N - 4; /* 5.6 mm beyond the surface: density 0 */
-        const float before = gv_get(g, GRID_DENSITY, gidx(g, x, c, c));
+        const float before = gv_get(g, GRID_DENSITY, gv_idx(g, x, c, c));
         const float px = ((float)x - 0.5f * (float)(N - 1)) * H;
         assert_int_equal(apply(&gs, g, HOST_ACT_TOOTHPASTE, HOST_SHAPE_SPHERE, 0, 5.0f, 4e-3f,
                                vec3(px, ((float)c - 0.5f * (float)(N - 1)) * H,
                                     ((float)c - 0.5f * (float)(N - 1)) * H),
                                k == 0 ? DT : 2.0f * DT), ARGIL_OK);
-        rise[k] = gv_get(g, GRID_DENSITY, gidx(g, x, c, c)) - before;
-        free_all(&gs, g);
+        rise[k] = gv_get(g, GRID_DENSITY, gv_idx(g, x, c, c)) - before;
+        sphere_model_free(&gs, g);
     }
     print_message("# toothpaste 5/s: density at the tool centre +%.4f (10 ms), +%.4f (20 ms)\n",
                   (double)rise[0], (double)rise[1]);
@@ -190,7 +165,7 @@ static void test_chisel_moves_the_surface_by_its_depth(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     /* 2 mm/s for 0.5 s at 10 ms: 1 mm in along the normal, under a 6 mm ball on the surface */
     for (int k = 0; k < 50; k++)
         assert_int_equal(apply(&gs, g, HOST_ACT_CHISEL, HOST_SHAPE_SPHERE, 0, 2.0f, 6e-3f,
@@ -199,7 +174,7 @@ static void test_chisel_moves_the_surface_by_its_depth(void **st)
     print_message("# chisel 2 mm/s x 0.5 s: +z surface %.3f mm (sphere %.1f)\n",
                   (double)z1 * 1e3, (double)R * 1e3);
     assert_true(fabsf((R - z1) - 1e-3f) < 0.25e-3f);
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 /* A box cuts as deep off-centre as on its axis; a sphere's cut is shallower off-centre. */
@@ -209,12 +184,12 @@ static void test_box_is_flat_bottomed(void **st)
     float depth[2][2];
     for (int s = 0; s < 2; s++) {
         gsolve_t gs;
-        grid_t *g = sphere_grid(&gs);
+        grid_t *g = sphere_model_new(&gs, N, H, R);
         assert_int_equal(apply(&gs, g, HOST_ACT_CARVE, s ? HOST_SHAPE_BOX : HOST_SHAPE_SPHERE, 0,
                                0.0f, 5e-3f, vec3(0, 0, R + 1e-3f), DT), ARGIL_OK);
         depth[s][0] = R - crossing_m(g, 2, 1, 0);
         depth[s][1] = R - crossing_m(g, 2, 1, 3); /* 3.75 mm off the axis (along x) */
-        free_all(&gs, g);
+        sphere_model_free(&gs, g);
     }
     print_message("# cut depth on the axis / 3.75 mm off it: sphere %.2f / %.2f mm, box %.2f / "
                   "%.2f mm\n", (double)depth[0][0] * 1e3, (double)depth[0][1] * 1e3,
@@ -228,7 +203,7 @@ static void test_stroke_fills_the_gap(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
+    grid_t *g = sphere_model_new(&gs, N, H, R);
     host_tool_t t;
     host_tool_default(&t);
     const vec3_t pts[2] = {vec3(-8e-3f, 0, R + 1e-3f), vec3(8e-3f, 0, R + 1e-3f)};
@@ -239,18 +214,16 @@ static void test_stroke_fills_the_gap(void **st)
     print_message("# stroke from x -8 to +8 mm: +z surface mid-way %.2f mm\n", (double)mid * 1e3);
     assert_true(mid < R - 1.5e-3f);
     assert_true(hi[0] - lo[0] > 16); /* the box covers the stroke (> 20 mm of samples) */
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 static void test_bad_settings_change_nothing(void **st)
 {
     (void)st;
     gsolve_t gs;
-    grid_t *g = sphere_grid(&gs);
-    const size_t n = (size_t)N * N * N;
-    float *before = malloc(n * sizeof(float));
+    grid_t *g = sphere_model_new(&gs, N, H, R);
+    float *before = gv_dup(g, GRID_DENSITY);
     assert_non_null(before);
-    gv_copy(g, GRID_DENSITY, before);
     host_tool_t t;
     host_tool_default(&t);
     const vec3_t at = vec3(0, R, 0);
@@ -281,7 +254,7 @@ static void test_bad_settings_change_nothing(void **st)
     assert_int_equal(hi[0], 0);
     assert_true(gv_equal(g, GRID_DENSITY, before));
     free(before);
-    free_all(&gs, g);
+    sphere_model_free(&gs, g);
 }
 
 static bool send_nothing(void *ctx, const uint8_t *frame, size_t len)

@@ -19,51 +19,17 @@
 #include "host/mesh/mc.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 48
 #define H 1.25e-3f
 #define RAD 0.020f
 #define DT 0.01f
 
-static size_t gidx(const grid_t *g, int32_t x, int32_t y, int32_t z)
-{
-    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
-}
-
 /* A 48³ grid at 1.25 mm centred on the origin holding a 20 mm sphere. */
 static grid_t *sphere_grid(void)
 {
-    grid_t *g = malloc(sizeof(*g));
-    assert_non_null(g);
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(g, vec3(0, 0, 0), RAD);
-    return g;
-}
-
-static void free_grid(grid_t *g)
-{
-    grid_free(g);
-    free(g);
-}
-
-/* Where the density along +axis from the centre sample crosses 0.5 (m from the grid centre). */
-static float crossing_m(const grid_t *g, int axis)
-{
-    const int32_t c = N / 2;
-    int32_t at[3] = {c, c, c};
-    for (int32_t i = c; i + 1 < N; i++) {
-        at[axis] = i;
-        const float a = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
-        at[axis] = i + 1;
-        const float b = gv_get(g, GRID_DENSITY, gidx(g, at[0], at[1], at[2]));
-        if (a >= 0.5f && b < 0.5f) {
-            const float pos = (float)i + (a - 0.5f) / (a - b);
-            return (pos - 0.5f * (float)(N - 1)) * H;
-        }
-    }
-    return -1.0f;
+    return sphere_grid_new(N, H, RAD);
 }
 
 static size_t mesh_vertices(const grid_t *g)
@@ -79,31 +45,6 @@ static size_t mesh_vertices(const grid_t *g)
     return n;
 }
 
-/* A force spread like the board's Gaussian filter (σ 1.5 samples, 7³ nodes) at sample c. */
-static void push_at(grid_t *g, int32_t x, int32_t y, int32_t z, float force_n)
-{
-    double wsum = 0.0;
-    for (int dz = -3; dz <= 3; dz++)
-        for (int dy = -3; dy <= 3; dy++)
-            for (int dx = -3; dx <= 3; dx++)
-                wsum += exp(-(dx * dx + dy * dy + dz * dz) / 4.5);
-    for (int dz = -3; dz <= 3; dz++)
-        for (int dy = -3; dy <= 3; dy++)
-            for (int dx = -3; dx <= 3; dx++)
-                assert_true(grid_add_force(
-                    g, x + dx, y + dy, z + dz,
-                    (float)(force_n * exp(-(dx * dx + dy * dy + dz * dz) / 4.5) / wsum)));
-}
-
-/* The surface sample on +y nearest density 0.5 (on the centre column). */
-static int32_t surface_y(const grid_t *g)
-{
-    int32_t sy = N / 2;
-    while (gv_get(g, GRID_DENSITY, gidx(g, N / 2, sy + 1, N / 2)) >= 0.5f)
-        sy++;
-    return sy;
-}
-
 static void test_seed_at_coarser_ratios(void **st)
 {
     (void)st;
@@ -114,10 +55,9 @@ static void test_seed_at_coarser_ratios(void **st)
     for (int k = 0; k < 2; k++) {
         grid_t *g = sphere_grid();
         const size_t n = (size_t)N * N * N;
-        float *orig = malloc(n * sizeof(float));
+        float *orig = gv_dup(g, GRID_DENSITY);
         assert_non_null(orig);
-        gv_copy(g, GRID_DENSITY, orig);
-        const float x0 = crossing_m(g, 0);
+        const float x0 = sphere_crossing_m(g, 0);
         gsolve_t gs;
         assert_int_equal(gsolve_init_ratio(&gs, g, ratios[k]), ARGIL_OK);
         assert_int_equal(gsolve_ratio(&gs), ratios[k]);
@@ -130,7 +70,7 @@ static void test_seed_at_coarser_ratios(void **st)
                 any_err = e;
             assert_true(gv_get(g, GRID_REST, i) == gv_get(g, GRID_DENSITY, i));
         }
-        const float dx = crossing_m(g, 0) - x0;
+        const float dx = sphere_crossing_m(g, 0) - x0;
         print_message("# seed R=%d: ramp error %.2e, largest %.2e; +x surface moved %.4f mm\n",
                       (int)ratios[k], (double)ramp_err, (double)any_err, (double)dx * 1e3);
         /* Quasi-interpolation (p_c = density at sample R c) then GSOLVE_SEED_FIT_ITERS of
@@ -140,25 +80,25 @@ static void test_seed_at_coarser_ratios(void **st)
         assert_true(fabsf(dx) < surf_max_m[k]);
         gsolve_free(&gs);
         free(orig);
-        free_grid(g);
+        sphere_grid_free(g);
     }
     grid_t *g = sphere_grid();
     gsolve_t gs;
     assert_int_equal(gsolve_init_ratio(&gs, g, 3), ARGIL_ERR_ARG);
     assert_int_equal(gsolve_init_ratio(&gs, g, 0), ARGIL_ERR_ARG);
     assert_int_equal(gsolve_init_ratio(&gs, g, 8), ARGIL_ERR_ARG);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 /* Pushes the +y surface for a step (40 N for 10 ms) with the window on it and lets it flow for
  * `flow` steps. */
 static void push_and_flow(gsolve_t *gs, grid_t *g, float force_n, int flow)
 {
-    const int32_t c = N / 2, sy = surface_y(g);
+    const int32_t c = N / 2, sy = sphere_surface_y(g);
     const int32_t lo[3] = {c - 10, sy - 10, c - 10}, hi[3] = {c + 10, sy + 10, c + 10};
     for (int k = 0; k < flow; k++) {
         if (k == 0 && force_n != 0.0f)
-            push_at(g, c, sy, c, force_n);
+            sphere_push_gauss(g, c, sy, c, force_n);
         int32_t dlo[3], dhi[3];
         float change;
         assert_int_equal(gsolve_step(gs, g, lo, hi, DT, dlo, dhi, &change), ARGIL_OK);
@@ -212,7 +152,7 @@ static void refine_keeps_the_shape(int32_t r0)
     assert_true(gv_equal(g, GRID_DENSITY, before));
     free(before);
     gsolve_free(&gs);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_refine_keeps_the_shape(void **st)
@@ -236,19 +176,18 @@ static void dent(int32_t r0, int refines, float *sum_moved, float *at_moved)
         assert_int_equal(gsolve_refine(&gs, g, &dd, lo, hi), ARGIL_OK);
     }
     const size_t n = (size_t)N * N * N;
-    float *before = malloc(n * sizeof(float));
+    float *before = gv_dup(g, GRID_DENSITY);
     assert_non_null(before);
-    gv_copy(g, GRID_DENSITY, before);
-    const int32_t c = N / 2, sy = surface_y(g);
+    const int32_t c = N / 2, sy = sphere_surface_y(g);
     push_and_flow(&gs, g, -40.0f, 30);
     double sum = 0.0;
     for (size_t i = 0; i < n; i++)
         sum += (double)gv_get(g, GRID_DENSITY, i) - before[i];
     *sum_moved = (float)sum;
-    *at_moved = gv_get(g, GRID_DENSITY, gidx(g, c, sy, c)) - before[gidx(g, c, sy, c)];
+    *at_moved = gv_get(g, GRID_DENSITY, gv_idx(g, c, sy, c)) - before[gv_idx(g, c, sy, c)];
     free(before);
     gsolve_free(&gs);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_push_after_refine_moves_the_clay(void **st)
@@ -290,28 +229,8 @@ static void test_window_shift_at_ratio_2(void **st)
     assert_int_equal(gsolve_init_ratio(&b, g2, 2), ARGIL_OK);
     a.settle_enabled = false; /* b's reopened window leaves nothing behind either */
     const int32_t c = N / 2, sy = c + 15;
-    float largest = 0.0f;
-    for (int k = 0; k < 12; k++) {
-        const int32_t shift = 2 * (k / 3); /* one knot span every third step */
-        const int32_t lo[3] = {c - 8 + shift, sy - 8, c - 8}, hi[3] = {c + 8 + shift, sy + 8, c + 8};
-        if (k < 8) {
-            assert_true(grid_add_force(g1, c + shift, sy, c, -20.0f));
-            assert_true(grid_add_force(g2, c + shift, sy, c, -20.0f));
-        }
-        if (k % 3 == 0)
-            gsolve_close_window(&b);
-        int32_t dlo[3], dhi[3];
-        float ch1, ch2;
-        assert_int_equal(gsolve_step(&a, g1, lo, hi, DT, dlo, dhi, &ch1), ARGIL_OK);
-        assert_int_equal(gsolve_step(&b, g2, lo, hi, DT, dlo, dhi, &ch2), ARGIL_OK);
-        assert_true(ch1 == ch2);
-        if (ch1 > largest)
-            largest = ch1;
-    }
-    assert_int_equal(a.stats.windows_opened, 1);
-    assert_int_equal(a.stats.windows_moved, 3);
-    assert_int_equal(b.stats.windows_opened, 4);
-    assert_true(gv_same(g1, GRID_DENSITY, g2, GRID_DENSITY));
+    /* one knot span every third step */
+    const float largest = sphere_moved_vs_fresh_window(&a, g1, &b, g2, 2, DT);
     assert_true(largest > 1e-4f); /* the forces did move the clay */
     /* one sample to the side (samples 26..46 → 27..47): the same coefficients 13..23 */
     const int32_t lo[3] = {c + 3, sy - 8, c - 8}, hi[3] = {c + 24, sy + 8, c + 8};
@@ -325,8 +244,8 @@ static void test_window_shift_at_ratio_2(void **st)
     assert_int_equal(a.stats.windows_moved, moved);
     gsolve_free(&a);
     gsolve_free(&b);
-    free_grid(g1);
-    free_grid(g2);
+    sphere_grid_free(g1);
+    sphere_grid_free(g2);
 }
 
 /* Carving at R = 2 (tool_apply on coefficients 2.5 mm apart) cuts where the grid's carve does. */
@@ -341,7 +260,7 @@ static void test_carve_at_ratio_2(void **st)
     int32_t lo[3], hi[3], rlo[3], rhi[3];
     assert_int_equal(gsolve_carve_sphere(&gs, g, at, radius, lo, hi), ARGIL_OK);
     grid_carve_sphere(ref, at, radius, rlo, rhi);
-    const float y_b = crossing_m(g, 1), y_g = crossing_m(ref, 1);
+    const float y_b = sphere_crossing_m(g, 1), y_g = sphere_crossing_m(ref, 1);
     print_message("# carve at R=2: +y surface %.2f mm (grid carve %.2f mm, sphere %.1f)\n",
                   (double)y_b * 1e3, (double)y_g * 1e3, (double)RAD * 1e3);
     assert_true(hi[0] > lo[0]);
@@ -356,10 +275,10 @@ static void test_carve_at_ratio_2(void **st)
     float dd;
     assert_int_equal(gsolve_refine(&gs, g, &dd, lo, hi), ARGIL_OK);
     assert_true(dd < 1e-5f);
-    assert_true(fabsf(crossing_m(g, 1) - y_b) < 0.05e-3f);
+    assert_true(fabsf(sphere_crossing_m(g, 1) - y_b) < 0.05e-3f);
     gsolve_free(&gs);
-    free_grid(ref);
-    free_grid(g);
+    sphere_grid_free(ref);
+    sphere_grid_free(g);
 }
 
 /* The peer's refine: refused with the springs solve and at R = 1; at R = 2 it halves R. */
@@ -393,7 +312,7 @@ static void test_peer_refine(void **st)
     assert_int_equal(p->stats.refines, 1);
     peer_free(p);
     free(p);
-    free_grid(g);
+    sphere_grid_free(g);
 }
 
 static void test_script_refine_verb(void **st)

@@ -1,7 +1,8 @@
 /* Incremental block meshing: after an edit only the dirty blocks are meshed again and the result
  * equals a from-scratch mesh array for array; the mesh is closed, manifold, shares every vertex
  * across blocks, matches the whole-grid mesher, carries painted colours, and meshes any region
- * at any iso. */
+ * at any iso. The block tables follow the surface: memory does not grow with the box, and a box
+ * grown by clay written outside it re-meshes only the blocks the new clay touches. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -100,7 +101,9 @@ static void test_incremental_equals_full(void **state)
     assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
     assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
     const size_t all_blocks = inc.blocks_meshed;
-    assert_int_equal(all_blocks, inc.n_blocks);
+    assert_int_equal(all_blocks, mc_blocks_box_blocks(&inc)); /* 97 padded cells: 7^3 blocks */
+    assert_int_equal(all_blocks, 343);
+    assert_true(inc.n_blocks * 2 < all_blocks); /* only the blocks the surface crosses keep a slot */
     mesh_t a, b;
     mesh_init(&a);
     mesh_init(&b);
@@ -303,6 +306,164 @@ static void test_errors(void **state)
     mesh_free(&m);
 }
 
+/* Writes a ball of clay (the grid's density profile, max with what is there) and returns its
+ * sample box [lo, hi). */
+static void add_ball(grid_t *g, vec3_t c_m, float r_m, int32_t lo[3], int32_t hi[3])
+{
+    const float cc[3] = {c_m.x, c_m.y, c_m.z}, o[3] = {g->origin_m.x, g->origin_m.y, g->origin_m.z};
+    int32_t n[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = (int32_t)floorf((cc[a] - r_m - g->band_m - o[a]) / g->spacing_m) - 1;
+        hi[a] = (int32_t)ceilf((cc[a] + r_m + g->band_m - o[a]) / g->spacing_m) + 2;
+        n[a] = hi[a] - lo[a];
+    }
+    const size_t cnt = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    float *d = malloc(cnt * sizeof(float));
+    assert_non_null(d);
+    grid_read_box(g, GRID_DENSITY, lo, n, d);
+    size_t i = 0;
+    for (int32_t z = 0; z < n[2]; z++)
+        for (int32_t y = 0; y < n[1]; y++)
+            for (int32_t x = 0; x < n[0]; x++, i++) {
+                const vec3_t p = vec3(o[0] + g->spacing_m * (float)(lo[0] + x),
+                                      o[1] + g->spacing_m * (float)(lo[1] + y),
+                                      o[2] + g->spacing_m * (float)(lo[2] + z));
+                const float v = grid_profile(r_m - vec3_norm(vec3_sub(p, c_m)), g->band_m);
+                d[i] = v > d[i] ? v : d[i];
+            }
+    assert_int_equal(grid_write_box(g, GRID_DENSITY, lo, n, d), ARGIL_OK);
+    free(d);
+}
+
+/* A sphere of r = 30 mm in a 176^3 box: the mesher holds slots only where the surface is, far
+ * below per-block tables over the box; clay written outside the box (past +x and past -z, so
+ * block keys go negative) grows the mesher without a rebuild, re-meshes only the blocks the new
+ * clay touches, and the result is the from-scratch mesh of the grown grid, array for array. */
+static void test_memory_follows_surface_and_growth(void **state)
+{
+    (void)state;
+    grid_t g;
+    make_grid(&g, 176, 1e-3f, 0.030f);
+    mc_blocks_t inc;
+    grid_mesh_view_t view;
+    assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
+    const size_t box_blocks = mc_blocks_box_blocks(&inc);
+    assert_int_equal(box_blocks, 12 * 12 * 12); /* 177 padded cells per axis */
+    assert_int_equal(inc.blocks_meshed, box_blocks);
+    /* Blocks of empty space (grid blocks not held or uniform 0) are skipped unread: 81 read. */
+    assert_true(inc.blocks_read * 10 < box_blocks);
+    /* The tables over the box as they were: one block record and one dirty flag per block. */
+    const size_t dense_tables = box_blocks * (sizeof(mc_block_mesh_t) + 1);
+    const size_t table = inc.cap * sizeof(mc_block_t);
+    assert_true(inc.n_blocks >= 50 && inc.n_blocks <= 120); /* the blocks the shell crosses: 74 */
+    assert_true(table * 4 < dense_tables); /* 18 KB against 98 KB */
+    /* Everything it holds, the sphere's triangles (≈ 1.6 MB of the 1.8) included. */
+    const size_t bytes0 = mc_blocks_bytes(&inc);
+    assert_true(bytes0 < 2200 * 1024);
+    mesh_t a, b;
+    mesh_init(&a);
+    mesh_init(&b);
+    assert_int_equal(mc_blocks_assemble(&inc, &a), ARGIL_OK);
+    const size_t tri0 = a.n_tri;
+    assert_true(tri0 > 15000);
+
+    /* Clay outside the box: a 6 mm ball 40 mm past +x and one 30 mm past -z. */
+    int32_t lo1[3], hi1[3], lo2[3], hi2[3];
+    add_ball(&g, vec3(0.1275f, 0.0f, 0.0f), 0.006f, lo1, hi1);
+    add_ball(&g, vec3(0.0f, 0.01f, -0.1175f), 0.006f, lo2, hi2);
+    assert_true(grid_mesh_view_stale(&view, &g));
+    const size_t slots_before = inc.n_blocks;
+    assert_int_equal(grid_mesh_grow(&inc, &view, &g), ARGIL_OK);
+    assert_false(grid_mesh_view_stale(&view, &g));
+    assert_true(view.lo[2] < -20 && view.hi[0] > 210);
+    grid_mesh_mark(&inc, &view, lo1, hi1);
+    grid_mesh_mark(&inc, &view, lo2, hi2);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
+    /* Each ball's box (25 samples + the normals' halo) spans at most 3 blocks per axis (45 of
+     * the 2700 blocks are meshed). */
+    assert_true(inc.blocks_meshed >= 2 && inc.blocks_meshed <= 2 * 27);
+    const size_t grown_blocks = mc_blocks_box_blocks(&inc);
+    assert_true(grown_blocks * 3 > 4 * box_blocks); /* 225 x 176 x 215 samples: 2700 blocks */
+    assert_true(inc.blocks_meshed * 50 < grown_blocks);
+    assert_true(inc.n_blocks > slots_before && inc.n_blocks <= slots_before + 2 * 27);
+    /* Memory grew by the balls' surfaces only, not with the box (the tables alone would double). */
+    assert_true(mc_blocks_bytes(&inc) < bytes0 + 300 * 1024);
+    assert_true(inc.cap * sizeof(mc_block_t) * 4 < grown_blocks * (sizeof(mc_block_mesh_t) + 1));
+    assert_int_equal(mc_blocks_assemble(&inc, &a), ARGIL_OK);
+    assert_true(a.n_tri > tri0 + 2000);
+
+    /* From scratch over the grown bounds: the same arrays. */
+    mc_blocks_t full;
+    grid_mesh_view_t fview;
+    assert_int_equal(grid_mesh_blocks_init(&full, &fview, &g, 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update_read(&full, grid_mesh_read, &fview), ARGIL_OK);
+    assert_int_equal(full.blocks_meshed, grown_blocks);
+    assert_int_equal(mc_blocks_assemble(&full, &b), ARGIL_OK);
+    assert_same_mesh(&a, &b);
+    assert_closed(&a);
+    /* and the whole-grid mesher on a dense copy sees the same surface */
+    mesh_t w;
+    mesh_init(&w);
+    assert_int_equal(grid_mesh_extract(&g, 0.5f, &w), ARGIL_OK);
+    assert_int_equal(w.n_tri, a.n_tri);
+    assert_int_equal(w.n_vert, a.n_vert);
+    assert_float_equal(mesh_volume_m3(&w), mesh_volume_m3(&a), 1e-12);
+    mesh_free(&w);
+    mesh_free(&a);
+    mesh_free(&b);
+    mc_blocks_free(&inc);
+    mc_blocks_free(&full);
+    grid_free(&g);
+}
+
+/* A block whose surface is carved away gives its slot back; growth past the edge-id span, an
+ * empty box and the dense array after growth are refused; with iso < 0 growth re-meshes all. */
+static void test_slots_released_and_grow_errors(void **state)
+{
+    (void)state;
+    grid_t g;
+    make_grid(&g, 40, 1e-3f, 0.010f);
+    mc_blocks_t inc;
+    grid_mesh_view_t view;
+    assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
+    assert_int_equal(inc.n_blocks, 8); /* 41 padded cells: the sphere's 8 blocks round the centre */
+    int32_t lo[3], hi[3];
+    grid_carve_sphere(&g, vec3(0, 0, 0), 0.019f, lo, hi);
+    grid_mesh_mark(&inc, &view, lo, hi);
+    assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
+    assert_int_equal(inc.blocks_meshed, 27);
+    assert_int_equal(inc.n_blocks, 0);
+    mesh_t m;
+    mesh_init(&m);
+    assert_int_equal(mc_blocks_assemble(&inc, &m), ARGIL_OK);
+    assert_int_equal(m.n_tri, 0);
+    const int32_t far_lo[3] = {0, 0, 0}, far_hi[3] = {MC_BLOCKS_SPAN_MAX + 1, 1, 1};
+    assert_int_equal(mc_blocks_grow(&inc, far_lo, far_hi), ARGIL_ERR_FULL);
+    assert_int_equal(inc.hi[0], 40); /* kept */
+    const int32_t empty_hi[3] = {0, 5, 5};
+    assert_int_equal(mc_blocks_grow(&inc, far_lo, empty_hi), ARGIL_ERR_ARG);
+    mc_blocks_free(&inc);
+
+    const int32_t dims[3] = {4, 4, 4}, glo[3] = {-3, 0, 0}, ghi[3] = {4, 4, 4};
+    float d[64] = {0};
+    d[21] = 1.0f;
+    assert_int_equal(mc_blocks_init(&inc, dims, 1.0f, vec3(0, 0, 0), 0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update(&inc, d, NULL), ARGIL_OK);
+    assert_int_equal(mc_blocks_grow(&inc, glo, ghi), ARGIL_OK);
+    assert_int_equal(mc_blocks_update(&inc, d, NULL), ARGIL_ERR_ARG); /* d holds [0, dims) only */
+    mc_blocks_free(&inc);
+    assert_int_equal(mc_blocks_init(&inc, dims, 1.0f, vec3(0, 0, 0), -0.5f), ARGIL_OK);
+    assert_int_equal(mc_blocks_update(&inc, d, NULL), ARGIL_OK);
+    assert_false(inc.all_dirty);
+    assert_int_equal(mc_blocks_grow(&inc, glo, ghi), ARGIL_OK);
+    assert_true(inc.all_dirty); /* 0 counts as inside: the box's faces moved */
+    mc_blocks_free(&inc);
+    mesh_free(&m);
+    grid_free(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -312,6 +473,8 @@ int main(void)
         cmocka_unit_test(test_painted_colours),
         cmocka_unit_test(test_region_and_iso),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_memory_follows_surface_and_growth),
+        cmocka_unit_test(test_slots_released_and_grow_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -371,6 +371,66 @@ static void test_header_variants_accepted(void **state)
     mesh_free(&m);
 }
 
+/* A mesh with colours: red green blue uchar after the normal (27-byte vertices), read back
+ * exactly; a header whose colour is incomplete names the line; a coloured read leaves no colour
+ * behind in the next, uncoloured one. */
+static void test_colour_round_trip(void **state)
+{
+    fixture_t *f = *state;
+    mesh_t m, back;
+    mesh_init(&m);
+    mesh_init(&back);
+    assert_int_equal(mesh_enable_rgb(&m), ARGIL_OK);
+    for (size_t v = 0; v < f->mesh.n_vert; v++) {
+        const float *p = &f->mesh.pos[3 * v], *n = &f->mesh.normal[3 * v];
+        const uint8_t rgb[3] = {(uint8_t)(v * 7), (uint8_t)(255 - v), (uint8_t)(v * 13 + 1)};
+        assert_int_equal(mesh_add_vertex_rgb(&m, vec3(p[0], p[1], p[2]), vec3(n[0], n[1], n[2]),
+                                             rgb, NULL),
+                         ARGIL_OK);
+    }
+    for (size_t t = 0; t < f->mesh.n_tri; t++)
+        assert_int_equal(mesh_add_triangle(&m, f->mesh.tri[3 * t], f->mesh.tri[3 * t + 1],
+                                           f->mesh.tri[3 * t + 2]),
+                         ARGIL_OK);
+    char err[256] = "";
+    assert_int_equal(ply_write(f->path, &m, err, sizeof(err)), ARGIL_OK);
+    size_t len;
+    unsigned char *buf = slurp(f->path, &len);
+    const char *rgb_props = "property float nz\nproperty uchar red\nproperty uchar green\n"
+                            "property uchar blue\nelement face";
+    assert_non_null(strstr((const char *)buf, rgb_props));
+    const size_t hl = (size_t)(strstr((const char *)buf, "end_header\n") - (char *)buf) + 11;
+    assert_int_equal(len, hl + 27 * m.n_vert + 13 * m.n_tri);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_true(back.has_rgb);
+    assert_int_equal(back.n_vert, m.n_vert);
+    assert_memory_equal(back.pos, m.pos, 3 * sizeof(float) * m.n_vert);
+    assert_memory_equal(back.normal, m.normal, 3 * sizeof(float) * m.n_vert);
+    assert_memory_equal(back.rgb, m.rgb, 3 * m.n_vert);
+    assert_memory_equal(back.tri, m.tri, 3 * sizeof(uint32_t) * m.n_tri);
+    /* the same mesh without colours into the same out: no colour array stays */
+    assert_int_equal(ply_write(f->path, &f->mesh, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_false(back.has_rgb);
+    assert_null(back.rgb);
+    assert_int_equal(back.n_vert, f->mesh.n_vert);
+    mesh_free(&back);
+
+    /* red without green and blue, a wrong colour type, colour cut short by the file's end */
+    char *h = header_for(0, 0), text[1200];
+    char *nz = strstr(h, "property float nz\n") + strlen("property float nz\n");
+    snprintf(text, sizeof(text), "%.*sproperty uchar red\n%s", (int)(nz - h), h, nz);
+    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 12",
+                      "property uchar green");
+    snprintf(text, sizeof(text), "%.*sproperty float red\n%s", (int)(nz - h), h, nz);
+    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 11",
+                      "'property uchar red' or 'element face <count>'");
+    free(h);
+    expect_read_error(f, buf, hl + 27 * m.n_vert - 1, ARGIL_ERR_PARSE, "file too short", NULL);
+    free(buf);
+    mesh_free(&m);
+}
+
 static void test_io_errors(void **state)
 {
     fixture_t *f = *state;
@@ -434,6 +494,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_huge_declared_counts, setup, teardown),
         cmocka_unit_test_setup_teardown(test_bad_records, setup, teardown),
         cmocka_unit_test_setup_teardown(test_header_variants_accepted, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_colour_round_trip, setup, teardown),
         cmocka_unit_test_setup_teardown(test_io_errors, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -3,7 +3,10 @@
  * settling), then undo gives back every coefficient and sample bit for bit, redo likewise; the
  * solver's round-off after an undo does not spoil the next undo or redo; a new stroke clears
  * redo; a small budget drops the oldest strokes; a knot insertion cuts the history; undo off
- * refuses. */
+ * refuses. A press in the air (nothing touched) is no step: undo after it takes back the last
+ * real stroke with its settling. The diff spread over slices between the solver's writes gives
+ * the same journal bytes as the whole diff at once, and an undo asked for in the middle of it is
+ * exact. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -19,6 +22,7 @@
 #include "host/app/session_undo.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
+#include "tests/unit/sphere_grid.h"
 
 #define N 32
 #define H 1.25e-3f
@@ -42,10 +46,7 @@ typedef struct {
 
 static void rig_init(rig_t *r, int32_t ratio, size_t budget)
 {
-    const int32_t dims[3] = {N, N, N};
-    const float o = -0.5f * (float)(N - 1) * H;
-    assert_int_equal(grid_init(&r->g, dims, H, vec3(o, o, o)), ARGIL_OK);
-    grid_fill_sphere(&r->g, vec3(0, 0, 0), R);
+    sphere_grid_init(&r->g, N, H, R);
     assert_int_equal(gsolve_init_ratio(&r->gs, &r->g, ratio), ARGIL_OK);
     assert_int_equal(session_undo_init(&r->su, &r->gs.field, budget), ARGIL_OK);
     assert_true(r->su.on);
@@ -246,6 +247,7 @@ static void test_budget_drops_oldest(void **st_)
     rig_init(&r, 1, 64u << 20);
     stroke(&r, 0);
     assert_int_equal(session_undo_edit_start(&r.su, &r.gs.field), ARGIL_OK);
+    assert_int_equal(session_undo_finish(&r.su, &r.gs.field), ARGIL_OK);
     const size_t one = r.su.stats.last_step_bytes;
     assert_true(one > 1000);
     rig_free(&r);
@@ -259,6 +261,7 @@ static void test_budget_drops_oldest(void **st_)
         state_take(&r, &s[k + 1]);
     }
     assert_int_equal(session_undo_edit_start(&r.su, &r.gs.field), ARGIL_OK);
+    assert_int_equal(session_undo_finish(&r.su, &r.gs.field), ARGIL_OK);
     const size_t held = r.su.u.done; /* steps recorded (a new empty stroke is open) */
     printf("# budget %zu B: %zu of %d strokes kept, %zu B held\n", one * 5 / 2, held, K,
            session_undo_bytes(&r.su));
@@ -298,6 +301,173 @@ static void test_knot_insertion_cuts_history(void **st_)
     rig_free(&r);
 }
 
+/* As the session drives it: implicit steps (force_n inward at `at`, 0: the clay moves on by
+ * itself), each after one slice of the pending diff (when slice) and the copy aside that comes
+ * before any write. */
+static void steps_sliced(rig_t *r, vec3_t at, float force_n, int steps, bool slice)
+{
+    for (int k = 0; k < steps; k++) {
+        if (slice)
+            (void)session_undo_slice(&r->su, &r->gs.field);
+        session_undo_before_write(&r->su, &r->gs.field);
+        dynamics(r, at, force_n, 1);
+    }
+}
+
+/* A press of button 1 (not an edit) whose stroke touches the clay (touch) or not. */
+static void press_stroke(rig_t *r, int k, bool touch, bool slice)
+{
+    assert_int_equal(session_undo_press(&r->su, &r->gs.field), ARGIL_OK);
+    const float ang = 0.9f * (float)k;
+    const vec3_t at = vec3(R * cosf(ang), R * sinf(ang), -0.2f * R);
+    if (touch) {
+        session_undo_touched(&r->su);
+        session_undo_before_write(&r->su, &r->gs.field);
+        tool(r, k % 2 ? HOST_ACT_ADD : HOST_ACT_CARVE, at, 3e-3f);
+        steps_sliced(r, at, -2.0f, 3, slice);
+    }
+    steps_sliced(r, at, 0.0f, 3, slice);
+}
+
+static void test_air_press_is_no_step(void **st_)
+{
+    (void)st_;
+    rig_t r;
+    rig_init(&r, 1, 16u << 20);
+    state_t s0, s1;
+    state_take(&r, &s0);
+    press_stroke(&r, 0, true, true);
+    state_take(&r, &s1);
+    assert_true(state_diff(&r, &s0) > 100);
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    /* a press in the air: the clay settles on (the last stroke's), nothing more to undo */
+    press_stroke(&r, 1, false, true);
+    assert_true(state_diff(&r, &s1) > 0); /* the clay did move on */
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    press_stroke(&r, 2, false, true); /* the air press is sealed: joined to the stroke */
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    assert_int_equal(session_undo_finish(&r.su, &r.gs.field), ARGIL_OK);
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    printf("# after a stroke and 2 presses in the air: %zu step to undo, %u recorded, %u air\n",
+           session_undo_undo_count(&r.su), r.su.stats.steps, r.su.stats.air_presses);
+    assert_int_equal(r.su.stats.air_presses, 1); /* the second is still open */
+    assert_int_equal(r.su.stats.steps, 1);
+    state_t s2;
+    state_take(&r, &s2);
+    /* undo takes back the stroke and everything after it: the start */
+    assert_int_equal(step(&r, false), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s0), 0);
+    assert_int_equal(session_undo_undo_count(&r.su), 0);
+    assert_int_equal(session_undo_redo_count(&r.su), 1);
+    assert_int_equal(step(&r, false), ARGIL_ERR_EMPTY);
+    /* redo brings back the stroke with its settling, to the last boundary */
+    assert_int_equal(step(&r, true), ARGIL_OK);
+    assert_int_equal(session_undo_redo_count(&r.su), 0);
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    assert_int_equal(step(&r, false), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s0), 0);
+    /* a press in the air after an undo: still nothing to undo; the next real stroke is one */
+    press_stroke(&r, 3, false, true);
+    press_stroke(&r, 4, false, true);
+    assert_int_equal(session_undo_undo_count(&r.su), 0);
+    assert_int_equal(step(&r, false), ARGIL_ERR_EMPTY);
+    press_stroke(&r, 5, false, true);
+    press_stroke(&r, 6, true, true);
+    assert_int_equal(session_undo_undo_count(&r.su), 1);
+    assert_int_equal(step(&r, false), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s0), 0);
+    state_free(&s0);
+    state_free(&s1);
+    state_free(&s2);
+    rig_free(&r);
+}
+
+/* The journal bytes of every step held. */
+static size_t journal_bytes(const rig_t *r, uint8_t *out, size_t cap)
+{
+    const undo_t *u = &r->su.u;
+    size_t n = 0;
+    for (size_t i = 0; i < u->nsteps; i++) {
+        const undo_step_t *st = &u->steps[i];
+        assert_true(n + st->len <= cap);
+        for (size_t b = 0; b < st->len; b++)
+            out[n + b] = u->ring[(st->off + b) % u->ring_cap];
+        n += st->len;
+    }
+    return n;
+}
+
+static void test_sliced_diff_is_the_whole_diff(void **st_)
+{
+    (void)st_;
+    enum { K = 4 };
+    rig_t a, b;
+    rig_init(&a, 1, 16u << 20);
+    rig_init(&b, 1, 16u << 20);
+    uint32_t max_slices = 0;
+    for (int k = 0; k < K; k++) {
+        /* a: the whole diff at the press; b: a slice before each implicit step */
+        press_stroke(&a, k, true, false);
+        assert_int_equal(session_undo_finish(&a.su, &a.gs.field), ARGIL_OK);
+        const uint32_t s0 = b.su.stats.slices;
+        press_stroke(&b, k, true, true);
+        if (b.su.stats.slices - s0 > max_slices)
+            max_slices = b.su.stats.slices - s0;
+    }
+    assert_int_equal(session_undo_press(&a.su, &a.gs.field), ARGIL_OK);
+    assert_int_equal(session_undo_finish(&a.su, &a.gs.field), ARGIL_OK);
+    assert_int_equal(session_undo_press(&b.su, &b.gs.field), ARGIL_OK);
+    uint32_t tail = 0;
+    while (session_undo_slice(&b.su, &b.gs.field))
+        tail++;
+    printf("# %u steps, %zu B; sliced: up to %u slices a stroke, the last step %u more, %u blocks "
+           "copied aside\n", b.su.stats.steps, b.su.u.bytes, max_slices, tail + 1,
+           b.su.stats.copied_blocks);
+    assert_int_equal(a.su.stats.steps, K);
+    assert_int_equal(b.su.stats.steps, K);
+    assert_true(b.su.stats.copied_blocks > 0); /* writes came while the diff was pending */
+    assert_true(tail > 0);                     /* and it took several slices */
+    const size_t cap = 16u << 20;
+    uint8_t *ja = malloc(cap), *jb = malloc(cap);
+    assert_non_null(ja);
+    assert_non_null(jb);
+    const size_t na = journal_bytes(&a, ja, cap), nb = journal_bytes(&b, jb, cap);
+    assert_int_equal(na, nb);
+    assert_true(na > 10000);
+    assert_memory_equal(ja, jb, na);
+    free(ja);
+    free(jb);
+    rig_free(&a);
+    rig_free(&b);
+}
+
+static void test_undo_in_the_middle_of_the_slices(void **st_)
+{
+    (void)st_;
+    rig_t r;
+    rig_init(&r, 1, 16u << 20);
+    state_t s0, s1;
+    state_take(&r, &s0);
+    press_stroke(&r, 0, true, false);
+    state_take(&r, &s1);
+    /* the next press seals stroke 0: one slice, then the clay is written again */
+    assert_int_equal(session_undo_press(&r.su, &r.gs.field), ARGIL_OK);
+    session_undo_touched(&r.su);
+    assert_true(session_undo_slice(&r.su, &r.gs.field));
+    assert_true(r.su.pend_open && r.su.pend_next < r.su.npend);
+    steps_sliced(&r, vec3(0, R, 0), -2.0f, 2, false);
+    assert_true(r.su.pend_open); /* still pending: the undo finishes it first */
+    assert_int_equal(step(&r, false), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s1), 0);
+    assert_int_equal(step(&r, false), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s0), 0);
+    assert_int_equal(step(&r, true), ARGIL_OK);
+    assert_int_equal(state_diff(&r, &s1), 0);
+    state_free(&s0);
+    state_free(&s1);
+    rig_free(&r);
+}
+
 static void test_off(void **st_)
 {
     (void)st_;
@@ -325,6 +495,9 @@ int main(void)
         cmocka_unit_test(test_undo_redo_bit_exact),
         cmocka_unit_test(test_budget_drops_oldest),
         cmocka_unit_test(test_knot_insertion_cuts_history),
+        cmocka_unit_test(test_air_press_is_no_step),
+        cmocka_unit_test(test_sliced_diff_is_the_whole_diff),
+        cmocka_unit_test(test_undo_in_the_middle_of_the_slices),
         cmocka_unit_test(test_off),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
