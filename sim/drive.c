@@ -8,7 +8,7 @@
 
 void drive_cfg_default(drive_cfg_t *cfg)
 {
-    cfg->heartbeat_period_us = 100000u;
+    cfg->heartbeat_period_us = ARGIL_DRIVE_HEARTBEAT_PERIOD_US;
     cfg->rated_torque_nm = 0.030f;
     cfg->peak_torque_nm = cfg->rated_torque_nm * (float)ARM_PEAK_TORQUE_PERMILLE / 1000.0f;
     cfg->quick_stop_us = 10000u;

@@ -7,12 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shared/argil_limits.h"
+
 const board_setting_t board_settings[] = {
     {"can", "bus", "bus", "socketcan|sim",
      "drive bus: the SocketCAN interface, or the simulated arm (no hardware)"},
     {"can", "interface", "can", "IF", "SocketCAN interface of the drives (can0)"},
     {"can", "heartbeat_timeout_ms", "drive-heartbeat-ms", "MS",
-     "heartbeat consumer time per drive; drives produce every 100 ms (150)"},
+     "heartbeat consumer time per drive; drives produce every 100 ms: 2 periods + margin (250)"},
     {"can", "bus_recovery_ms", "bus-recovery-ms", "MS",
      "bus-off must be restarted (restart-ms) within this, else exit for a restart (500)"},
     {"gpio", "chip", "gpio-chip", "CHIP", "GPIO chip: name, path, label or number (gpiochip0)"},
@@ -60,7 +62,7 @@ void board_config_default(board_daemon_cfg_t *c)
     memset(c, 0, sizeof(*c));
     c->bus = BOARD_BUS_SOCKETCAN;
     copy_str(c->can_if, sizeof(c->can_if), "can0");
-    c->drive_heartbeat_ms = 150;
+    c->drive_heartbeat_ms = ARGIL_DRIVE_HEARTBEAT_CONSUMER_US / 1000u;
     c->bus_recovery_ms = 500;
     gpio_names_default(&c->gpio);
     c->link = BOARD_LINK_UDP;

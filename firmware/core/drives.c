@@ -4,7 +4,7 @@
 
 void drives_cfg_default(drives_cfg_t *cfg)
 {
-    cfg->heartbeat_timeout_us = 150000u;
+    cfg->heartbeat_timeout_us = ARGIL_DRIVE_HEARTBEAT_CONSUMER_US;
     cfg->bus_passive_fault_us = 100000u;
     cfg->bus_recovery_us = 500000u;
 }

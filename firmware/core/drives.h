@@ -28,8 +28,9 @@ typedef enum {
 } can_bus_state_t;
 
 typedef struct {
-    uint32_t heartbeat_timeout_us;   /* consumer time per drive; drives produce every 100 ms,
-                                        so the default is 150 ms (one late heartbeat tolerated) */
+    uint32_t heartbeat_timeout_us;   /* consumer time per drive (CiA 301 0x1016); default
+                                        ARGIL_DRIVE_HEARTBEAT_CONSUMER_US (250 ms for drives
+                                        beating every 100 ms: one lost heartbeat tolerated) */
     uint32_t bus_passive_fault_us;   /* error-passive this long is a fault (default 100 ms) */
     uint32_t bus_recovery_us;        /* bus-off not restarted within this is unrecoverable
                                         (default 500 ms); the owner then gives up */

@@ -121,21 +121,51 @@ static void test_quick_stop_and_fault_reset(void **st)
     assert_int_equal(seen[2], CIA402_CW_FAULT_RESET);
 }
 
-static void test_heartbeat_consumer_150ms(void **st)
+/* 1 ms ticks of the CiA 402 master; returns the tick (1-based) at which a heartbeat was first
+ * reported lost, 0 if none. Drive 2 beats every 100 ms except at the beats in skip[]; the others
+ * beat every 100 ms. */
+static int ticks_until_lost(int ticks, const int *skip, int n_skip)
 {
-    (void)st;
     drives_t dr;
-    drives_cfg_default(&cfg);
     drives_init(&dr);
     heartbeat_all(&dr, NMT_STATE_OPERATIONAL);
     can_batch_t tx = {0};
-    for (int ms = 0; ms < 150; ms++) {
+    for (int ms = 1; ms <= ticks; ms++) {
+        if (ms % 100 == 0) {
+            bool skipped = false;
+            for (int k = 0; k < n_skip; k++)
+                skipped |= skip[k] == ms / 100;
+            can_frame_t f;
+            for (uint8_t n = 1; n <= ARGIL_DRIVES; n++) {
+                canopen_heartbeat_encode(&f, n, NMT_STATE_OPERATIONAL);
+                if (n != 2 || !skipped)
+                    rx_frame(&dr, &f);
+            }
+        }
+        if (drives_heartbeat_lost(&dr, &cfg))
+            return ms;
         tx.n = 0;
         drives_process(&dr, &cfg, false, torque, 1000, &tx);
     }
-    assert_false(drives_heartbeat_lost(&dr, &cfg)); /* exactly 150 ms: still fine */
-    drives_process(&dr, &cfg, false, torque, 1000, &tx);
-    assert_true(drives_heartbeat_lost(&dr, &cfg));
+    return 0;
+}
+
+/* CiA 301 practice: a consumer time of two producer periods plus margin (250 ms for 100 ms
+ * beats), so one lost heartbeat never faults and two in a row do before the third is due. */
+static void test_heartbeat_consumer_rides_one_lost_beat(void **st)
+{
+    (void)st;
+    drives_cfg_default(&cfg);
+    assert_int_equal(cfg.heartbeat_timeout_us, 250000u);
+    assert_int_equal(ticks_until_lost(2000, NULL, 0), 0);
+    /* one lost beat, and one lost beat every other beat: never a fault */
+    static const int one[] = {3}, every_other[] = {2, 4, 6, 8, 10, 12, 14, 16, 18};
+    assert_int_equal(ticks_until_lost(2000, one, 1), 0);
+    assert_int_equal(ticks_until_lost(2000, every_other, 9), 0);
+    /* beats 3 and 4 lost: the last one received was at 200 ms; lost at 200 + 250 ms + one
+     * tick (the age must exceed the consumer time), before beat 5 at 500 ms */
+    static const int two[] = {3, 4};
+    assert_int_equal(ticks_until_lost(2000, two, 2), 451);
 }
 
 static void test_emcy_latched_and_classified(void **st)
@@ -274,7 +304,7 @@ int main(void)
         cmocka_unit_test(test_nmt_start_then_power_walk),
         cmocka_unit_test(test_quick_stop_and_fault_reset),
         cmocka_unit_test(test_fault_reset_while_off_is_bounded),
-        cmocka_unit_test(test_heartbeat_consumer_150ms),
+        cmocka_unit_test(test_heartbeat_consumer_rides_one_lost_beat),
         cmocka_unit_test(test_emcy_latched_and_classified),
         cmocka_unit_test(test_bus_passive_off_and_recovery),
         cmocka_unit_test(test_shutdown_frames),
