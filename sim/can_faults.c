@@ -10,13 +10,14 @@
 void can_faults_init(can_faults_t *cf)
 {
     memset(cf, 0, sizeof(*cf));
-    cf->rng = 1u;
+    cf->seed = 1u;
 }
 
 void can_faults_set_drop(can_faults_t *cf, uint32_t ppm, uint32_t seed)
 {
     cf->drop_ppm = ppm > 1000000u ? 1000000u : ppm;
-    cf->rng = seed != 0 ? seed : 1u;
+    cf->seed = seed != 0 ? seed : 1u;
+    memset(cf->frames_seen, 0, sizeof(cf->frames_seen));
 }
 
 void can_faults_set_delay(can_faults_t *cf, int64_t delay_us)
@@ -54,17 +55,28 @@ void can_faults_encoder_jump(can_faults_t *cf, int node, int32_t counts)
         cf->encoder_offset_counts[node - 1] += counts;
 }
 
-/* xorshift32 (Marsaglia 2003): true with probability ppm / 1e6. */
-static bool drop_now(can_faults_t *cf)
+/* MurmurHash3's 32-bit finaliser (Appleby): every input bit reaches every output bit. */
+static uint32_t mix32(uint32_t h)
+{
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    h ^= h >> 16;
+    return h;
+}
+
+/* True with probability ppm / 1e6 for the n-th frame of this CAN id in this direction since
+ * the drop began: a function of (seed, direction, id, n) alone, so the same frames are lost
+ * whatever order the two directions' frames interleave in (SIL, argil-sim on a bus). */
+static bool drop_now(can_faults_t *cf, int dir, uint32_t id)
 {
     if (cf->drop_ppm == 0)
         return false;
-    uint32_t x = cf->rng;
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    cf->rng = x;
-    return x % 1000000u < cf->drop_ppm;
+    uint32_t *const n = &cf->frames_seen[dir][id & CAN_FAULTS_ID_MASK];
+    (*n)++;
+    const uint32_t h = mix32(cf->seed ^ mix32((uint32_t)dir << 27 ^ (id & CAN_FAULTS_ID_MASK) << 16 ^ *n));
+    return h % 1000000u < cf->drop_ppm;
 }
 
 /* Holds f until due_us, or passes it when there is no delay; counts an overflow. */
@@ -145,7 +157,7 @@ void can_faults_to_board(can_faults_t *cf, const can_batch_t *in, can_batch_t *o
             const int32_t pc = p > INT32_MAX ? INT32_MAX : p < INT32_MIN ? INT32_MIN : (int32_t)p;
             canopen_tpdo_encode(&f, node, sw, pc, tq);
         }
-        if (drop_now(cf)) {
+        if (drop_now(cf, 0, f.id)) {
             cf->dropped_to_board++;
             continue;
         }
@@ -165,7 +177,7 @@ void can_faults_from_board(can_faults_t *cf, const can_batch_t *in, can_batch_t 
             cf->silenced++;
             continue;
         }
-        if (drop_now(cf)) {
+        if (drop_now(cf, 1, f->id)) {
             cf->dropped_from_board++;
             continue;
         }

@@ -12,6 +12,7 @@
 #include "shared/canopen.h"
 
 #define CAN_FAULTS_HELD_MAX 256u   /* frames in flight per direction while delayed */
+#define CAN_FAULTS_ID_MASK 0x7FFu  /* 11-bit CAN ids: frames are counted per id */
 
 typedef struct {
     int64_t due_us;
@@ -25,7 +26,9 @@ typedef struct {
 
 typedef struct {
     uint32_t drop_ppm;             /* probability of dropping a frame, parts per million */
-    uint32_t rng;                  /* xorshift32 state */
+    uint32_t seed;                 /* the drop's seed */
+    uint32_t frames_seen[2][CAN_FAULTS_ID_MASK + 1u]; /* per direction (0: to the board) and id,
+                                      frames since the drop began */
     int64_t delay_us;              /* frames are held this long, both directions */
     bool bus_off;                  /* the device side is off the bus: nothing flows */
     bool bus_off_frame_due;        /* the board still has to get the bus-off error frame */
@@ -45,8 +48,9 @@ typedef struct {
 /* No faults: every frame passes at once. */
 void can_faults_init(can_faults_t *cf);
 
-/* Drops each frame, either direction, with probability ppm / 1e6 from a PRNG seeded with seed
- * (0 is taken as 1). ppm 0 stops dropping. */
+/* Drops each frame, either direction, with probability ppm / 1e6: whether the n-th frame of a
+ * CAN id is lost depends only on (seed, direction, id, n) (0 is taken as seed 1), so a seed
+ * loses the same frames in SIL and on a bus. ppm 0 stops dropping. */
 void can_faults_set_drop(can_faults_t *cf, uint32_t ppm, uint32_t seed);
 
 /* Holds every frame, either direction, for delay_us; 0 releases the held frames at the next

@@ -57,6 +57,36 @@ static void test_drop_rate_follows_the_percentage(void **st)
     assert_in_range(cf.dropped_from_board - before, 19000u, 21000u);
 }
 
+/* Which frames a seed loses does not depend on how the two directions' frames interleave, nor
+ * on other ids' traffic: the n-th heartbeat of drive 2 is lost, or not, in SIL and on a bus
+ * alike. */
+static void test_drop_is_per_frame_not_per_draw(void **st)
+{
+    (void)st;
+    static can_faults_t a, b;
+    can_faults_init(&a);
+    can_faults_init(&b);
+    can_faults_set_drop(&a, 100000u, 7u);
+    can_faults_set_drop(&b, 100000u, 7u);
+    const can_batch_t hb = batch_of(0x702, 1), tpdo = batch_of(0x182, 3), rpdo = batch_of(0x202, 2);
+    bool lost_a[400], lost_b[400];
+    uint32_t lost = 0;
+    for (int k = 0; k < 400; k++) {
+        can_batch_t out;
+        /* a: only heartbeats; b: heartbeats among TPDOs one way and RPDOs the other */
+        can_faults_to_board(&a, &hb, &out, k * 1000);
+        lost_a[k] = out.n == 0;
+        can_faults_from_board(&b, &rpdo, &out, k * 1000);
+        if (k % 3 == 0)
+            can_faults_to_board(&b, &tpdo, &out, k * 1000);
+        can_faults_to_board(&b, &hb, &out, k * 1000);
+        lost_b[k] = out.n == 0;
+        lost += lost_a[k];
+    }
+    assert_memory_equal(lost_a, lost_b, sizeof(lost_a));
+    assert_in_range(lost, 20u, 60u); /* 10 % of 400 */
+}
+
 static void test_delay_holds_frames_in_order(void **st)
 {
     (void)st;
@@ -202,6 +232,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_drop_rate_follows_the_percentage),
+        cmocka_unit_test(test_drop_is_per_frame_not_per_draw),
         cmocka_unit_test(test_delay_holds_frames_in_order),
         cmocka_unit_test(test_bus_off_heartbeat_and_encoder),
         cmocka_unit_test(test_runner_applies_steps_on_time),
