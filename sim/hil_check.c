@@ -12,6 +12,7 @@
 void hil_obs_init(hil_obs_t *o)
 {
     memset(o, 0, sizeof(*o));
+    o->heartbeat_ticks = ARGIL_DRIVE_HEARTBEAT_CONSUMER_US / HIL_TICK_US;
 }
 
 void hil_obs_free(hil_obs_t *o)
@@ -352,13 +353,44 @@ hil_err_t hil_obs_add_events(hil_obs_t *o, const scenario_t *s, const char *text
     return HIL_OK;
 }
 
-/* Absolute time of scenario time t_us: the logged injection of a step at exactly that time,
- * else the rig's mark of that time, else start + t. */
+static bool is_sync(const hil_frame_t *h);
+
+/* The step scenario time t_us is anchored on: one at exactly t_us whose injection the log holds,
+ * else the latest such step before t_us; -1 when none. */
+static int anchor_step(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
+{
+    int best = -1;
+    for (uint32_t i = 0; i < s->n_steps; i++) {
+        if (!o->step_seen[i] || s->step[i].t_us > t_us)
+            continue;
+        if (s->step[i].t_us == t_us)
+            return (int)i;
+        if (best < 0 || s->step[i].t_us >= s->step[best].t_us)
+            best = (int)i;
+    }
+    return best;
+}
+
+/* Absolute time of scenario time t_us: the logged injection of a step at exactly that time;
+ * else, on a log with SYNCs, as many board ticks after the latest step's injection as the
+ * scenario puts between them (each side's injection is stamped when it acted, so a rig whose
+ * sides run a few ticks apart is judged from what the board could see); else the rig's mark
+ * of that time; else start + t. */
 static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
 {
-    for (uint32_t i = 0; i < s->n_steps; i++)
-        if (s->step[i].t_us == t_us && o->step_seen[i])
-            return o->step_us[i];
+    const int a = anchor_step(s, o, t_us);
+    if (a >= 0 && s->step[a].t_us == t_us)
+        return o->step_us[a];
+    if (a >= 0 && o->n_syncs > 0) {
+        const int64_t want = (t_us - s->step[a].t_us) / HIL_TICK_US;
+        int64_t n = 0;
+        if (want == 0)
+            return o->step_us[a];
+        for (size_t k = 0; k < o->n_frames; k++)
+            if (o->frame[k].t_us > o->step_us[a] && is_sync(&o->frame[k]) && ++n == want)
+                return o->frame[k].t_us;
+        /* the log ends first: the marks below */
+    }
     for (uint32_t m = 0; m < o->n_marks; m++) {
         if (o->mark_t_us[m] != t_us)
             continue;
@@ -376,10 +408,8 @@ static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
  * it only once the host link has delivered it. */
 static bool host_anchored(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
 {
-    for (uint32_t i = 0; i < s->n_steps; i++)
-        if (s->step[i].t_us == t_us && o->step_seen[i])
-            return scenario_action_is_host_side(s->step[i].action);
-    return false;
+    const int a = anchor_step(s, o, t_us);
+    return a >= 0 && scenario_action_is_host_side(s->step[a].action);
 }
 
 /* DRIVE_ENABLE level just before t (taken as high when nothing was logged before). */
@@ -477,6 +507,99 @@ static const char *bnd(char *buf, size_t n, const hil_obs_t *o, int64_t within_u
     return buf;
 }
 
+/* The heartbeat consumer from the bus's side (heartbeat_supervised, [t0, t_end)). A heartbeat
+ * on the bus at h is read by the board in the tick that ends with the first SYNC after h, or
+ * one tick later when it arrived after that tick's read; the board faults in the tick whose age
+ * exceeds C = heartbeat_ticks ticks: with a the SYNCs since a drive's last heartbeat, its RPDOs
+ * go off at a = C + 1, or C + 2 after a late read. A tick either way for the log's order of
+ * frames from two senders: drives off while every a < C is a spurious fault, drives on with
+ * some a > C + 2 a missed one; once off they stay off. Needs SYNCs. */
+static void check_heartbeat_supervised(const hil_obs_t *o, int64_t t0, int64_t t_end,
+                                       hil_result_t *r)
+{
+    const int64_t c = o->heartbeat_ticks, period = ARGIL_DRIVE_HEARTBEAT_PERIOD_US / HIL_TICK_US;
+    if (o->n_syncs == 0) {
+        snprintf(r->msg, sizeof(r->msg), "the log has no SYNC: heartbeat ages need board ticks");
+        return;
+    }
+    int64_t syncs = 0, last_hb[ARGIL_DRIVES] = {-1, -1, -1}, widest = 0, t_off = -1;
+    size_t rpdos = 0;
+    for (size_t k = 0; k < o->n_frames && o->frame[k].t_us < t_end; k++) {
+        const hil_frame_t *h = &o->frame[k];
+        uint8_t node;
+        nmt_state_t st;
+        uint16_t cw;
+        int16_t tq;
+        if (is_sync(h)) {
+            syncs++;
+            continue;
+        }
+        if ((h->f.id & ERR_FLAG) == 0 && canopen_heartbeat_decode(&h->f, &node, &st) &&
+            node >= 1 && node <= ARGIL_DRIVES) {
+            const int64_t gap = last_hb[node - 1] < 0 ? 0 : syncs - last_hb[node - 1];
+            if (h->t_us >= t0 && gap >= period + period / 2 && gap <= c)
+                r->tolerated++; /* a lost heartbeat (or a late one) the board must ride */
+            last_hb[node - 1] = syncs;
+            continue;
+        }
+        if (h->t_us < t0 || !rpdo(h, &node, &cw, &tq))
+            continue;
+        rpdos++;
+        int64_t age = 0;
+        int oldest = 0;
+        for (int j = 0; j < ARGIL_DRIVES; j++)
+            if (last_hb[j] >= 0 && syncs - last_hb[j] > age) {
+                age = syncs - last_hb[j];
+                oldest = j + 1;
+            }
+        if (age > widest)
+            widest = age;
+        const bool on = cw == CIA402_CW_ENABLE_OP;
+        if (t_off >= 0) {
+            if (on || tq != 0) {
+                r->observed_us = h->t_us - t0;
+                snprintf(r->msg, sizeof(r->msg), "drive %u: controlword 0x%04X torque %d at "
+                         "+%.3f ms after the drives went off at +%.3f ms", node, cw, tq,
+                         MS(h->t_us - t0), MS(t_off - t0));
+                return;
+            }
+            continue;
+        }
+        if (!on && age < c) {
+            r->observed_us = h->t_us - t0;
+            snprintf(r->msg, sizeof(r->msg), "drives off at +%.3f ms (drive %u: controlword "
+                     "0x%04X) with every heartbeat under %lld ticks old (oldest %lld)",
+                     MS(h->t_us - t0), node, cw, (long long)c, (long long)age);
+            return;
+        }
+        if (on && age > c + 2) {
+            r->observed_us = h->t_us - t0;
+            snprintf(r->msg, sizeof(r->msg), "drive %d's last heartbeat %lld ticks old "
+                     "(consumer %lld) and drives still on at +%.3f ms", oldest, (long long)age,
+                     (long long)c, MS(h->t_us - t0));
+            return;
+        }
+        if (!on) {
+            t_off = h->t_us;
+            r->observed_us = h->t_us - t0;
+            r->observed_ticks = age;
+        }
+    }
+    if (rpdos == 0) {
+        snprintf(r->msg, sizeof(r->msg), "no RPDO in the window: nothing ran");
+        return;
+    }
+    r->pass = true;
+    if (t_off >= 0)
+        snprintf(r->msg, sizeof(r->msg), "%u lost heartbeat(s) ridden; off at +%.3f ms, %lld "
+                 "ticks after a drive's last heartbeat (consumer %lld), and stayed off",
+                 r->tolerated, MS(t_off - t0), (long long)r->observed_ticks, (long long)c);
+    else
+        snprintf(r->msg, sizeof(r->msg), "%u lost heartbeat(s) ridden, on throughout: widest "
+                 "heartbeat age %lld ticks (consumer %lld, %zu RPDOs)", r->tolerated,
+                 (long long)widest, (long long)c, rpdos);
+}
+
 void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_result_t *r)
 {
     const scn_expect_t *e = &s->expect[i];
@@ -490,6 +613,7 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
     r->pass = false;
     r->observed_us = -1;
     r->observed_ticks = -1;
+    r->tolerated = 0;
     size_t rpdos = 0;
     uint8_t node;
     uint16_t cw;
@@ -533,8 +657,10 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                 const hil_gpio_t *g = &o->gpio[k];
                 if (g->t_us < t0 || g->t_us >= t_end)
                     continue;
-                if (!g->drive_enable && level) /* the earliest the edge can have been */
-                    t_low = g->prev_us >= t0 ? g->prev_us + 1 : g->t_us;
+                /* the earliest the edge can have been: just after the sample before, or t0
+                 * itself when that sample was taken before t0 (unknown: the sample's time) */
+                if (!g->drive_enable && level)
+                    t_low = g->prev_us >= t0 ? g->prev_us + 1 : g->prev_us >= 0 ? t0 : g->t_us;
                 if (g->drive_enable) {
                     snprintf(r->msg, sizeof(r->msg), "DRIVE_ENABLE back high at +%.3f ms",
                              MS(g->t_us - t0));
@@ -712,6 +838,9 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
             snprintf(r->msg, sizeof(r->msg), "ran without a fault (%zu RPDOs)", rpdos);
         return;
     }
+    case SCN_EXP_HEARTBEAT_SUPERVISED:
+        check_heartbeat_supervised(o, t0, t_end, r);
+        return;
     default:
         snprintf(r->msg, sizeof(r->msg), "unknown expectation");
         return;

@@ -37,6 +37,8 @@ typedef struct {
     int64_t start_us;              /* scenario time 0 */
     bool step_seen[SCN_STEPS_MAX];
     int64_t step_us[SCN_STEPS_MAX]; /* when each scenario step was injected */
+    uint32_t heartbeat_ticks;      /* the board's drive heartbeat consumer time in ticks
+                                      (hil_obs_init: ARGIL_DRIVE_HEARTBEAT_CONSUMER_US) */
     uint32_t link_ticks;           /* set by the caller: board ticks the host link may take to
                                       deliver a host-side step (UDP, link thread, ring); added
                                       to the bounds of expectations anchored on one */
@@ -94,6 +96,8 @@ typedef struct {
     bool pass;
     int64_t observed_us;           /* latency from the expectation's time, −1 when not seen */
     int64_t observed_ticks;        /* the same in board ticks (SYNCs), −1 when not counted */
+    uint32_t tolerated;            /* heartbeat_supervised: heartbeat gaps longer than one
+                                      producer period that the board rode through */
     char msg[160];                 /* one line: what was seen */
 } hil_result_t;
 

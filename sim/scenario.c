@@ -22,7 +22,7 @@ static const char *const action_names[SCN_ACTION_COUNT] = {
 
 static const char *const expect_names[SCN_EXP_COUNT] = {
     "torque_zero", "force_zero", "quick_stop", "fault", "enabled", "torque_nonzero",
-    "no_torque_frames", "running", "safe"};
+    "no_torque_frames", "running", "safe", "heartbeat_supervised"};
 
 const char *scenario_action_name(scn_action_t a)
 {
@@ -362,7 +362,7 @@ static scn_err_t parse_expect(const words_t *w, uint32_t line, scn_expect_t *e,
     if (e->kind == SCN_EXP_COUNT)
         return fail(err, SCN_ERR_EXPECT, line, "unknown expectation '%s'", w->w[3]);
     const bool needs_until = e->kind == SCN_EXP_NO_TORQUE_FRAMES || e->kind == SCN_EXP_RUNNING ||
-                             e->kind == SCN_EXP_SAFE;
+                             e->kind == SCN_EXP_SAFE || e->kind == SCN_EXP_HEARTBEAT_SUPERVISED;
     if (w->n < 6)
         return fail(err, SCN_ERR_EXPECT, line, "'%s' needs 'within D' or 'until X'", w->w[3]);
     e->within_us = 0;

@@ -89,6 +89,10 @@ typedef enum {
     SCN_EXP_RUNNING,         /* drives stay enabled, no DRIVE_ENABLE drop (until …) */
     SCN_EXP_SAFE,            /* once a drive is commanded off or DRIVE_ENABLE drops, no
                                 non-zero torque follows (until …): the fault latches */
+    SCN_EXP_HEARTBEAT_SUPERVISED, /* the drive heartbeat consumer as required, judged from the
+                                heartbeats on the bus: drives stay enabled while every drive's
+                                last heartbeat is within the consumer time, are off once one is
+                                surely past it, and stay off (until …) */
     SCN_EXP_COUNT
 } scn_expect_kind_t;
 

@@ -53,29 +53,39 @@ static char *slurp(const char *path, size_t *len)
 int main(int argc, char **argv)
 {
     if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
-        puts("usage: argil-hil-check [--link-ticks N] SCENARIO CANDUMP_LOG EVENT_LOG\n"
+        puts("usage: argil-hil-check [--link-ticks N] [--heartbeat-ticks N] SCENARIO CANDUMP_LOG "
+             "EVENT_LOG\n"
              "  Checks each expectation of SCENARIO (hil/scenarios/*.scn) against a candump -l\n"
              "  log and argil-sim's event log; prints one line per expectation and\n"
              "  'N passed, N failed'. Exit 0 all passed, 1 some failed, 2 bad usage or input.\n"
              "  --link-ticks N  board ticks (0-50, default 0) the host link may take to deliver a\n"
-             "                  host-side step: added to the bounds anchored on one");
+             "                  host-side step: added to the bounds anchored on one\n"
+             "  --heartbeat-ticks N  the board's drive heartbeat consumer time in ticks (10-10000,\n"
+             "                  default 250) for heartbeat_supervised");
         return 0;
     }
-    uint32_t link_ticks = 0;
-    if (argc == 6 && strcmp(argv[1], "--link-ticks") == 0) {
+    uint32_t link_ticks = 0, heartbeat_ticks = 0;
+    while (argc >= 3 && (strcmp(argv[1], "--link-ticks") == 0 ||
+                         strcmp(argv[1], "--heartbeat-ticks") == 0)) {
+        const bool link = strcmp(argv[1], "--link-ticks") == 0;
+        const long lo = link ? 0 : 10, hi = link ? 50 : 10000;
         char *end = NULL;
         const long v = strtol(argv[2], &end, 10);
-        if (end == argv[2] || *end != '\0' || v < 0 || v > 50) {
-            fprintf(stderr, "argil-hil-check: --link-ticks '%s': expected 0-50\n", argv[2]);
+        if (end == argv[2] || *end != '\0' || v < lo || v > hi) {
+            fprintf(stderr, "argil-hil-check: %s '%s': expected %ld-%ld\n", argv[1], argv[2], lo,
+                    hi);
             return 2;
         }
-        link_ticks = (uint32_t)v;
+        if (link)
+            link_ticks = (uint32_t)v;
+        else
+            heartbeat_ticks = (uint32_t)v;
         argv += 2;
         argc -= 2;
     }
     if (argc != 4) {
-        fprintf(stderr, "usage: argil-hil-check [--link-ticks N] SCENARIO CANDUMP_LOG EVENT_LOG "
-                        "(try --help)\n");
+        fprintf(stderr, "usage: argil-hil-check [--link-ticks N] [--heartbeat-ticks N] SCENARIO "
+                        "CANDUMP_LOG EVENT_LOG (try --help)\n");
         return 2;
     }
     static scenario_t s;
@@ -99,6 +109,8 @@ int main(int argc, char **argv)
     hil_obs_t o;
     hil_obs_init(&o);
     o.link_ticks = link_ticks;
+    if (heartbeat_ticks > 0)
+        o.heartbeat_ticks = heartbeat_ticks;
     uint32_t line = 0;
     hil_err_t e = hil_obs_add_candump(&o, can, can_len, &line);
     if (e != HIL_OK) {

@@ -427,6 +427,136 @@ static void test_sync_marks_gpio_window_link_ticks(void **st)
     hil_obs_free(&o);
 }
 
+/* A 1 kHz log from 10 s: three drives beating every 100 ticks (drive 2 skips the beats in
+ * skip[], as numbered from 1), RPDOs ENABLE_OP with torque until tick off_tick (0: never) and
+ * QUICK_STOP with torque 0 after, or torque back on from tick on_again (0: never). */
+static void synth_beats(hil_obs_t *o, const scenario_t *s, int ticks, const int *skip, int n_skip,
+                        int off_tick, int on_again)
+{
+    hil_obs_init(o);
+    uint32_t line;
+    const char ev[] = "(10.000000) start scenario hb\n";
+    assert_int_equal(hil_obs_add_events(o, s, ev, strlen(ev), &line), HIL_OK);
+    for (int k = 1; k <= ticks; k++) {
+        const int64_t t = 10000000 + (int64_t)k * 1000;
+        can_frame_t f;
+        if (k % 100 == 50) {
+            bool skipped = false;
+            for (int i = 0; i < n_skip; i++)
+                skipped |= skip[i] == k / 100 + 1;
+            for (uint8_t n = 1; n <= 3; n++) {
+                canopen_heartbeat_encode(&f, n, NMT_STATE_OPERATIONAL);
+                if (n != 2 || !skipped)
+                    assert_int_equal(hil_obs_push_frame(o, t + 100, &f), HIL_OK);
+            }
+        }
+        const bool off = off_tick > 0 && k >= off_tick && (on_again == 0 || k < on_again);
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_rpdo_encode(&f, n, off ? CIA402_CW_QUICK_STOP : CIA402_CW_ENABLE_OP,
+                                off ? 0 : 100);
+            assert_int_equal(hil_obs_push_frame(o, t + 300, &f), HIL_OK);
+        }
+        f = (can_frame_t){.id = CANOPEN_COB_SYNC, .len = 0};
+        assert_int_equal(hil_obs_push_frame(o, t + 500, &f), HIL_OK);
+    }
+}
+
+/* heartbeat_supervised holds the board to the consumer rule from what was on the bus: one lost
+ * heartbeat ridden, two in a row off at 250 (+2) ticks, and off stays off. */
+static void test_heartbeat_supervised(void **st)
+{
+    (void)st;
+    static const char text[] = "name hb\nduration 3s\nat 0.5 can_drop 10% seed 7\n"
+                               "expect at 0.5 heartbeat_supervised until end\n";
+    static scenario_t s;
+    scn_error_t err;
+    assert_int_equal(scenario_parse(&s, text, sizeof(text) - 1, &err), SCN_OK);
+    assert_int_equal(s.expect[0].kind, SCN_EXP_HEARTBEAT_SUPERVISED);
+    hil_obs_t o;
+    hil_result_t r;
+    /* beat 8 (tick 750) lost: a 200-tick gap, on throughout */
+    static const int one[] = {8}, two[] = {8, 9};
+    synth_beats(&o, &s, 2500, one, 1, 0, 0);
+    hil_check_expect(&s, &o, 0, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    assert_int_equal(r.tolerated, 1);
+    hil_obs_free(&o);
+    /* the same log with the board off at tick 900 (heartbeat 250 ticks old at most): spurious */
+    synth_beats(&o, &s, 2500, one, 1, 900, 0);
+    hil_check_expect(&s, &o, 0, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "under 250 ticks old"));
+    hil_obs_free(&o);
+    /* beats 8 and 9 lost: the last drive-2 beat on the bus came in tick 650, read in it; the
+     * board's age passes 250 in tick 901, whose RPDOs follow 251 SYNCs after the beat */
+    synth_beats(&o, &s, 2500, two, 2, 901, 0);
+    hil_check_expect(&s, &o, 0, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    assert_int_equal(r.observed_ticks, 251);
+    hil_obs_free(&o);
+    /* ... off only at tick 905: 255 SYNCs, past the bound (251 + a late read + log order) */
+    synth_beats(&o, &s, 2500, two, 2, 905, 0);
+    hil_check_expect(&s, &o, 0, &r);
+    assert_false(r.pass);
+    assert_non_null(strstr(r.msg, "still on"));
+    hil_obs_free(&o);
+    /* ... off at 901 but torque again at 1500: the fault must latch */
+    synth_beats(&o, &s, 2500, two, 2, 901, 1500);
+    hil_check_expect(&s, &o, 0, &r);
+    assert_false(r.pass);
+    hil_obs_free(&o);
+}
+
+/* An expectation time after a step counts board ticks from that step's logged injection: a
+ * host that performed "link lost" 30 ticks after argil-sim's clock passed it gets its 80 ticks
+ * from when it did, not from argil-sim's mark. */
+static void test_times_after_a_step_count_from_its_injection(void **st)
+{
+    (void)st;
+    static const char text[] = "name lost\nduration 3s\nat 1.0 link lost\n"
+                               "expect at 1.080 no_torque_frames until end\n";
+    static scenario_t s;
+    scn_error_t err;
+    assert_int_equal(scenario_parse(&s, text, sizeof(text) - 1, &err), SCN_OK);
+    hil_obs_t o;
+    hil_obs_init(&o);
+    o.link_ticks = 6;
+    for (int k = 1; k <= 2000; k++) {
+        const int64_t t = 10000000 + (int64_t)k * 1000;
+        can_frame_t f;
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_rpdo_encode(&f, n, CIA402_CW_ENABLE_OP, k < 1030 + 76 ? 100 : 0);
+            assert_int_equal(hil_obs_push_frame(&o, t + 300, &f), HIL_OK);
+        }
+        f = (can_frame_t){.id = CANOPEN_COB_SYNC, .len = 0};
+        assert_int_equal(hil_obs_push_frame(&o, t + 500, &f), HIL_OK);
+    }
+    /* hil-host's step just after the 1030th SYNC; argil-sim's mark at the 1080th */
+    const char ev[] = "(10.000000) start scenario lost\n"
+                      "(11.030600) inject line=3 link lost\n"
+                      "(11.080600) mark at 1.080000 sync=1080\n";
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(&o, &s, ev, strlen(ev), &line), HIL_OK);
+    hil_result_t r;
+    hil_check_expect(&s, &o, 0, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    /* torque until 5 ticks later than the board's 70 + link 6 after the step: caught */
+    for (size_t k = 0; k < o.n_frames; k++) {
+        uint8_t node;
+        uint16_t cw;
+        int16_t tq;
+        if (canopen_rpdo_decode(&o.frame[k].f, &node, &cw, &tq) &&
+            o.frame[k].t_us < 10000000 + (1030 + 80 + 6 + 5) * 1000)
+            canopen_rpdo_encode(&o.frame[k].f, node, cw, 100);
+    }
+    hil_check_expect(&s, &o, 0, &r);
+    assert_false(r.pass);
+    hil_obs_free(&o);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -436,6 +566,8 @@ int main(void)
         cmocka_unit_test(test_bounds_in_ticks),
         cmocka_unit_test(test_marks_anchor_expectations),
         cmocka_unit_test(test_sync_marks_gpio_window_link_ticks),
+        cmocka_unit_test(test_heartbeat_supervised),
+        cmocka_unit_test(test_times_after_a_step_count_from_its_injection),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
