@@ -8,7 +8,7 @@
 # Logs: BUILD_DIR/hil/run-<rig>/console.log (the VM's serial console) and run-<rig>/logs/ (per
 # check: the daemon's timestamped stderr, the candump -L log, GPIO samples, host output).
 # Env: HIL_CACHE (the debs; default /var/cache/argil-hil as root, else BUILD_DIR/hil/debs),
-#      HIL_TIMEOUT_S (per boot, default 400), HIL_MEM_MB (default 256), HIL_SMP (default 2:
+#      HIL_TIMEOUT_S (per boot, default 900), HIL_MEM_MB (default 256), HIL_SMP (default 2:
 #      argil-board's loop on vCPU 0, the rig's arm (argil-sim), host and candump on vCPU 1; on
 #      one vCPU under TCG they starve each other and the scenarios see "host lost"/"drive
 #      heartbeat lost" before sculpting. The bounds are in board ticks, so the two vCPUs
@@ -50,7 +50,7 @@ for rig in $rigs; do
     t0=$(date +%s.%N)
     st=0
     # The VM prints one line per check; show those as they come, keep the whole console.
-    { timeout "${HIL_TIMEOUT_S:-400}" qemu-system-x86_64 -accel tcg -M q35 -smp "${HIL_SMP:-2}" \
+    { timeout "${HIL_TIMEOUT_S:-900}" qemu-system-x86_64 -accel tcg -M q35 -smp "${HIL_SMP:-2}" \
         -m "${HIL_MEM_MB:-256}" -nodefaults -nographic -no-reboot -net none -serial stdio \
         -device isa-debug-exit,iobase=0xf4,iosize=0x04 \
         -object can-bus,id=canbus0 -device kvaser_pci,canbus=canbus0 -device kvaser_pci,canbus=canbus0 \

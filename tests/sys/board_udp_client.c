@@ -1,10 +1,13 @@
 /* A host for tests/sys/test_board_daemon.sh: talks to a running argil-board over real UDP on
  * 127.0.0.1 with the host's protocol peer, and checks what a person would notice:
  *   1. HELLO → the board answers, takes the window, arms and goes ACTIVE;
- *   2. the host falls silent → within heartbeat timeout + fade the force is zero, sculpting
- *      stops and the board is in FAULT (host lost);
+ *   2. the host falls silent → FAULT (host lost) 50 board ticks after the board's last host
+ *      heartbeat and the force zero, sculpting off, 20 ticks later (50 ms timeout + 20 ms fade
+ *      at 1 kHz), counted in the board's own ticks (its telemetry's tick), so the bounds hold on
+ *      a board that ticks slower than 1 kHz (the HIL VM) as on a real one;
  *   3. a new host (new socket) says HELLO → window re-sent, re-arm → ACTIVE again, no restart.
- * Usage: board_udp_client PORT. Prints one line per phase; exit 0 when all hold. */
+ * Usage: board_udp_client PORT [LINK_TICKS]. LINK_TICKS (default 1): board ticks the link may
+ * take each way (heartbeat in, telemetry out). Prints one line per phase; exit 0 when all hold. */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
 #include <math.h>
@@ -141,9 +144,12 @@ static int until_active(host_t *h, int max_ms, bool rearm)
 
 int main(int argc, char **argv)
 {
-    if (argc != 2)
+    if (argc != 2 && argc != 3)
         return 2;
     const int port = atoi(argv[1]);
+    const int link_ticks = argc == 3 ? atoi(argv[2]) : 1;
+    if (link_ticks < 0 || link_ticks > 50)
+        return 2;
     static host_t h;
     host_open(&h, port);
     const int t1 = until_active(&h, 4000, false);
@@ -153,27 +159,40 @@ int main(int argc, char **argv)
         printf("FAIL: board state %u, never ACTIVE\n", h.tm.state);
         return 1;
     }
-    /* 2: silence. Keep listening; find when the force is zero and the state FAULT. */
+    /* 2: silence. Keep listening (3 s of wall time at most, and 300 board ticks); find the
+     * board ticks at which the state is FAULT and the force zero. */
     uint64_t next = now_us();
     const uint64_t t0 = next;
-    int fault_ms = -1, zero_ms = -1;
+    const int64_t tick0 = h.tm.tick; /* the board's tick when we fell silent, as last reported */
+    int64_t fault_tick = -1, zero_tick = -1;
+    int fault_ms = -1;
     float peak_after_fault = 0.0f;
-    for (int ms = 0; ms < 300; ms++) {
+    for (int ms = 0; ms < 3000 && (int64_t)h.tm.tick - tick0 < 300; ms++) {
         host_ms(&h, false, &next);
         const float f = sqrtf(h.tm.force_n[0] * h.tm.force_n[0] + h.tm.force_n[1] * h.tm.force_n[1] +
                               h.tm.force_n[2] * h.tm.force_n[2]);
-        if (fault_ms < 0 && h.tm.state == SAFETY_FAULT)
+        const int64_t tick = (int64_t)h.tm.tick - tick0;
+        if (fault_tick < 0 && h.tm.state == SAFETY_FAULT) {
+            fault_tick = tick;
             fault_ms = (int)((now_us() - t0) / 1000u);
-        if (fault_ms >= 0 && zero_ms < 0 && f == 0.0f && (h.tm.flags & 2u) == 0)
-            zero_ms = (int)((now_us() - t0) / 1000u);
-        if (fault_ms >= 0 && ms > fault_ms + 25 && f > peak_after_fault)
+        }
+        if (fault_tick >= 0 && zero_tick < 0 && f == 0.0f && (h.tm.flags & 2u) == 0)
+            zero_tick = tick;
+        if (zero_tick >= 0 && tick > zero_tick && f > peak_after_fault)
             peak_after_fault = f;
     }
-    printf("phase 2: host silent: FAULT (host lost) after %d ms, force zero and sculpting off "
-           "after %d ms, peak force 25 ms after the fault %.3f N\n", fault_ms, zero_ms,
-           (double)peak_after_fault);
-    /* 50 ms timeout + 20 ms fade; 60 ms of slack for a shared, non-RT test machine. */
-    if (fault_ms < 40 || fault_ms > 130 || zero_ms < 0 || zero_ms > 150 || peak_after_fault != 0.0f) {
+    /* The board's last heartbeat from us came at most one heartbeat period (5 ticks at 1 kHz,
+     * fewer on a slower board) before tick0, and at most link_ticks after it; our view of its
+     * ticks lags by link_ticks more. */
+    const int64_t fault_lo = 50 - 5, fault_hi = 50 + 2 * link_ticks + 1;
+    const int64_t zero_hi = 70 + 2 * link_ticks + 1;
+    printf("phase 2: host silent: FAULT (host lost) after %lld board ticks (%d ms), force zero "
+           "and sculpting off after %lld ticks, peak force after that %.3f N (bounds: FAULT "
+           "%lld..%lld, zero by %lld ticks)\n", (long long)fault_tick, fault_ms,
+           (long long)zero_tick, (double)peak_after_fault, (long long)fault_lo,
+           (long long)fault_hi, (long long)zero_hi);
+    if (fault_tick < fault_lo || fault_tick > fault_hi || zero_tick < 0 || zero_tick > zero_hi ||
+        peak_after_fault != 0.0f) {
         printf("FAIL: host-loss timing\n");
         return 1;
     }

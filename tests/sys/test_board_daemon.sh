@@ -47,7 +47,9 @@ for rate in 1000 2000; do
         --stats-period-s 0 --overrun-streak 0 >"$tmp/daemon.out" 2>"$tmp/daemon.err" &
     pid=$!
     sleep 0.3
-    "$REL/board_udp_client" "$port" >"$tmp/client.out" 2>&1 || {
+    # 30 link ticks each way: the daemon and the client are ordinary threads on a shared,
+    # non-RT test machine (the VM rig passes 6, a real board 1).
+    "$REL/board_udp_client" "$port" 30 >"$tmp/client.out" 2>&1 || {
         cat "$tmp/client.out"; kill "$pid"; cat "$tmp/daemon.err"; fail "UDP session at $rate Hz"; }
     cat "$tmp/client.out"
     kill -TERM "$pid"

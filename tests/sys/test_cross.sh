@@ -51,7 +51,7 @@ until grep -q "running at" "$tmp/a64d.err"; do
     sleep 0.1
 done
 st=0
-timeout -s KILL 60 "$REL/board_udp_client" "$port" >"$tmp/a64c.out" 2>&1 || st=$?
+timeout -s KILL 60 "$REL/board_udp_client" "$port" 30 >"$tmp/a64c.out" 2>&1 || st=$?
 sed 's/^/aarch64 daemon, native host: /' "$tmp/a64c.out"
 kill -TERM "$dpid" 2>/dev/null || true
 dst=0; wait "$dpid" || dst=$?
