@@ -66,39 +66,81 @@ argil_err_t can_socket_open(const char *ifname, int *fd, char *err, size_t err_l
     return ARGIL_OK;
 }
 
+/* One frame from fd: 1 read into *f, 0 nothing waiting, -1 an I/O error (st->last_errno),
+ * 2 read but refused (malformed, RTR, 29-bit: counted in rx_dropped). */
+static int read_frame(int fd, can_frame_t *f, can_socket_stats_t *st)
+{
+    struct can_frame cf;
+    const ssize_t n = recv(fd, &cf, sizeof(cf), MSG_DONTWAIT);
+    if (n < 0) {
+        if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+            return 0;
+        st->last_errno = errno;
+        return -1;
+    }
+    if (n != (ssize_t)sizeof(cf) || cf.can_dlc > 8 || (cf.can_id & CAN_RTR_FLAG)) {
+        st->rx_dropped++;
+        return 2;
+    }
+    memset(f, 0, sizeof(*f));
+    if (cf.can_id & CAN_ERR_FLAG) {
+        f->id = cf.can_id & (CAN_ERR_FLAG | CAN_ERR_MASK);
+        st->rx_error_frames++;
+    } else if (cf.can_id & CAN_EFF_FLAG) {
+        st->rx_dropped++; /* CANopen uses 11-bit identifiers only */
+        return 2;
+    } else {
+        f->id = cf.can_id & CAN_SFF_MASK;
+    }
+    f->len = cf.can_dlc;
+    memcpy(f->data, cf.data, f->len);
+    st->rx_frames++;
+    return 1;
+}
+
 argil_err_t can_socket_receive(int fd, can_batch_t *rx, can_socket_stats_t *st)
 {
     rx->n = 0;
     for (uint32_t i = 0; i < CAN_BATCH_MAX; i++) {
-        struct can_frame cf;
-        const ssize_t n = recv(fd, &cf, sizeof(cf), MSG_DONTWAIT);
-        if (n < 0) {
-            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
-                return ARGIL_OK;
-            st->last_errno = errno;
-            return ARGIL_ERR_IO;
-        }
-        if (n != (ssize_t)sizeof(cf) || cf.can_dlc > 8 || (cf.can_id & CAN_RTR_FLAG)) {
-            st->rx_dropped++;
-            continue;
-        }
         can_frame_t f;
-        memset(&f, 0, sizeof(f));
-        if (cf.can_id & CAN_ERR_FLAG) {
-            f.id = cf.can_id & (CAN_ERR_FLAG | CAN_ERR_MASK);
-            st->rx_error_frames++;
-        } else if (cf.can_id & CAN_EFF_FLAG) {
-            st->rx_dropped++; /* CANopen uses 11-bit identifiers only */
-            continue;
-        } else {
-            f.id = cf.can_id & CAN_SFF_MASK;
-        }
-        f.len = cf.can_dlc;
-        memcpy(f.data, cf.data, f.len);
-        (void)can_batch_push(rx, &f);
-        st->rx_frames++;
+        const int r = read_frame(fd, &f, st);
+        if (r == 0)
+            return ARGIL_OK;
+        if (r < 0)
+            return ARGIL_ERR_IO;
+        if (r == 1)
+            (void)can_batch_push(rx, &f);
     }
-    /* More is waiting than a tick takes: it stays queued for the next tick. */
+    return ARGIL_OK;
+}
+
+static bool is_tpdo1(uint32_t id)
+{
+    return id > CANOPEN_COB_TPDO1 && id <= CANOPEN_COB_TPDO1 + 0x7Fu;
+}
+
+argil_err_t can_socket_receive_latest(int fd, can_batch_t *rx, can_socket_stats_t *st)
+{
+    rx->n = 0;
+    for (uint32_t i = 0; i < CAN_RX_DRAIN_MAX && rx->n < CAN_BATCH_MAX; i++) {
+        can_frame_t f;
+        const int r = read_frame(fd, &f, st);
+        if (r == 0)
+            return ARGIL_OK;
+        if (r < 0)
+            return ARGIL_ERR_IO;
+        if (r != 1)
+            continue;
+        bool replaced = false;
+        for (uint8_t k = 0; is_tpdo1(f.id) && k < rx->n && !replaced; k++)
+            if (rx->f[k].id == f.id) {
+                rx->f[k] = f;
+                replaced = true;
+                st->rx_coalesced++;
+            }
+        if (!replaced)
+            (void)can_batch_push(rx, &f);
+    }
     return ARGIL_OK;
 }
 

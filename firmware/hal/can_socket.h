@@ -12,7 +12,9 @@
 typedef struct {
     uint32_t rx_frames;
     uint32_t rx_error_frames;
-    uint32_t rx_dropped;          /* frames beyond CAN_BATCH_MAX in one tick, or malformed */
+    uint32_t rx_dropped;          /* malformed or not CANopen (29-bit) */
+    uint32_t rx_coalesced;        /* TPDOs replaced in the same read by a newer one of the
+                                     same drive (can_socket_receive_latest) */
     uint32_t tx_frames;
     uint32_t tx_busy;             /* sends refused: the queue is full (ENOBUFS/EAGAIN) */
     uint32_t tx_errors;           /* sends refused for other reasons (ENETDOWN…) */
@@ -28,6 +30,14 @@ argil_err_t can_socket_open(const char *ifname, int *fd, char *err, size_t err_l
 /* Reads every frame waiting on fd (up to CAN_BATCH_MAX) into rx without blocking. Error
  * frames keep their CAN_ERR_FLAG id (firmware/core/drives.h decodes them). */
 argil_err_t can_socket_receive(int fd, can_batch_t *rx, can_socket_stats_t *st);
+
+/* The board's read: drains fd (at most CAN_RX_DRAIN_MAX frames) into rx without blocking,
+ * keeping only the newest TPDO1 of each drive where several wait (the core keeps the last of
+ * them anyway), so a backlog after a stalled tick cannot fill the batch, leave frames in the
+ * socket until its queue overflows and lose a heartbeat or an EMCY. Stops when rx is full of
+ * other frames (they wait for the next tick). */
+#define CAN_RX_DRAIN_MAX 1024u
+argil_err_t can_socket_receive_latest(int fd, can_batch_t *rx, can_socket_stats_t *st);
 
 /* Writes every frame of tx without blocking; ARGIL_ERR_FULL when the kernel queue is full,
  * ARGIL_ERR_IO for another failure (the rest of the batch is not sent). */

@@ -79,6 +79,53 @@ static void test_can_socket_frames_and_error_frames(void **st)
     close(sv[1]);
 }
 
+/* After a stalled tick the board's socket holds a backlog: 40 ticks of the three drives' TPDOs
+ * with a heartbeat and an EMCY among them. The board's read takes them all in one tick, the
+ * newest TPDO of each drive and both of the others, instead of 32 frames that leave the
+ * heartbeat queued behind the rest until the socket's queue overflows. */
+static void test_can_board_read_drains_a_backlog(void **st)
+{
+    (void)st;
+    int sv[2];
+    assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+    struct can_frame cf;
+    for (int k = 0; k < 40; k++) {
+        for (int n = 1; n <= 3; n++) {
+            memset(&cf, 0, sizeof(cf));
+            cf.can_id = 0x180u + (uint32_t)n;
+            cf.can_dlc = 8;
+            cf.data[2] = (uint8_t)k; /* position: the tick it was sent in */
+            assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+        }
+        if (k == 20 || k == 30) {
+            memset(&cf, 0, sizeof(cf));
+            cf.can_id = k == 20 ? 0x702u : 0x083u; /* drive 2's heartbeat, drive 3's EMCY */
+            cf.can_dlc = k == 20 ? 1 : 8;
+            cf.data[0] = k == 20 ? 0x05 : 0x10;
+            assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+        }
+    }
+    can_batch_t rx;
+    can_socket_stats_t stats = {0};
+    assert_int_equal(can_socket_receive_latest(sv[0], &rx, &stats), ARGIL_OK);
+    assert_int_equal(rx.n, 5);
+    assert_int_equal(stats.rx_frames, 122);
+    assert_int_equal(stats.rx_coalesced, 117);
+    bool hb = false, emcy = false;
+    for (uint8_t i = 0; i < rx.n; i++) {
+        if (rx.f[i].id >= 0x181 && rx.f[i].id <= 0x183)
+            assert_int_equal(rx.f[i].data[2], 39); /* the newest of each drive */
+        hb |= rx.f[i].id == 0x702;
+        emcy |= rx.f[i].id == 0x083;
+    }
+    assert_true(hb && emcy);
+    /* Nothing is left for the next tick. */
+    assert_int_equal(can_socket_receive_latest(sv[0], &rx, &stats), ARGIL_OK);
+    assert_int_equal(rx.n, 0);
+    close(sv[0]);
+    close(sv[1]);
+}
+
 static void test_can_open_errors_are_one_line(void **st)
 {
     (void)st;
@@ -368,6 +415,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_can_socket_frames_and_error_frames),
+        cmocka_unit_test(test_can_board_read_drains_a_backlog),
         cmocka_unit_test(test_can_open_errors_are_one_line),
         cmocka_unit_test(test_gpio_mapping_by_name),
         cmocka_unit_test(test_gpio_errors_name_the_line),
