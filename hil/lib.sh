@@ -568,7 +568,8 @@ check_scenario() {
     # host's heartbeats must get in), and runs at SIM_RUN_PRIO once its clock starts: above the
     # rig's host and the board's link thread, or it fell up to 90 board ticks behind the SYNCs
     # it answers and the drives' heartbeats reached the board up to 90 ticks late.
-    hil-probe fifo "$SIM_PRIO" argil-sim --can "${SIM_CAN_IF:-$CAN_IF}" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
+    # SIM_CPU pins it to the CPU the board's loop does not own (the VM's vCPU 1).
+    ${SIM_CPU:+taskset -c "$SIM_CPU"} hil-probe fifo "$SIM_PRIO" argil-sim --can "${SIM_CAN_IF:-$CAN_IF}" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
         >"$OUT/$CHECK.sim.out" 2>&1 &
     SIM_PID=$!
     i=0
