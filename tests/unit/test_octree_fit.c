@@ -260,28 +260,18 @@ static void scan_case(fs_shape_t s, bool normals)
     assert_true(noisy.nodes <= clean.nodes + clean.nodes / 2);
 }
 
-static void test_scan_holed_box(void **state)
-{
-    (void)state;
-    scan_case(FS_HOLED_BOX, true);
-}
+typedef struct {
+    fs_shape_t shape;
+    bool normals; /* the true ones, else PCA */
+} scan_kind_t;
 
-static void test_scan_holed_box_pca(void **state)
-{
-    (void)state;
-    scan_case(FS_HOLED_BOX, false);
-}
+static scan_kind_t g_scans[4] = {
+    {FS_HOLED_BOX, true}, {FS_HOLED_BOX, false}, {FS_PLATE_2_HOLES, true}, {FS_PLATE_2_HOLES, false}};
 
-static void test_scan_plate(void **state)
+static void test_scan(void **state)
 {
-    (void)state;
-    scan_case(FS_PLATE_2_HOLES, true);
-}
-
-static void test_scan_plate_pca(void **state)
-{
-    (void)state;
-    scan_case(FS_PLATE_2_HOLES, false);
+    const scan_kind_t *k = *state;
+    scan_case(k->shape, k->normals);
 }
 
 /* A 40^3 volume of intensities 10..90 (a sphere of radius 12 mm, 2 mm ramp) fits so that the
@@ -323,6 +313,64 @@ static void test_volume(void **state)
     }
     octfit_free(&m);
     free(v);
+}
+
+/* Clouds that bound no solid are refused with the rule they break, never fitted or crashed on:
+ * too few points, NaN, duplicates of fewer than 4 positions, points on a plane (clean or noisy)
+ * or on a line. A cloud whose every point is repeated still fits. */
+static void test_bad_clouds(void **state)
+{
+    (void)state;
+    octfit_opts_t o;
+    octfit_opts_default(&o);
+    o.tolerance = 1e-4f;
+    octfit_model_t m;
+    mesh_t c;
+    mesh_init(&c);
+    for (int i = 0; i < 3; i++)
+        add(&c, vec3(0.01f * (float)i, 0, 0), vec3(0, 0, 1), 0.0);
+    assert_int_equal(octfit_check_points(&c, NULL, NULL), OCTFIT_CLOUD_FEW);
+    assert_int_equal(octfit_points(&c, &o, &m), ARGIL_ERR_ARG);
+    mesh_free(&c);
+    mesh_init(&c); /* 500 copies of three positions */
+    for (int i = 0; i < 500; i++)
+        add(&c, vec3(0.01f * (float)(i % 3), 0.02f, 0), vec3(0, 0, 1), 0.0);
+    assert_int_equal(octfit_check_points(&c, NULL, NULL), OCTFIT_CLOUD_DUPLICATES);
+    assert_int_equal(octfit_points(&c, &o, &m), ARGIL_ERR_ARG);
+    assert_int_equal(normals_estimate(&c, NULL, NULL), ARGIL_OK); /* no crash on duplicates */
+    mesh_free(&c);
+    for (int noisy = 0; noisy < 2; noisy++) { /* a 50 mm square, clean and with 0.2 mm noise */
+        mesh_init(&c);
+        for (int i = 0; i < 3000; i++)
+            add(&c, vec3((float)(0.05 * urand()), (float)(0.05 * urand()), 0), vec3(0, 0, 1),
+                noisy ? 0.0002 : 0.0);
+        float thick, noise;
+        assert_int_equal(octfit_check_points(&c, &thick, &noise), OCTFIT_CLOUD_FLAT);
+        assert_true(thick <= 3.0f * noise + 1e-7f);
+        assert_int_equal(normals_estimate(&c, NULL, NULL), ARGIL_OK);
+        assert_int_equal(octfit_points(&c, &o, &m), ARGIL_ERR_ARG);
+        mesh_free(&c);
+    }
+    mesh_init(&c);
+    for (int i = 0; i < 1000; i++)
+        add(&c, vec3((float)(0.05 * urand()), 0.01f, 0.02f), vec3(0, 0, 1), 0.0);
+    assert_int_equal(octfit_check_points(&c, NULL, NULL), OCTFIT_CLOUD_FLAT);
+    mesh_free(&c);
+    sphere_cloud(&c, 1500, 0.0, 2.0);
+    mesh_t d;
+    mesh_init(&d);
+    for (size_t i = 0; i < c.n_vert; i++)
+        for (int k = 0; k < 3; k++)
+            add(&d, vec3(c.pos[3 * i], c.pos[3 * i + 1], c.pos[3 * i + 2]),
+                vec3(c.normal[3 * i], c.normal[3 * i + 1], c.normal[3 * i + 2]), 0.0);
+    assert_int_equal(octfit_check_points(&d, NULL, NULL), OCTFIT_CLOUD_OK);
+    const float half[3] = {0.03f, 0.03f, 0.03f};
+    const dist_t r = fit_and_measure("sphere, every point x3", &d, sd_sphere, half, 0.06f, 0.0005f, 5, NULL);
+    assert_true(r.max <= 0.02 && r.components == 1 && r.euler == 2);
+    d.pos[7] = NAN;
+    assert_int_equal(octfit_check_points(&d, NULL, NULL), OCTFIT_CLOUD_NONFINITE);
+    mesh_free(&d);
+    mesh_free(&c);
 }
 
 static volatile int g_stop = 1;
@@ -386,12 +434,13 @@ int main(void)
         cmocka_unit_test(test_torus),
         cmocka_unit_test(test_box),
         cmocka_unit_test(test_torus_estimated_normals),
-        cmocka_unit_test(test_scan_holed_box),
-        cmocka_unit_test(test_scan_holed_box_pca),
-        cmocka_unit_test(test_scan_plate),
-        cmocka_unit_test(test_scan_plate_pca),
+        {"test_scan_holed_box", test_scan, NULL, NULL, &g_scans[0]},
+        {"test_scan_holed_box_pca", test_scan, NULL, NULL, &g_scans[1]},
+        {"test_scan_plate", test_scan, NULL, NULL, &g_scans[2]},
+        {"test_scan_plate_pca", test_scan, NULL, NULL, &g_scans[3]},
         cmocka_unit_test(test_volume),
         cmocka_unit_test(test_limits_and_errors),
+        cmocka_unit_test(test_bad_clouds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
