@@ -66,7 +66,7 @@ if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/nu
     done
 fi
 
-echo "== meshing and fitting (tests/bench/bench_mesh.c, one core)"
+echo "== meshing and fitting (tests/bench/bench_mesh.c, one core; ends with 30,000-point scans with holes, edges, noise)"
 if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_mesh.c "$rel/libargil.a" -o "$tmp/bench_mesh" -lm; then
     "$tmp/bench_mesh"
 else

@@ -102,8 +102,9 @@ static void usage_fit(FILE *f)
             "                  default: sdf for meshes with triangles, grid for volumes, rbf for\n"
             "                  clouds of up to 1000 points and octree above\n"
             "  --tolerance E   wanted RMS fitting error in the input's units (default 0.2 %% of\n"
-            "                  the size; octree: the per-node bound, rbf: the sample count\n"
-            "                  doubles until it is met or 1365)\n"
+            "                  the size; octree: the per-node bound, never below 1.5 x the noise\n"
+            "                  read from the points; rbf: the sample count doubles until it is\n"
+            "                  met or 1365)\n"
             "  --max-depth D   octree: deepest subdivision level, 0..10 (default 5)\n"
             "  --resolution N  grid samples along the longest axis, 8..256 (default 64)\n"
             "  --samples S     rbf: surface samples to start with, 4..1365 (default 300)\n"
@@ -271,10 +272,12 @@ static int fit_points_octree(const char *in, const char *out, mesh_t *m, const f
             rc = 0;
             const grid_t *g = &d.grid;
             if (!quiet)
-                printf("argil fit: %s: %zu points -> octree B-spline of %u nodes (%u leaves, depth "
-                       "%u), error rms %.4g max %.4g (%.3f %% / %.3f %% of size); grid %dx%dx%d\n",
-                       out, m->n_vert, d.octree.n_nodes, d.octree.n_leaves, d.octree.depth,
-                       d.octree.rms_err, d.octree.max_err, 100.0 * d.octree.rms_err / size,
+                printf("argil fit: %s: %zu points (noise %.3g, %.3f %% of size) -> octree B-spline "
+                       "of %u nodes (%u leaves, depth %u), error rms %.4g max %.4g (%.3f %% / %.3f %% "
+                       "of size); grid %dx%dx%d\n",
+                       out, m->n_vert, d.octree.noise_m, 100.0 * d.octree.noise_m / size,
+                       d.octree.n_nodes, d.octree.n_leaves, d.octree.depth, d.octree.rms_err,
+                       d.octree.max_err, 100.0 * d.octree.rms_err / size,
                        100.0 * d.octree.max_err / size, g->dims[0], g->dims[1], g->dims[2]);
         }
     }
@@ -323,6 +326,21 @@ static int fit_points(const char *in, const char *out, fit_method_t method, doub
         fprintf(stderr, "argil fit: %s: --method grid is for volumes (.nrrd .nhdr)\n", in);
         mesh_free(&m);
         return 2;
+    }
+    float thick, noise;
+    const octfit_cloud_t why = octfit_check_points(&m, &thick, &noise);
+    if (why != OCTFIT_CLOUD_OK) {
+        if (why == OCTFIT_CLOUD_FLAT)
+            fprintf(stderr, "argil fit: %s: the points lie on one plane or line (%.3g off it, RMS, "
+                            "against noise %.3g): they bound no solid\n", in, thick, noise);
+        else
+            fprintf(stderr, "argil fit: %s: %s\n", in,
+                    why == OCTFIT_CLOUD_DUPLICATES ? "fewer than 4 distinct points (the rest repeat them)"
+                    : why == OCTFIT_CLOUD_NONFINITE ? "a coordinate or normal is NaN or infinite"
+                    : why == OCTFIT_CLOUD_MANY      ? "too many points"
+                                                    : "fewer than 4 points");
+        mesh_free(&m);
+        return 1;
     }
     if (!normals) {
         normals_opts_t no = {0, &g_fit_stop, quiet ? NULL : progress_cb, &pr};

@@ -8,8 +8,9 @@
 
 #include "host/fit/knn.h"
 
-/* Eigenvector of the smallest eigenvalue of the symmetric 3x3 matrix a (cyclic Jacobi). */
-static void sym3_min_eigvec(double a[3][3], double v_out[3])
+/* Eigenvector of the smallest eigenvalue of the symmetric 3x3 matrix a (cyclic Jacobi); returns
+ * that eigenvalue. */
+static double sym3_min_eigvec(double a[3][3], double v_out[3])
 {
     double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     for (int sweep = 0; sweep < 32; sweep++) {
@@ -46,6 +47,155 @@ static void sym3_min_eigvec(double a[3][3], double v_out[3])
             best = i;
     for (int k = 0; k < 3; k++)
         v_out[k] = v[k][best];
+    return a[best][best];
+}
+
+/* The least-squares plane through the points idx[0..got) of pos (idx NULL: the first got): its
+ * unit normal (PCA, Hoppe et al. 1992) into n_out; returns the mean square distance to it. */
+static double nm_plane_fit(const float *pos, const uint32_t *idx, size_t got, float n_out[3])
+{
+    double c[3] = {0, 0, 0}, cov[3][3] = {{0}};
+    for (size_t j = 0; j < got; j++)
+        for (int a = 0; a < 3; a++)
+            c[a] += pos[3 * (size_t)(idx != NULL ? idx[j] : j) + (size_t)a] / (double)got;
+    for (size_t j = 0; j < got; j++) {
+        double d[3];
+        for (int a = 0; a < 3; a++)
+            d[a] = pos[3 * (size_t)(idx != NULL ? idx[j] : j) + (size_t)a] - c[a];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                cov[a][b] += d[a] * d[b];
+    }
+    double v[3];
+    const double lmin = sym3_min_eigvec(cov, v);
+    const double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int a = 0; a < 3; a++)
+        n_out[a] = len > 0 ? (float)(v[a] / len) : (a == 0);
+    return got > 0 && lmin > 0.0 ? lmin / (double)got : 0.0;
+}
+
+static int nm_cmp_f(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The RMS residual of the height-field quadric h = a u^2 + b uv + c v^2 + d u + e v + f fitted
+ * by least squares to points idx[0..got) of pos in the frame (u, v, n) of their plane (normal n
+ * through centroid c), unbiased for its 6 degrees of freedom: what is left is noise, not the
+ * surface's curvature. 0 when got <= 6 or the system is singular. */
+static double nm_quadric_rms(const float *pos, const uint32_t *idx, uint32_t got, const float n[3])
+{
+    if (got <= 6)
+        return 0.0;
+    double c[3] = {0, 0, 0}, u[3], v[3];
+    for (uint32_t j = 0; j < got; j++)
+        for (int a = 0; a < 3; a++)
+            c[a] += pos[3 * (size_t)idx[j] + (size_t)a] / (double)got;
+    const int ax = fabsf(n[0]) < 0.6f ? 0 : 1; /* u = n x e_ax, v = n x u */
+    const double e[3] = {ax == 0, ax == 1, 0};
+    u[0] = n[1] * e[2] - n[2] * e[1], u[1] = n[2] * e[0] - n[0] * e[2], u[2] = n[0] * e[1] - n[1] * e[0];
+    const double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int a = 0; a < 3; a++)
+        u[a] /= ul;
+    v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+    double A[6][6] = {{0}}, b[6] = {0}, x[KNN_K_MAX][7];
+    for (uint32_t j = 0; j < got; j++) {
+        double d[3], pu = 0, pv = 0, h = 0;
+        for (int a = 0; a < 3; a++) {
+            d[a] = pos[3 * (size_t)idx[j] + (size_t)a] - c[a];
+            pu += d[a] * u[a], pv += d[a] * v[a], h += d[a] * n[a];
+        }
+        const double row[7] = {pu * pu, pu * pv, pv * pv, pu, pv, 1.0, h};
+        for (int r = 0; r < 6; r++) {
+            for (int q = 0; q < 6; q++)
+                A[r][q] += row[r] * row[q];
+            b[r] += row[r] * h;
+        }
+        memcpy(x[j], row, sizeof(row));
+    }
+    for (int k = 0; k < 6; k++) { /* Cholesky, in place in the lower triangle */
+        for (int q = 0; q < k; q++)
+            A[k][k] -= A[k][q] * A[k][q];
+        if (!(A[k][k] > 1e-30))
+            return 0.0;
+        A[k][k] = sqrt(A[k][k]);
+        for (int r = k + 1; r < 6; r++) {
+            for (int q = 0; q < k; q++)
+                A[r][k] -= A[r][q] * A[k][q];
+            A[r][k] /= A[k][k];
+        }
+    }
+    for (int r = 0; r < 6; r++) { /* L y = b, then L^T x = y */
+        for (int q = 0; q < r; q++)
+            b[r] -= A[r][q] * b[q];
+        b[r] /= A[r][r];
+    }
+    for (int r = 5; r >= 0; r--) {
+        for (int q = r + 1; q < 6; q++)
+            b[r] -= A[q][r] * b[q];
+        b[r] /= A[r][r];
+    }
+    double ss = 0.0;
+    for (uint32_t j = 0; j < got; j++) {
+        double f = -x[j][6];
+        for (int q = 0; q < 6; q++)
+            f += b[q] * x[j][q];
+        ss += f * f;
+    }
+    return sqrt(ss / (double)(got - 6));
+}
+
+/* Over up to NORMALS_NOISE_SAMPLES evenly spread points of m (binned in g): the median of the
+ * quadric residual of their k nearest neighbours (nm_quadric_rms) into *sigma_m, and the median
+ * distance to the k-th neighbour into *radius_m. */
+static argil_err_t nm_noise_stats(const mesh_t *m, const knn_grid_t *g, uint32_t k, float *sigma_m,
+                                  float *radius_m)
+{
+    const uint32_t n = (uint32_t)m->n_vert, ns = n < NORMALS_NOISE_SAMPLES ? n : NORMALS_NOISE_SAMPLES;
+    if (k > n)
+        k = n;
+    float *r = malloc(2 * (size_t)ns * sizeof(float));
+    if (r == NULL)
+        return ARGIL_ERR_NOMEM;
+    uint32_t nb[KNN_K_MAX];
+    float d2[KNN_K_MAX];
+    for (uint32_t s = 0; s < ns; s++) {
+        const float *p = m->pos + 3 * ((size_t)s * n / ns);
+        const uint32_t got = knn_grid_query(g, vec3(p[0], p[1], p[2]), k, nb, d2);
+        float nrm[3];
+        nm_plane_fit(m->pos, nb, got, nrm);
+        r[s] = (float)nm_quadric_rms(m->pos, nb, got, nrm);
+        r[ns + s] = got > 0 ? sqrtf(d2[got - 1]) : 0.0f;
+    }
+    qsort(r, ns, sizeof(float), nm_cmp_f);
+    qsort(r + ns, ns, sizeof(float), nm_cmp_f);
+    *sigma_m = r[ns / 2];
+    *radius_m = r[ns + ns / 2];
+    free(r);
+    return ARGIL_OK;
+}
+
+float normals_thickness(const mesh_t *m)
+{
+    float nrm[3];
+    return m->n_vert > 0 ? (float)sqrt(nm_plane_fit(m->pos, NULL, m->n_vert, nrm)) : 0.0f;
+}
+
+argil_err_t normals_noise(const mesh_t *m, uint32_t k, float *sigma_m)
+{
+    *sigma_m = 0.0f;
+    if (k == 0)
+        k = NORMALS_NOISE_K_DEFAULT;
+    if (m == NULL || m->n_vert < 4 || m->n_vert >= UINT32_MAX || k < 4 || k > KNN_K_MAX)
+        return ARGIL_ERR_ARG;
+    knn_grid_t g;
+    argil_err_t e = knn_grid_build(&g, m->pos, m->n_vert);
+    float radius;
+    if (e == ARGIL_OK)
+        e = nm_noise_stats(m, &g, k, sigma_m, &radius);
+    knn_grid_free(&g);
+    return e;
 }
 
 typedef struct {
@@ -114,12 +264,25 @@ argil_err_t normals_estimate(mesh_t *m, const normals_opts_t *o, uint32_t *parts
     if (k < 4 || k > KNN_K_MAX)
         return ARGIL_ERR_ARG;
     const uint32_t n = (uint32_t)m->n_vert;
-    if (k > n)
-        k = n;
     knn_grid_t g;
     argil_err_t e = knn_grid_build(&g, m->pos, n);
     if (e != ARGIL_OK)
         return e;
+    if (o == NULL || o->k == 0) {
+        /* a plane through noise of sigma tilts by about sigma / radius: widen a noisy cloud's
+         * neighbourhood (area ~ k) until its radius is NORMALS_NOISE_RADII sigma */
+        float sigma, radius;
+        e = nm_noise_stats(m, &g, k, &sigma, &radius);
+        if (e != ARGIL_OK) {
+            knn_grid_free(&g);
+            return e;
+        }
+        const double want = radius > 0.0f ? NORMALS_NOISE_RADII * sigma / radius : 1.0;
+        if (want > 1.0)
+            k = (uint32_t)fmin((double)KNN_K_MAX, ceil((double)k * want * want));
+    }
+    if (k > n)
+        k = n;
     uint32_t *nb = malloc((size_t)n * k * sizeof(uint32_t));
     uint8_t *done = calloc(n, 1);
     nm_heap_t h = {NULL, 0, 0};
@@ -141,23 +304,7 @@ argil_err_t normals_estimate(mesh_t *m, const normals_opts_t *o, uint32_t *parts
         const uint32_t got = knn_grid_query(&g, vec3(p[0], p[1], p[2]), k, ni, NULL);
         for (uint32_t j = got; j < k; j++)
             ni[j] = i;
-        double c[3] = {0, 0, 0}, cov[3][3] = {{0}};
-        for (uint32_t j = 0; j < got; j++)
-            for (int a = 0; a < 3; a++)
-                c[a] += m->pos[3 * (size_t)ni[j] + (size_t)a] / (double)got;
-        for (uint32_t j = 0; j < got; j++) {
-            double d[3];
-            for (int a = 0; a < 3; a++)
-                d[a] = m->pos[3 * (size_t)ni[j] + (size_t)a] - c[a];
-            for (int a = 0; a < 3; a++)
-                for (int b = 0; b < 3; b++)
-                    cov[a][b] += d[a] * d[b];
-        }
-        double v[3];
-        sym3_min_eigvec(cov, v);
-        const double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        for (int a = 0; a < 3; a++)
-            m->normal[3 * (size_t)i + (size_t)a] = len > 0 ? (float)(v[a] / len) : (a == 0);
+        nm_plane_fit(m->pos, ni, got, m->normal + 3 * (size_t)i);
     }
     /* Prim over the k-NN graph, one tree per connected part, each rooted at its largest x */
     uint32_t n_parts = 0, left = n;

@@ -1,6 +1,7 @@
 /* Hierarchical octree B-spline fitting (Hua & Qin §4): per node a regularised least-squares
  * fit solved by Cholesky on the OCTFIT_NCOEF-square normal equations, split while the node's
- * MSE exceeds the bound; evaluation blends the leaves with C1 bump weights. */
+ * MSE exceeds the bound (never below the cloud's estimated noise); evaluation blends the leaves
+ * with C1 bump weights. */
 #include "host/fit/octree_fit.h"
 
 #include <math.h>
@@ -8,10 +9,19 @@
 #include <string.h>
 
 #include "host/fit/knn.h"
+#include "host/fit/normals.h"
 
-#define OF_FIT_SAMPLES_MAX 1000u /* data used per node's normal equations (spread evenly) */
+#define OF_FIT_SAMPLES_MAX 600u  /* data used per node's normal equations (spread evenly) */
 #define OF_SPLIT_MIN 32u         /* a node holding fewer data is not split */
 #define OF_LAMBDA_REL 1e-3       /* prior weight relative to the mean diagonal of A^T A */
+#define OF_PRIOR_FLOOR_REL 0.05  /* a coefficient whose data weigh less leans on the prior */
+#define OF_SMOOTH_REL 1e-4       /* thin-plate weight (relative, as above) on clean data ... */
+#define OF_SMOOTH_NOISE 30.0     /* ... plus this x (noise / knot spacing)^2 */
+#define OF_NOISE_OFFSET 3.0f     /* automatic offset e >= this x noise */
+#define OF_BINS 4                /* per axis: the bins of a node's local bias test */
+#define OF_BIN_MIN 8u            /* data a bin needs to take part */
+#define OF_NOISE_BIAS 1.5        /* a noisy node is split where a bin is off by this x noise */
+#define OF_NOISE_SPLIT 1.5       /* a node whose RMS residual is within this x noise is a leaf */
 #define OF_VOLUME_SAMPLES_MAX (1u << 20)
 
 typedef float (*of_prior_fn)(const void *ctx, const double p[3]);
@@ -22,6 +32,7 @@ typedef struct {
     size_t n;
     of_prior_fn prior;
     const void *prior_ctx;
+    double noise; /* estimated noise (sigma) of the data, in their units; 0 for none */
 } of_data_t;
 
 void octfit_opts_default(octfit_opts_t *o)
@@ -223,15 +234,126 @@ static bool of_cholesky(double *a, double *b, int n)
     return true;
 }
 
+/* The prior at Greville points, by lattice position: the nodes of one depth share their
+ * Greville lattice (a node's points are 4 of its neighbour's 6 per axis), so each value is
+ * asked of the prior once instead of up to 27 times. Open addressing; key 0 = empty. */
+typedef struct {
+    uint64_t *key;
+    float *val;
+    size_t cap, n;
+} of_cache_t;
+
+static void of_cache_free(of_cache_t *c)
+{
+    free(c->key);
+    free(c->val);
+    memset(c, 0, sizeof(*c));
+}
+
+static size_t of_cache_slot(const of_cache_t *c, uint64_t key)
+{
+    size_t i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (c->cap - 1);
+    while (c->key[i] != 0 && c->key[i] != key)
+        i = (i + 1) & (c->cap - 1);
+    return i;
+}
+
+/* Doubles the table (or makes its first one); false when out of memory (then it is unchanged). */
+static bool of_cache_grow(of_cache_t *c)
+{
+    of_cache_t g = {NULL, NULL, c->cap ? 2 * c->cap : 4096, c->n};
+    g.key = calloc(g.cap, sizeof(uint64_t));
+    g.val = malloc(g.cap * sizeof(float));
+    if (g.key == NULL || g.val == NULL) {
+        of_cache_free(&g);
+        return false;
+    }
+    for (size_t i = 0; i < c->cap; i++)
+        if (c->key[i] != 0) {
+            const size_t j = of_cache_slot(&g, c->key[i]);
+            g.key[j] = c->key[i];
+            g.val[j] = c->val[i];
+        }
+    of_cache_free(c);
+    *c = g;
+    return true;
+}
+
+/* The prior at g, the Greville point with lattice key key (non-zero). */
+static float of_prior_at(const of_data_t *d, of_cache_t *c, uint64_t key, const double g[3])
+{
+    if (c->cap > 0) {
+        const size_t i = of_cache_slot(c, key);
+        if (c->key[i] == key)
+            return c->val[i];
+    }
+    const float v = d->prior(d->prior_ctx, g);
+    if (2 * (c->n + 1) > c->cap && !of_cache_grow(c))
+        return v; /* no room: uncached, same value */
+    const size_t i = of_cache_slot(c, key);
+    c->key[i] = key;
+    c->val[i] = v;
+    c->n++;
+    return v;
+}
+
 typedef struct {
     double *ata, *atb; /* OCTFIT_NCOEF^2 and OCTFIT_NCOEF scratch */
+    double *smooth;    /* OCTFIT_NCOEF^2: the thin-plate energy's matrix (of_smooth_init) */
+    of_cache_t prior;
 } of_scratch_t;
 
-/* Least-squares fit of b (already initialised over the node's widened cube) to the data idx,
- * pulled towards the prior at the Greville points with weight lambda; MSE over all idx. */
-static argil_err_t of_fit_node(const of_data_t *d, const uint32_t *idx, size_t n_idx,
-                               bspline_t *b, of_scratch_t *s, double *mse)
+/* S such that c^T S c = sum over the coefficient lattice of the squared second differences
+ * c_aa^2 + 2 c_ab^2 (a != b): on uniform knots, h^4 times the thin-plate energy density
+ * f_xx^2 + f_yy^2 + f_zz^2 + 2 (f_xy^2 + f_xz^2 + f_yz^2) of the spline, up to the spline's
+ * lower-degree smoothing. Zero on linear functions, so planes are not biased. */
+static void of_smooth_init(double *S)
 {
+    const int n = (int)OCTFIT_N, nc = (int)OCTFIT_NCOEF;
+    memset(S, 0, sizeof(double) * (size_t)nc * (size_t)nc);
+    for (int a = 0; a < 3; a++)
+        for (int b = a; b < 3; b++)
+            for (int c = 0; c < nc; c++) {
+                int q[3] = {c % n, c / n % n, c / (n * n)}, id[4], m = 0;
+                double w[4];
+                const int st[3] = {1, n, n * n};
+                if (a == b) { /* c[i-1] - 2 c[i] + c[i+1] along a */
+                    if (q[a] < 1 || q[a] > n - 2)
+                        continue;
+                    id[0] = c - st[a], id[1] = c, id[2] = c + st[a];
+                    w[0] = 1.0, w[1] = -2.0, w[2] = 1.0;
+                    m = 3;
+                } else { /* the mixed difference over the lattice square at c, weight 2 */
+                    if (q[a] > n - 2 || q[b] > n - 2)
+                        continue;
+                    id[0] = c, id[1] = c + st[a], id[2] = c + st[b], id[3] = c + st[a] + st[b];
+                    w[0] = w[3] = M_SQRT2, w[1] = w[2] = -M_SQRT2;
+                    m = 4;
+                }
+                for (int x = 0; x < m; x++)
+                    for (int y = 0; y < m; y++)
+                        if (id[y] >= id[x])
+                            S[(size_t)id[x] * (size_t)nc + (size_t)id[y]] += w[x] * w[y];
+            }
+}
+
+typedef struct {
+    uint32_t node, depth;
+    uint32_t cell[3]; /* the cube's index among its depth's cubes */
+    double lo[3], size;
+    uint32_t *idx;
+    size_t n_idx;
+} of_task_t;
+
+/* Least-squares fit of b (already initialised over the node's widened cube) to the data of t,
+ * pulled towards the prior at the Greville points (weight lambda, more where data are thin) and
+ * smoothed by a thin-plate term weighted by the noise; the MSE over all of t's data and the
+ * largest local bias (mean residual of a bin of t's cube beyond 3 standard errors of noise). */
+static argil_err_t of_fit_node(const of_data_t *d, const of_task_t *t, bspline_t *b,
+                               of_scratch_t *s, double *mse, double *bias)
+{
+    const uint32_t *idx = t->idx, depth = t->depth, *cell = t->cell;
+    const size_t n_idx = t->n_idx;
     const int nc = (int)OCTFIT_NCOEF, n = (int)OCTFIT_N;
     memset(s->ata, 0, sizeof(double) * (size_t)nc * (size_t)nc);
     memset(s->atb, 0, sizeof(double) * (size_t)nc);
@@ -271,41 +393,68 @@ static argil_err_t of_fit_node(const of_data_t *d, const uint32_t *idx, size_t n
     double tr = 0.0;
     for (int c = 0; c < nc; c++)
         tr += s->ata[(size_t)c * (size_t)nc + (size_t)c];
-    const double lambda = tr > 0.0 ? OF_LAMBDA_REL * tr / nc : 1.0;
+    const double mean = tr > 0.0 ? tr / nc : 1.0, lambda = OF_LAMBDA_REL * mean;
+    /* Tikhonov: the thin-plate energy, stronger the larger the noise against the knot spacing,
+     * so that noise is averaged over several spans instead of followed */
+    const double h = b->knots[0][4] - b->knots[0][3], nr = d->noise / h;
+    const double smooth = used > 0 ? (OF_SMOOTH_REL + OF_SMOOTH_NOISE * nr * nr) * mean : 0.0;
+    for (int x = 0; x < nc; x++)
+        for (int y = x; y < nc; y++)
+            s->ata[(size_t)x * (size_t)nc + (size_t)y] += smooth * s->smooth[(size_t)x * (size_t)nc + (size_t)y];
     /* Greville abscissa of coefficient i on a uniform cubic knot vector: knot i + 2 */
     for (int kz = 0; kz < n; kz++)
         for (int ky = 0; ky < n; ky++)
             for (int kx = 0; kx < n; kx++) {
                 const int c = kx + n * (ky + n * kz);
                 const double g[3] = {b->knots[0][kx + 2], b->knots[1][ky + 2], b->knots[2][kz + 2]};
-                s->ata[(size_t)c * (size_t)nc + (size_t)c] += lambda;
-                s->atb[c] += lambda * d->prior(d->prior_ctx, g);
+                /* Greville point (kx, ky, kz) of cell (i, j, k) at this depth is lattice point
+                 * (2i + kx, 2j + ky, 2k + kz): knots are half a cell apart */
+                const uint64_t key = ((uint64_t)(depth + 1) << 60) |
+                                     ((uint64_t)(2 * cell[0] + (uint32_t)kx) << 40) |
+                                     ((uint64_t)(2 * cell[1] + (uint32_t)ky) << 20) |
+                                     (uint64_t)(2 * cell[2] + (uint32_t)kz);
+                /* a coefficient the data barely reach follows the prior, not the extrapolation
+                 * of data at the edge of its support (the floating blobs of an unweighted fit) */
+                double *acc = &s->ata[(size_t)c * (size_t)nc + (size_t)c];
+                const double lc = lambda + fmax(0.0, OF_PRIOR_FLOOR_REL * mean - *acc);
+                *acc += lc;
+                s->atb[c] += lc * of_prior_at(d, &s->prior, key, g);
             }
-    if (used == 0) { /* no data: A = lambda I, the prior itself */
+    if (used == 0) { /* no data: A diagonal, the prior itself */
         for (int c = 0; c < nc; c++)
-            s->atb[c] /= lambda;
+            s->atb[c] /= s->ata[(size_t)c * (size_t)nc + (size_t)c];
     } else if (!of_cholesky(s->ata, s->atb, nc)) {
         return ARGIL_ERR_STATE;
     }
     for (int c = 0; c < nc; c++)
         b->coef[c] = (float)s->atb[c];
-    double sum = 0.0;
+    /* the MSE, and the mean residual in each of OF_BINS^3 bins of the node's own cube: noise
+     * averages out of a bin's mean, a systematic error (a rounded edge) does not */
+    double sum = 0.0, bsum[OF_BINS * OF_BINS * OF_BINS] = {0};
+    uint32_t bn[OF_BINS * OF_BINS * OF_BINS] = {0};
     for (size_t u = 0; u < n_idx; u++) {
         const uint32_t j = idx[u];
         const double p[3] = {d->pos[3 * (size_t)j], d->pos[3 * (size_t)j + 1], d->pos[3 * (size_t)j + 2]};
         const double r = bspline_eval(b, p, NULL) - d->val[j];
         sum += r * r;
+        int bin = 0;
+        for (int a = 2; a >= 0 && bin >= 0; a--) {
+            const double x = (p[a] - t->lo[a]) / t->size * OF_BINS;
+            bin = x >= 0.0 && x < OF_BINS ? bin * OF_BINS + (int)x : -1;
+        }
+        if (bin >= 0) {
+            bsum[bin] += r;
+            bn[bin]++;
+        }
     }
     *mse = n_idx > 0 ? sum / (double)n_idx : 0.0; /* Hua & Qin §4 step 3 */
+    /* the largest bin bias beyond what noise alone gives its mean (3 standard errors) */
+    *bias = 0.0;
+    for (int k = 0; k < OF_BINS * OF_BINS * OF_BINS; k++)
+        if (bn[k] >= OF_BIN_MIN)
+            *bias = fmax(*bias, fabs(bsum[k]) / bn[k] - 3.0 * d->noise / sqrt((double)bn[k]));
     return ARGIL_OK;
 }
-
-typedef struct {
-    uint32_t node, depth;
-    double lo[3], size;
-    uint32_t *idx;
-    size_t n_idx;
-} of_task_t;
 
 static bool of_in_box(const float *p, const double lo[3], const double hi[3])
 {
@@ -318,20 +467,29 @@ static argil_err_t of_fit(const of_data_t *d, const double root_lo[3], double ro
                           const octfit_opts_t *o, octfit_model_t *out)
 {
     memset(out, 0, sizeof(*out));
-    const double bound = (double)o->tolerance * (double)o->tolerance;
+    /* Hua & Qin's MSE bound, but never below the noise: a node already fitted to within the
+     * noise has nothing left to fit but the noise itself */
+    const double tol = fmax((double)o->tolerance, OF_NOISE_SPLIT * d->noise), bound = tol * tol;
+    /* ... but that average over the node hides what is local: a node of a noisy cloud is also
+     * split where a part of it is off by more than the noise */
+    const bool noisy = d->noise > (double)o->tolerance;
     size_t cap = 1024, n_nodes = 1, head = 0, tail = 0;
     uint32_t *child = calloc(OCTFIT_NODES_MAX, sizeof(uint32_t));
     bspline_t *spl = calloc(OCTFIT_NODES_MAX, sizeof(bspline_t));
     of_task_t *q = malloc(cap * sizeof(of_task_t));
     of_scratch_t s = {malloc(sizeof(double) * OCTFIT_NCOEF * OCTFIT_NCOEF),
-                      malloc(sizeof(double) * OCTFIT_NCOEF)};
+                      malloc(sizeof(double) * OCTFIT_NCOEF),
+                      malloc(sizeof(double) * OCTFIT_NCOEF * OCTFIT_NCOEF), {NULL, NULL, 0, 0}};
     argil_err_t e = ARGIL_OK;
-    if (child == NULL || spl == NULL || q == NULL || s.ata == NULL || s.atb == NULL) {
+    if (child == NULL || spl == NULL || q == NULL || s.ata == NULL || s.atb == NULL ||
+        s.smooth == NULL) {
         e = ARGIL_ERR_NOMEM;
         goto out;
     }
+    of_smooth_init(s.smooth);
     q[tail].node = 0;
     q[tail].depth = 0;
+    memset(q[tail].cell, 0, sizeof(q[tail].cell));
     q[tail].size = root_size;
     memcpy(q[tail].lo, root_lo, sizeof(q[tail].lo));
     q[tail].idx = malloc((d->n + 1) * sizeof(uint32_t));
@@ -354,15 +512,16 @@ static argil_err_t of_fit(const of_data_t *d, const double root_lo[3], double ro
         }
         double wlo[3], whi[3];
         of_widen(t.lo, t.size, wlo, whi);
-        double mse = 0.0;
+        double mse = 0.0, bias = 0.0;
         e = bspline_init_uniform(&spl[t.node], nn, wlo, whi);
         if (e == ARGIL_OK)
-            e = of_fit_node(d, t.idx, t.n_idx, &spl[t.node], &s, &mse);
+            e = of_fit_node(d, &t, &spl[t.node], &s, &mse, &bias);
         if (e != ARGIL_OK) {
             free(t.idx);
             break;
         }
-        if (mse > bound && t.depth < o->max_depth && t.n_idx >= OF_SPLIT_MIN &&
+        const bool off = mse > bound || (noisy && bias > OF_NOISE_BIAS * d->noise);
+        if (off && t.depth < o->max_depth && t.n_idx >= OF_SPLIT_MIN &&
             n_nodes + 8 <= OCTFIT_NODES_MAX) {
             if (tail + 8 > cap) {
                 /* compact the queue, then grow it */
@@ -386,6 +545,8 @@ static argil_err_t of_fit(const of_data_t *d, const double root_lo[3], double ro
                 of_task_t *ct = &q[tail];
                 ct->node = (uint32_t)n_nodes + (uint32_t)c;
                 ct->depth = t.depth + 1;
+                for (int a = 0; a < 3; a++)
+                    ct->cell[a] = 2 * t.cell[a] + (uint32_t)((c >> a) & 1);
                 ct->size = 0.5 * t.size;
                 of_child_lo(t.lo, t.size, c, ct->lo);
                 double clo[3], chi[3];
@@ -438,6 +599,8 @@ out:
     free(q);
     free(s.ata);
     free(s.atb);
+    free(s.smooth);
+    of_cache_free(&s.prior);
     return e;
 }
 
@@ -468,6 +631,22 @@ static float of_cloud_prior(const void *ctx, const double p[3])
     return s > 0.0 ? -sqrtf(d2[0]) : sqrtf(d2[0]);
 }
 
+/* The bounding box of a cloud's (finite) points; returns its diagonal. */
+static float of_bounds(const mesh_t *pts, float lo[3], float hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+    }
+    for (size_t i = 0; i < pts->n_vert; i++)
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fminf(lo[a], pts->pos[3 * i + (size_t)a]);
+            hi[a] = fmaxf(hi[a], pts->pos[3 * i + (size_t)a]);
+        }
+    return sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
 static bool of_opts_ok(const octfit_opts_t *o)
 {
     return o != NULL && isfinite(o->tolerance) && o->tolerance > 0.0f &&
@@ -487,28 +666,62 @@ static void of_root(const float lo[3], const float hi[3], double root_lo[3], dou
         root_lo[a] = 0.5 * ((double)lo[a] + hi[a]) - 0.5 * *size;
 }
 
+octfit_cloud_t octfit_check_points(const mesh_t *pts, float *thickness_m, float *noise_m)
+{
+    if (thickness_m != NULL)
+        *thickness_m = 0.0f;
+    if (noise_m != NULL)
+        *noise_m = 0.0f;
+    if (pts == NULL || pts->n_vert < 4)
+        return OCTFIT_CLOUD_FEW;
+    if (pts->n_vert > UINT32_MAX / 3)
+        return OCTFIT_CLOUD_MANY;
+    const size_t n = pts->n_vert;
+    for (size_t i = 0; i < 3 * n; i++)
+        if (!isfinite(pts->pos[i]) || (pts->normal != NULL && !isfinite(pts->normal[i])))
+            return OCTFIT_CLOUD_NONFINITE;
+    /* four distinct positions, found in one pass */
+    const float *first[4] = {pts->pos, NULL, NULL, NULL};
+    int distinct = 1;
+    for (size_t i = 1; i < n && distinct < 4; i++) {
+        const float *p = pts->pos + 3 * i;
+        bool seen = false;
+        for (int k = 0; k < distinct && !seen; k++)
+            seen = p[0] == first[k][0] && p[1] == first[k][1] && p[2] == first[k][2];
+        if (!seen)
+            first[distinct++] = p;
+    }
+    if (distinct < 4)
+        return OCTFIT_CLOUD_DUPLICATES;
+    float noise = 0.0f;
+    const float thick = normals_thickness(pts);
+    if (normals_noise(pts, 0, &noise) != ARGIL_OK)
+        noise = 0.0f;
+    if (thickness_m != NULL)
+        *thickness_m = thick;
+    if (noise_m != NULL)
+        *noise_m = noise;
+    float lo[3], hi[3];
+    const float diag = of_bounds(pts, lo, hi);
+    return thick <= OCTFIT_FLAT_NOISE * noise + 1e-6f * diag ? OCTFIT_CLOUD_FLAT : OCTFIT_CLOUD_OK;
+}
+
 argil_err_t octfit_points(const mesh_t *pts, const octfit_opts_t *o, octfit_model_t *out)
 {
     memset(out, 0, sizeof(*out));
-    if (pts == NULL || pts->n_vert < 4 || pts->normal == NULL || !of_opts_ok(o) ||
-        pts->n_vert > UINT32_MAX / 3)
+    float noise = 0.0f;
+    if (pts == NULL || pts->normal == NULL || !of_opts_ok(o) ||
+        octfit_check_points(pts, NULL, &noise) != OCTFIT_CLOUD_OK)
         return ARGIL_ERR_ARG;
     const size_t n = pts->n_vert;
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < 3 * n; i++)
-        if (!isfinite(pts->pos[i]) || !isfinite(pts->normal[i]))
-            return ARGIL_ERR_ARG;
-    for (size_t i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++) {
-            lo[a] = fminf(lo[a], pts->pos[3 * i + (size_t)a]);
-            hi[a] = fmaxf(hi[a], pts->pos[3 * i + (size_t)a]);
-        }
-    const float diag = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    const float eps = o->offset_m > 0.0f ? o->offset_m : 0.005f * diag;
+    float lo[3], hi[3];
+    const float diag = of_bounds(pts, lo, hi);
+    /* off-surface points must stand clear of the noise, or their +-e values say nothing */
+    const float eps = o->offset_m > 0.0f ? o->offset_m : fmaxf(0.005f * diag, OF_NOISE_OFFSET * noise);
     float *pos = malloc(9 * n * sizeof(float)), *val = malloc(3 * n * sizeof(float));
     of_cloud_prior_t pr;
     memset(&pr, 0, sizeof(pr));
+
     argil_err_t e = pos != NULL && val != NULL ? ARGIL_OK : ARGIL_ERR_NOMEM;
     const size_t np = n < OF_PRIOR_SAMPLES_MAX ? n : OF_PRIOR_SAMPLES_MAX;
     pr.pos = malloc(3 * np * sizeof(float));
@@ -538,13 +751,14 @@ argil_err_t octfit_points(const mesh_t *pts, const octfit_opts_t *o, octfit_mode
         val[n + i] = len > 0.0f ? eps : 0.0f;
         val[2 * n + i] = len > 0.0f ? -eps : 0.0f;
     }
-    const of_data_t d = {pos, val, 3 * n, of_cloud_prior, &pr};
+    const of_data_t d = {pos, val, 3 * n, of_cloud_prior, &pr, noise};
     double root_lo[3], size;
     of_root(lo, hi, root_lo, &size);
     e = of_fit(&d, root_lo, size, o, out);
     if (e != ARGIL_OK)
         goto out;
     out->kind = OCTFIT_SIGNED_DISTANCE;
+    out->noise_m = noise;
     /* distance estimate |f| / |grad f| at every surface sample */
     double sum2 = 0.0, mx = 0.0;
     const double h = 1e-4 * size;
@@ -554,11 +768,10 @@ argil_err_t octfit_points(const mesh_t *pts, const octfit_opts_t *o, octfit_mode
         const double p[3] = {pts->pos[3 * i], pts->pos[3 * i + 1], pts->pos[3 * i + 2]};
         const double f = of_eval_d(out, p);
         double g2 = 0.0;
-        for (int a = 0; a < 3; a++) {
-            double pp[3] = {p[0], p[1], p[2]}, pm[3] = {p[0], p[1], p[2]};
+        for (int a = 0; a < 3; a++) { /* forward differences: an estimate, at 4 evaluations */
+            double pp[3] = {p[0], p[1], p[2]};
             pp[a] += h;
-            pm[a] -= h;
-            const double g = (of_eval_d(out, pp) - of_eval_d(out, pm)) / (2.0 * h);
+            const double g = (of_eval_d(out, pp) - f) / h;
             g2 += g * g;
         }
         const double dist = g2 > 1e-12 ? fabs(f) / sqrt(g2) : fabs(f);
@@ -662,7 +875,7 @@ argil_err_t octfit_volume(const float *v, const int32_t dims[3], float spacing_m
                 const float s = v[(size_t)x + (size_t)dims[0] * ((size_t)y + (size_t)dims[1] * (size_t)z)];
                 val[i] = (s - lo) / (hi - lo) - iso_norm;
             }
-    const of_data_t d = {pos, val, n, of_vol_prior, &pr};
+    const of_data_t d = {pos, val, n, of_vol_prior, &pr, 0.0};
     const float blo[3] = {origin_m.x, origin_m.y, origin_m.z};
     const float bhi[3] = {origin_m.x + spacing_m * (float)(dims[0] - 1),
                           origin_m.y + spacing_m * (float)(dims[1] - 1),

@@ -39,6 +39,7 @@ typedef struct {
     uint32_t kind;         /* octfit_kind_t */
     uint32_t depth;        /* deepest leaf level (root = 0) */
     float rms_err, max_err; /* surface samples: |f| / |grad f| (m); volumes: |f - d| */
+    float noise_m;         /* the cloud's estimated noise sigma (not stored; 0 for volumes) */
 } octfit_model_t;
 
 typedef struct {
@@ -50,12 +51,32 @@ typedef struct {
     void *progress_ctx;
 } octfit_opts_t;
 
+/* Why a point cloud bounds no solid to fit (octfit_check_points). */
+typedef enum {
+    OCTFIT_CLOUD_OK = 0,
+    OCTFIT_CLOUD_FEW,        /* fewer than 4 points */
+    OCTFIT_CLOUD_MANY,       /* more than 2^32 / 3 points */
+    OCTFIT_CLOUD_NONFINITE,  /* a coordinate (or a normal, when it has them) is NaN or Inf */
+    OCTFIT_CLOUD_DUPLICATES, /* fewer than 4 distinct positions */
+    OCTFIT_CLOUD_FLAT        /* all on one plane or line: thickness within the noise */
+} octfit_cloud_t;
+
+#define OCTFIT_FLAT_NOISE 3.0f /* a cloud thinner (RMS off its plane) than this x its noise is flat */
+
+/* Which rule a cloud breaks (OCTFIT_CLOUD_OK if none); normals are checked when pts has them.
+ * thickness_m and noise_m (either may be NULL) receive the RMS distance of the points to their
+ * plane and the noise estimate (normals_noise) when they were measured, else 0. */
+octfit_cloud_t octfit_check_points(const mesh_t *pts, float *thickness_m, float *noise_m);
+
 /* No tolerance (the caller must set one > 0), max depth 5, automatic offset. */
 void octfit_opts_default(octfit_opts_t *o);
 
-/* Fits a point cloud with unit outward normals (>= 4 finite points). The prior where no data
- * reach is the distance to the nearest sample, signed by its normal. ARGIL_ERR_ARG (too few
- * points, NaN / Inf, bad options), NOMEM, STATE (stopped). */
+/* Fits a point cloud with unit outward normals that passes octfit_check_points. The prior where
+ * no data reach is the distance to the nearest sample, signed by its normal. The noise sigma is
+ * estimated from the points (normals_noise) and sets a floor under the off-surface distance
+ * (3 sigma), the node error bound (1.5 sigma, with a local bias test) and the smoothing, so a
+ * noisy scan is averaged, not followed. ARGIL_ERR_ARG (a cloud octfit_check_points rejects, bad
+ * options), NOMEM, STATE (stopped). */
 argil_err_t octfit_points(const mesh_t *pts, const octfit_opts_t *o, octfit_model_t *out);
 
 /* Fits a volume of intensities v (x fastest, dims, sample (0,0,0) at origin_m, cubic cells of

@@ -1,19 +1,22 @@
 /* make bench (host mesh + fit figures): full marching cubes of a 256³ sphere field, incremental
  * re-mesh after a 40³ tool stroke, the live mesher's memory and a stroke that grows the clay
- * past its box, and RBF and octree B-spline fitting on Guo et al. Table 2 point counts. Single
- * thread; medians of repeated runs. Built and run by tests/bench.sh. */
+ * past its box, RBF and octree B-spline fitting on Guo et al. Table 2 point counts, and octree
+ * fits of 30,000-point scans with through-holes, sharp edges and noise (`bench_mesh scans` runs
+ * only those). Single thread; medians of repeated runs. Built and run by tests/bench.sh. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "host/fit/normals.h"
 #include "host/fit/octree_fit.h"
 #include "host/fit/rbf.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/model/grid.h"
+#include "tests/unit/fit_shapes.h"
 #include "tests/unit/grid_view.h"
 
 static double now_s(void)
@@ -121,8 +124,78 @@ static void bench_grow(void)
     grid_free(&g);
 }
 
-int main(void)
+/* The octree fit of 30,000-point scans (tests/unit/fit_shapes.h), with the CLI's defaults:
+ * median time of 5 runs, nodes, and the meshed surface against the true one. */
+static void bench_scans(void)
 {
+    enum { RUNS = 5, POINTS = 30000 };
+    char load[64] = "?";
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la != NULL) {
+        if (fgets(load, sizeof(load), la) != NULL)
+            load[strcspn(load, " ")] = '\0';
+        fclose(la);
+    }
+    printf("  octree fit of scanned solids, %d points, CLI defaults (tolerance 0.2 %% of the longest\n"
+           "  extent, depth 5); median of %d runs; errors: mesh vertices (grid diagonal/64) to the true\n"
+           "  surface, %% of the bounding-box diagonal; goal <= 2 s, max <= 2 %%, 1 component (load %s):\n",
+           POINTS, RUNS, load);
+    for (int s = 0; s < 2; s++)
+        for (int noisy = 0; noisy < 2; noisy++)
+            for (int given = 1; given >= 0; given--) {
+                const fs_shape_t sh = (fs_shape_t)s;
+                const float *h = fs_half[sh];
+                mesh_t c;
+                mesh_init(&c);
+                if (fs_sample(sh, POINTS, noisy ? 0.005 * fs_diag(sh) : 0.0, 777 + (uint64_t)s, &c) != ARGIL_OK)
+                    return;
+                double tn[RUNS], tf[RUNS], cf[RUNS];
+                for (int r = 0; r < RUNS && !given; r++) {
+                    const double t0 = now_s();
+                    normals_estimate(&c, NULL, NULL);
+                    tn[r] = now_s() - t0;
+                }
+                struct timespec c0, c1;
+                octfit_opts_t o;
+                octfit_opts_default(&o);
+                o.tolerance = 0.002f * 2.0f * fmaxf(h[0], fmaxf(h[1], h[2]));
+                octfit_model_t of;
+                argil_err_t e = ARGIL_OK;
+                for (int r = 0; r < RUNS && e == ARGIL_OK; r++) {
+                    const double t0 = now_s();
+                    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+                    e = octfit_points(&c, &o, &of);
+                    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+                    tf[r] = now_s() - t0;
+                    cf[r] = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+                    if (r < RUNS - 1 && e == ARGIL_OK)
+                        octfit_free(&of);
+                }
+                fs_measure_t d = {0};
+                if (e == ARGIL_OK)
+                    e = fs_measure(&of, fs_dist_cb, &sh, h, (float)fs_diag(sh), 64, &d);
+                char nt[32] = "";
+                if (!given)
+                    snprintf(nt, sizeof(nt), " + normals %.3f s", median(tn, RUNS));
+                if (e == ARGIL_OK)
+                    printf("    %-14s %-5s %-7s: fit %.3f s (CPU %.3f s)%s, %5u nodes (depth %u); max %.3f %% mean %.3f %%, "
+                           "%u component(s), Euler %ld\n", s == FS_HOLED_BOX ? "holed box" : "plate, 2 holes",
+                           noisy ? "noisy" : "clean", given ? "normals" : "PCA", median(tf, RUNS),
+                           median(cf, RUNS), nt,
+                           of.n_nodes, of.depth, 100.0 * d.max, 100.0 * d.mean, d.components, d.euler);
+                else
+                    printf("    %-14s: FAILED (%d)\n", s == FS_HOLED_BOX ? "holed box" : "plate, 2 holes", (int)e);
+                octfit_free(&of);
+                mesh_free(&c);
+            }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "scans") == 0) {
+        bench_scans();
+        return 0;
+    }
     enum { N = 256, RUNS = 5 };
     grid_t g;
     const int32_t dims[3] = {N, N, N};
@@ -247,5 +320,6 @@ int main(void)
             octfit_free(&of);
         mesh_free(&p);
     }
+    bench_scans();
     return 0;
 }

@@ -3,7 +3,7 @@
 # normals, and as a closed STL through its signed distance), meshed to every export format, each
 # file loads in assimp and is watertight, every surface is within 0.5 % (mean) and 2 % (max) of
 # the true sphere, an octree model re-meshed finer comes from its B-splines (and argil info lists
-# the octree), and bad files and options give one clear line.
+# the octree), and bad files, clouds that bound no solid and bad options give one clear line.
 set -eu
 bin="$SAN/argil"
 tmp=$(mktemp -d)
@@ -55,6 +55,13 @@ expect_error 1 "bad.argil: byte .*checksum mismatch" mesh "$tmp/bad.argil" -o "$
 [ ! -e "$tmp/x.ply" ] || fail "a refused model still wrote a mesh"
 printf '0 0 0\n1 2\n' >"$tmp/bad.xyz"
 expect_error 1 "bad.xyz: line 2: 2 values" fit "$tmp/bad.xyz" -o "$tmp/y.argil"
+# clouds that bound no solid: one clear line each, nothing written
+awk 'BEGIN { for (i = 0; i < 500; i++) print 0.01 * (i % 3), 0.02, 0 }' >"$tmp/dup.xyz"
+expect_error 1 "dup.xyz: fewer than 4 distinct points" fit "$tmp/dup.xyz" -o "$tmp/y.argil"
+awk 'BEGIN { srand(3); for (i = 0; i < 2000; i++) print 0.05 * rand(), 0.05 * rand(), 0 }' >"$tmp/flat.xyz"
+expect_error 1 "flat.xyz: the points lie on one plane or line" fit "$tmp/flat.xyz" -o "$tmp/y.argil"
+expect_error 1 "flat.xyz: the points lie on one plane or line" fit "$tmp/flat.xyz" -o "$tmp/y.argil" --method rbf
+[ ! -e "$tmp/y.argil" ] || fail "a refused cloud still wrote a model"
 # sphere surface check on an ASCII PLY mesh of a model: mean <= 0.5 %, max <= 2 % of 60 mm
 check_sphere() { # model label
     "$bin" mesh "$1" -o "$tmp/c.ply" --ascii --resolution 60 --quiet || fail "$2: mesh"
