@@ -119,29 +119,50 @@ static bool is_tpdo1(uint32_t id)
     return id > CANOPEN_COB_TPDO1 && id <= CANOPEN_COB_TPDO1 + 0x7Fu;
 }
 
-argil_err_t can_socket_receive_latest(int fd, can_batch_t *rx, can_socket_stats_t *st)
+static bool fifo_full(const can_fifo_t *q)
+{
+    return q->n == CAN_RX_QUEUE_MAX;
+}
+
+static void fifo_push(can_fifo_t *q, const can_frame_t *f)
+{
+    q->f[(q->head + q->n) % CAN_RX_QUEUE_MAX] = *f;
+    q->n++;
+}
+
+/* Moves frames from q into rx while both allow. */
+static void fifo_pour(can_fifo_t *q, can_batch_t *rx)
+{
+    while (q->n > 0 && rx->n < CAN_BATCH_MAX) {
+        (void)can_batch_push(rx, &q->f[q->head]);
+        q->head = (q->head + 1u) % CAN_RX_QUEUE_MAX;
+        q->n--;
+    }
+}
+
+argil_err_t can_socket_receive_queued(int fd, can_rx_queue_t *q, can_batch_t *rx,
+                                      can_socket_stats_t *st)
 {
     rx->n = 0;
-    for (uint32_t i = 0; i < CAN_RX_DRAIN_MAX && rx->n < CAN_BATCH_MAX; i++) {
+    argil_err_t err = ARGIL_OK;
+    for (uint32_t i = 0; i < 2u * CAN_RX_QUEUE_MAX && !fifo_full(&q->tpdo) && !fifo_full(&q->event);
+         i++) {
         can_frame_t f;
         const int r = read_frame(fd, &f, st);
         if (r == 0)
-            return ARGIL_OK;
-        if (r < 0)
-            return ARGIL_ERR_IO;
-        if (r != 1)
-            continue;
-        bool replaced = false;
-        for (uint8_t k = 0; is_tpdo1(f.id) && k < rx->n && !replaced; k++)
-            if (rx->f[k].id == f.id) {
-                rx->f[k] = f;
-                replaced = true;
-                st->rx_coalesced++;
-            }
-        if (!replaced)
-            (void)can_batch_push(rx, &f);
+            break;
+        if (r < 0) {
+            err = ARGIL_ERR_IO;
+            break;
+        }
+        if (r == 1)
+            fifo_push(is_tpdo1(f.id) ? &q->tpdo : &q->event, &f);
     }
-    return ARGIL_OK;
+    if (q->tpdo.n + q->event.n > st->rx_queue_peak)
+        st->rx_queue_peak = q->tpdo.n + q->event.n;
+    fifo_pour(&q->event, rx);
+    fifo_pour(&q->tpdo, rx);
+    return err;
 }
 
 argil_err_t can_socket_send(int fd, const can_batch_t *tx, can_socket_stats_t *st)

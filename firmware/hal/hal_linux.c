@@ -167,7 +167,7 @@ argil_err_t hal_can_receive(hal_t *h, can_batch_t *rx)
         h->sim_from_board.n = 0;
         return ARGIL_OK;
     }
-    return can_socket_receive_latest(h->can_fd, rx, &h->can);
+    return can_socket_receive_queued(h->can_fd, &h->can_rx, rx, &h->can);
 }
 
 argil_err_t hal_can_send(hal_t *h, const can_batch_t *tx)

@@ -23,6 +23,7 @@ struct hal {
     hal_bus_t bus;
     int can_fd;
     can_socket_stats_t can;
+    can_rx_queue_t can_rx;
     gpio_port_t gpio;
     /* sim bus */
     sim_device_t *sim;

@@ -80,10 +80,10 @@ static void test_can_socket_frames_and_error_frames(void **st)
 }
 
 /* After a stalled tick the board's socket holds a backlog: 40 ticks of the three drives' TPDOs
- * with a heartbeat and an EMCY among them. The board's read takes them all in one tick, the
- * newest TPDO of each drive and both of the others, instead of 32 frames that leave the
- * heartbeat queued behind the rest until the socket's queue overflows. */
-static void test_can_board_read_drains_a_backlog(void **st)
+ * with a heartbeat and an EMCY among them. The board's read takes the whole backlog out of the
+ * socket at once (whose queue would overflow and lose frames), hands the core the heartbeat and
+ * the EMCY in the first tick, and the TPDOs in their order, a batch a tick. */
+static void test_can_board_read_queues_a_backlog(void **st)
 {
     (void)st;
     int sv[2];
@@ -105,22 +105,30 @@ static void test_can_board_read_drains_a_backlog(void **st)
             assert_int_equal(write(sv[1], &cf, sizeof(cf)), (ssize_t)sizeof(cf));
         }
     }
+    static can_rx_queue_t q;
     can_batch_t rx;
     can_socket_stats_t stats = {0};
-    assert_int_equal(can_socket_receive_latest(sv[0], &rx, &stats), ARGIL_OK);
-    assert_int_equal(rx.n, 5);
-    assert_int_equal(stats.rx_frames, 122);
-    assert_int_equal(stats.rx_coalesced, 117);
-    bool hb = false, emcy = false;
-    for (uint8_t i = 0; i < rx.n; i++) {
-        if (rx.f[i].id >= 0x181 && rx.f[i].id <= 0x183)
-            assert_int_equal(rx.f[i].data[2], 39); /* the newest of each drive */
-        hb |= rx.f[i].id == 0x702;
-        emcy |= rx.f[i].id == 0x083;
+    assert_int_equal(can_socket_receive_queued(sv[0], &q, &rx, &stats), ARGIL_OK);
+    assert_int_equal(stats.rx_frames, 122); /* the socket is empty after one read */
+    assert_int_equal(rx.n, CAN_BATCH_MAX);
+    assert_int_equal(rx.f[0].id, 0x702);
+    assert_int_equal(rx.f[1].id, 0x083);
+    int tpdos = 0, last[4] = {-1, -1, -1, -1};
+    for (int tick = 0; tick < 5; tick++) {
+        if (tick > 0)
+            assert_int_equal(can_socket_receive_queued(sv[0], &q, &rx, &stats), ARGIL_OK);
+        for (uint8_t i = 0; i < rx.n; i++) {
+            const uint32_t id = rx.f[i].id;
+            if (id < 0x181 || id > 0x183)
+                continue;
+            assert_int_equal(rx.f[i].data[2], last[id - 0x180] + 1); /* in order, none lost */
+            last[id - 0x180] = rx.f[i].data[2];
+            tpdos++;
+        }
     }
-    assert_true(hb && emcy);
-    /* Nothing is left for the next tick. */
-    assert_int_equal(can_socket_receive_latest(sv[0], &rx, &stats), ARGIL_OK);
+    assert_int_equal(tpdos, 120);
+    assert_int_equal(stats.rx_queue_peak, 122);
+    assert_int_equal(can_socket_receive_queued(sv[0], &q, &rx, &stats), ARGIL_OK);
     assert_int_equal(rx.n, 0);
     close(sv[0]);
     close(sv[1]);
@@ -415,7 +423,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_can_socket_frames_and_error_frames),
-        cmocka_unit_test(test_can_board_read_drains_a_backlog),
+        cmocka_unit_test(test_can_board_read_queues_a_backlog),
         cmocka_unit_test(test_can_open_errors_are_one_line),
         cmocka_unit_test(test_gpio_mapping_by_name),
         cmocka_unit_test(test_gpio_errors_name_the_line),
