@@ -461,6 +461,16 @@ static void synth_beats(hil_obs_t *o, const scenario_t *s, int ticks, const int 
     }
 }
 
+/* synth_beats' 2.5 s log judged by s's first expectation. */
+static void judge_beats(const scenario_t *s, const int *skip, int n_skip, int off_tick,
+                        int on_again, hil_result_t *r)
+{
+    hil_obs_t o;
+    synth_beats(&o, s, 2500, skip, n_skip, off_tick, on_again);
+    hil_check_expect(s, &o, 0, r);
+    hil_obs_free(&o);
+}
+
 /* heartbeat_supervised holds the board to the consumer rule from what was on the bus: one lost
  * heartbeat ridden, two in a row off at 250 (+2) ticks, and off stays off. */
 static void test_heartbeat_supervised(void **st)
@@ -472,41 +482,30 @@ static void test_heartbeat_supervised(void **st)
     scn_error_t err;
     assert_int_equal(scenario_parse(&s, text, sizeof(text) - 1, &err), SCN_OK);
     assert_int_equal(s.expect[0].kind, SCN_EXP_HEARTBEAT_SUPERVISED);
-    hil_obs_t o;
     hil_result_t r;
     /* beat 8 (tick 750) lost: a 200-tick gap, on throughout */
     static const int one[] = {8}, two[] = {8, 9};
-    synth_beats(&o, &s, 2500, one, 1, 0, 0);
-    hil_check_expect(&s, &o, 0, &r);
+    judge_beats(&s, one, 1, 0, 0, &r);
     if (!r.pass)
         fail_msg("%s", r.msg);
     assert_int_equal(r.tolerated, 1);
-    hil_obs_free(&o);
     /* the same log with the board off at tick 900 (heartbeat 250 ticks old at most): spurious */
-    synth_beats(&o, &s, 2500, one, 1, 900, 0);
-    hil_check_expect(&s, &o, 0, &r);
+    judge_beats(&s, one, 1, 900, 0, &r);
     assert_false(r.pass);
     assert_non_null(strstr(r.msg, "under 250 ticks old"));
-    hil_obs_free(&o);
     /* beats 8 and 9 lost: the last drive-2 beat on the bus came in tick 650, read in it; the
      * board's age passes 250 in tick 901, whose RPDOs follow 251 SYNCs after the beat */
-    synth_beats(&o, &s, 2500, two, 2, 901, 0);
-    hil_check_expect(&s, &o, 0, &r);
+    judge_beats(&s, two, 2, 901, 0, &r);
     if (!r.pass)
         fail_msg("%s", r.msg);
     assert_int_equal(r.observed_ticks, 251);
-    hil_obs_free(&o);
     /* ... off only at tick 905: 255 SYNCs, past the bound (251 + a late read + log order) */
-    synth_beats(&o, &s, 2500, two, 2, 905, 0);
-    hil_check_expect(&s, &o, 0, &r);
+    judge_beats(&s, two, 2, 905, 0, &r);
     assert_false(r.pass);
     assert_non_null(strstr(r.msg, "still on"));
-    hil_obs_free(&o);
     /* ... off at 901 but torque again at 1500: the fault must latch */
-    synth_beats(&o, &s, 2500, two, 2, 901, 1500);
-    hil_check_expect(&s, &o, 0, &r);
+    judge_beats(&s, two, 2, 901, 1500, &r);
     assert_false(r.pass);
-    hil_obs_free(&o);
 }
 
 /* An expectation time after a step counts board ticks from that step's logged injection: a
