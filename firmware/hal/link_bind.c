@@ -1,21 +1,14 @@
 /* Sender binding of the datagram transports (link_bind.h). */
 #include "link_bind.h"
 
+#include <string.h>
+
 #include "shared/proto.h"
 
 void link_bind_init(link_bind_t *lb)
 {
-    lb->bound = false;
-    lb->peer = 0;
-    lb->pending = false;
-    lb->pending_epoch = 0;
-    lb->pending_since_us = 0;
+    memset(lb, 0, sizeof(*lb)); /* nothing bound, no session, nothing counted */
     lb->state = HAL_SESSION_NONE;
-    lb->epoch = 0;
-    lb->lapsed_since_us = 0;
-    lb->binds = 0;
-    lb->refused_source = 0;
-    lb->refused_no_session = 0;
 }
 
 void link_bind_session(link_bind_t *lb, hal_session_state_t state, uint32_t epoch,

@@ -493,15 +493,24 @@ static fx_t *twin_run(const char *file)
     return t;
 }
 
+/* Runs a matrix row and its twin without the link faults; the largest difference between
+ * their forces tick by tick goes to *diff_n, the largest force to *peak_n. */
+static fx_t *run_with_twin(const matrix_row_t *row, fx_t **twin, float *diff_n, float *peak_n)
+{
+    fx_t *x = run_row_keep(row);
+    *twin = twin_run(row->file);
+    *diff_n = force_diff_n(x, *twin, peak_n);
+    return x;
+}
+
 /* The host's frames twice (up to 300; as many as it sends by the end): every second copy is
  * refused and counted, none acts, and the hand feels exactly what it feels without them. */
 static void test_link_duplicate(void **st)
 {
     (void)st;
-    fx_t *x = run_row_keep(&matrix[12]);
-    fx_t *t = twin_run(matrix[12].file);
-    float peak = 0.0f;
-    const float diff = force_diff_n(x, t, &peak);
+    fx_t *t;
+    float diff, peak;
+    fx_t *x = run_with_twin(&matrix[12], &t, &diff, &peak);
     const board_stats_t *bs = &x->r->board.stats;
     printf("  link_duplicate: %u copies, refused duplicate %u, stale %u, no session %u; force "
            "differs from the run without duplicates by %.6f N (peak %.3f N)\n", x->dup_sent,
@@ -523,10 +532,9 @@ static void test_link_duplicate(void **st)
 static void test_link_reorder(void **st)
 {
     (void)st;
-    fx_t *x = run_row_keep(&matrix[13]);
-    fx_t *t = twin_run(matrix[13].file);
-    float peak = 0.0f;
-    const float diff = force_diff_n(x, t, &peak);
+    fx_t *t;
+    float diff, peak;
+    fx_t *x = run_with_twin(&matrix[13], &t, &diff, &peak);
     const board_stats_t *bs = &x->r->board.stats;
     printf("  link_reorder: refused duplicate %u, stale %u; force differs from the run in "
            "order by %.6f N (peak %.3f N)\n", bs->refused_duplicate, bs->refused_stale,

@@ -28,6 +28,16 @@ board = ('127.0.0.1', port)
 sent = disarm = end = hello = received = 0
 seq = 0x40000000
 t_end = time.monotonic() + seconds
+
+def drain():
+    global received
+    try:
+        while True:
+            s.recv(2048)
+            received += 1
+    except BlockingIOError:
+        pass
+
 while time.monotonic() < t_end:
     k = sent % 10
     if k == 9:
@@ -44,17 +54,7 @@ while time.monotonic() < t_end:
     sent += 1
     seq += 1
     time.sleep(0.002)
-    try:
-        while True:
-            s.recv(2048)
-            received += 1
-    except BlockingIOError:
-        pass
+    drain()
 time.sleep(0.2)
-try:
-    while True:
-        s.recv(2048)
-        received += 1
-except BlockingIOError:
-    pass
+drain()
 print('sent %d disarm %d end %d hello %d received %d' % (sent, disarm, end, hello, received))
