@@ -28,7 +28,7 @@ LDLIBS := -lm
 
 SHARED_SRC := $(wildcard shared/*.c)
 CORE_SRC := $(wildcard firmware/core/*.c)
-HAL_SIM_SRC := firmware/hal/hal_sim.c
+HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 # The host's USB link cuts its byte stream with the board's own framer (host/link/link_usb.c).
@@ -39,7 +39,7 @@ RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
 BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
                  firmware/hal/gpio_gpiod.c firmware/hal/link_framer.c firmware/hal/link_udp.c \
-                 firmware/hal/link_ffs.c
+                 firmware/hal/link_bind.c firmware/hal/link_ffs.c
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
 BOARD_LDLIBS := -lgpiod -lpthread -lm

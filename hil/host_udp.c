@@ -118,6 +118,7 @@ typedef struct {
     bool synced;
     uint32_t next_step;
     atomic_uint rearm_ms;           /* ARM heartbeats wanted (ms), for the main loop */
+    uint32_t next_seq;              /* every frame's number, one sequence (under mu) */
     atomic_int unsupported;
     atomic_bool synced_flag, done;
     atomic_llong now_us;            /* scenario time, for the main loop's prints */
@@ -129,13 +130,30 @@ static void raw_send(shost_t *h, const uint8_t *f, size_t len)
     h->frames_sent++;
 }
 
+/* Gives a frame the next number of this host's one sequence (the board refuses a number it
+ * has seen and one far behind its newest) and reseals its CRC; the caller holds h->mu. */
+static void stamp_seq(shost_t *h, uint8_t *f, size_t len)
+{
+    if (len < PROTO_HEADER_SIZE + PROTO_CRC_SIZE)
+        return;
+    const uint32_t seq = h->next_seq++;
+    for (int k = 0; k < 4; k++)
+        f[8 + k] = (uint8_t)(seq >> (8 * k));
+    const uint32_t crc = crc32c(0u, f, len - PROTO_CRC_SIZE);
+    for (int k = 0; k < 4; k++)
+        f[len - PROTO_CRC_SIZE + (size_t)k] = (uint8_t)(crc >> (8 * k));
+}
+
 /* The peer's frames go through the scripted link faults; the caller holds h->mu. */
-static bool shost_send_locked(shost_t *h, const uint8_t *f, size_t len)
+static bool shost_send_locked(shost_t *h, const uint8_t *frame, size_t len)
 {
     if (h->lost || len > PROTO_FRAME_MAX) {
         h->frames_dropped++;
         return true;
     }
+    uint8_t f[PROTO_FRAME_MAX];
+    memcpy(f, frame, len);
+    stamp_seq(h, f, len);
     if (h->delay_us > 0) {
         if (h->n_held == HELD_MAX) {
             h->frames_dropped++;
@@ -385,9 +403,7 @@ static bool shost_send_nan_tool(shost_t *h, const msg_tool_t *tool)
         return false;
     const float nan = NAN;
     memcpy(buf + at, &nan, 4);
-    const uint32_t crc = crc32c(0u, buf, len - PROTO_CRC_SIZE);
-    for (int k = 0; k < 4; k++)
-        buf[len - PROTO_CRC_SIZE + (size_t)k] = (uint8_t)(crc >> (8 * k));
+    stamp_seq(h, buf, len); /* and the CRC made valid again */
     if (!h->lost)
         raw_send(h, buf, len);
     return true;

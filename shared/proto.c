@@ -1,4 +1,4 @@
-/* Wire protocol v1: frames between board and host, encoded field by field (docs/protocol.md),
+/* Wire protocol v2: frames between board and host, encoded field by field (docs/protocol.md),
  * and the reassembly of WINDOW chunks into one versioned local density window. */
 #include "proto.h"
 
@@ -18,7 +18,7 @@
 #define WINDOW_SAMPLE_SIZE 4u
 #define TOOL_SIZE 72u
 #define FAULT_SIZE 15u
-#define RT_STATS_SIZE (48u + 8u * PROTO_RT_HIST_BINS)
+#define RT_STATS_SIZE (48u + 8u * PROTO_RT_HIST_BINS + 24u)
 
 _Static_assert(IMPULSE_HEAD_SIZE + IMPULSE_ENTRY_SIZE * PROTO_IMPULSE_MAX <= PROTO_PAYLOAD_MAX,
                "a full IMPULSE frame must fit in PROTO_FRAME_MAX");
@@ -195,7 +195,7 @@ static proto_err_t msg_check(const proto_msg_t *msg)
         return PROTO_OK;
     }
     case MSG_HEARTBEAT:
-        return msg->u.heartbeat.command > PROTO_CMD_DISARM ? PROTO_ERR_VALUE : PROTO_OK;
+        return msg->u.heartbeat.command > PROTO_CMD_LAST ? PROTO_ERR_VALUE : PROTO_OK;
     case MSG_TELEMETRY: {
         const msg_telemetry_t *t = &msg->u.telemetry;
         if (t->tool_kind >= TOOL_KIND_COUNT || !all_finite(t->pos_m, 3u) ||
@@ -398,6 +398,12 @@ static void put_payload(wire_writer_t *w, const proto_msg_t *msg)
             wire_put_u32(w, r->wake_hist[i]);
         for (size_t i = 0; i < PROTO_RT_HIST_BINS; i++)
             wire_put_u32(w, r->compute_hist[i]);
+        wire_put_u32(w, r->link.decode_errors);
+        wire_put_u32(w, r->link.wrong_source);
+        wire_put_u32(w, r->link.no_session);
+        wire_put_u32(w, r->link.duplicate);
+        wire_put_u32(w, r->link.stale);
+        wire_put_u32(w, r->link.sessions);
         break;
     }
     default:
@@ -526,6 +532,12 @@ static proto_err_t get_fixed(wire_reader_t *r, size_t plen, proto_msg_t *msg)
             s->wake_hist[i] = wire_get_u32(r);
         for (size_t i = 0; i < PROTO_RT_HIST_BINS; i++)
             s->compute_hist[i] = wire_get_u32(r);
+        s->link.decode_errors = wire_get_u32(r);
+        s->link.wrong_source = wire_get_u32(r);
+        s->link.no_session = wire_get_u32(r);
+        s->link.duplicate = wire_get_u32(r);
+        s->link.stale = wire_get_u32(r);
+        s->link.sessions = wire_get_u32(r);
         return PROTO_OK;
     }
     default:

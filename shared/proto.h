@@ -1,4 +1,4 @@
-/* argil wire protocol v1: the frames that cross between board and host (USB bulk or UDP).
+/* argil wire protocol v2: the frames that cross between board and host (USB bulk or UDP).
  * A frame is header + payload + CRC-32C, little-endian, encoded field by field.
  * Byte-level layout and golden vectors: docs/protocol.md. */
 #ifndef ARGIL_PROTO_H
@@ -11,7 +11,7 @@
 #include "argil_limits.h"
 
 #define PROTO_MAGIC 0x4C475241u        /* bytes 'A' 'R' 'G' 'L' on the wire */
-#define PROTO_VERSION 1u
+#define PROTO_VERSION 2u
 #define PROTO_HEADER_SIZE 12u          /* magic u32, version u8, type u8, length u16, seq u32 */
 #define PROTO_CRC_SIZE 4u              /* CRC-32C of header + payload */
 #define PROTO_FRAME_MAX 1024u          /* no frame is larger: a WINDOW chunk fits in 1 KiB */
@@ -31,7 +31,7 @@ typedef enum {
     PROTO_ERR_OVERSIZE = -2,   /* declared payload length above PROTO_PAYLOAD_MAX */
     PROTO_ERR_MAGIC = -3,      /* the first four bytes are not 'ARGL' */
     PROTO_ERR_CRC = -4,        /* CRC-32C does not match */
-    PROTO_ERR_VERSION = -5,    /* protocol version not 1 */
+    PROTO_ERR_VERSION = -5,    /* protocol version not PROTO_VERSION */
     PROTO_ERR_TYPE = -6,       /* unknown message type */
     PROTO_ERR_PAYLOAD = -7,    /* payload length does not match its type's layout */
     PROTO_ERR_VALUE = -8,      /* a field out of range: NaN/Inf, zero spacing, count too high */
@@ -66,8 +66,11 @@ typedef struct {
 typedef enum {
     PROTO_CMD_NONE = 0,
     PROTO_CMD_ARM = 1,       /* IDLE → ARMED → ACTIVE, or re-arm after ESTOP / FAULT */
-    PROTO_CMD_DISARM = 2     /* back to IDLE, drives off */
+    PROTO_CMD_DISARM = 2,    /* back to IDLE, drives off */
+    PROTO_CMD_END = 3        /* disarm, and end this host's session: the board serves no one
+                              * until a host says HELLO */
 } proto_cmd_t;
+#define PROTO_CMD_LAST PROTO_CMD_END
 
 /* HEARTBEAT: both ways, at least every 10 ms; its absence for the timeout is a fault. */
 typedef struct {
@@ -190,6 +193,16 @@ typedef struct {
 
 #define PROTO_RT_HIST_BINS 12u      /* histogram bins of RT_STATS (firmware/core/rt_stats.h) */
 
+/* The host frames the board refused since it started, by reason (RT_STATS, from version 2). */
+typedef struct {
+    uint32_t decode_errors;  /* refused by the decoder: CRC, torn frame, garbage, a bad field */
+    uint32_t wrong_source;   /* from an address other than the session host's (UDP) */
+    uint32_t no_session;     /* no host session to belong to (no HELLO yet, or after an END) */
+    uint32_t duplicate;      /* a sequence number the session already accepted (replay) */
+    uint32_t stale;          /* a sequence number older than the session's window */
+    uint32_t sessions;       /* host sessions started (host HELLOs accepted) */
+} proto_link_counts_t;
+
 /* RT_STATS: board → host once a second (and when the board stops): the fast loop's deadline
  * statistics since it started. All times in ns. */
 typedef struct {
@@ -206,6 +219,7 @@ typedef struct {
     uint32_t worst_streak;   /* longest run of overruns; ≤ overruns */
     uint32_t wake_hist[PROTO_RT_HIST_BINS];    /* wake-up latency histogram; sums to ticks */
     uint32_t compute_hist[PROTO_RT_HIST_BINS]; /* compute time histogram; sums to ticks */
+    proto_link_counts_t link;                  /* host frames refused, by reason */
 } msg_rt_stats_t;
 
 typedef struct {

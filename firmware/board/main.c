@@ -183,6 +183,7 @@ typedef struct {
     uint32_t fault;
     uint32_t can_tx_errors;
     uint32_t link_tx_dropped;
+    proto_link_counts_t link;      /* host frames refused, by reason; sessions */
     uint8_t nmt[ARGIL_DRIVES];
     uint8_t power[ARGIL_DRIVES];
     uint8_t bus;
@@ -228,6 +229,7 @@ static void publish(daemon_t *d)
     s->fault = (uint32_t)d->board->safety.fault;
     s->can_tx_errors = d->io.can_tx_errors;
     s->link_tx_dropped = atomic_load_explicit(&d->hal->link_tx.dropped, memory_order_relaxed);
+    board_link_counts(d->board, &s->link);
     for (int j = 0; j < ARGIL_DRIVES; j++) {
         s->nmt[j] = (uint8_t)d->board->drives.d[j].nmt;
         s->power[j] = (uint8_t)d->board->drives.d[j].power;
@@ -251,6 +253,7 @@ static void read_snapshot(daemon_t *d, snapshot_t *out)
         out->fault = d->snap.fault;
         out->can_tx_errors = d->snap.can_tx_errors;
         out->link_tx_dropped = d->snap.link_tx_dropped;
+        out->link = d->snap.link;
         memcpy(out->nmt, d->snap.nmt, sizeof(out->nmt));
         memcpy(out->power, d->snap.power, sizeof(out->power));
         out->bus = d->snap.bus;
@@ -356,9 +359,17 @@ static void *udp_thread(void *arg)
     const struct timespec nap = {0, 250000};
     while (!atomic_load(&d->stop)) {
         size_t n;
-        while ((n = link_udp_receive(&d->udp, rx, sizeof(rx))) > 0)
+        const uint64_t now_us = now_ns() / 1000u;
+        while ((n = link_udp_receive(&d->udp, rx, sizeof(rx), now_us)) > 0)
             (void)spsc_push(&d->hal->link_rx, rx, n);
+        hal_linux_link_refusals_set(d->hal, d->udp.bind.refused_source,
+                                    d->udp.bind.refused_no_session);
+        /* Frames first, then the session: those of the tick that ended it still go out. */
         drain_tx(d, tx, sizeof(tx));
+        hal_session_state_t state;
+        uint32_t epoch;
+        hal_linux_link_session_get(d->hal, &state, &epoch);
+        link_udp_session(&d->udp, state, epoch, now_ns() / 1000u);
         nanosleep(&nap, NULL);
     }
     drain_tx(d, tx, sizeof(tx));
@@ -478,6 +489,11 @@ static void print_stats(const char *when, const snapshot_t *s, uint32_t rate_hz)
     for (int j = 0; j < ARGIL_DRIVES; j++)
         fprintf(stderr, " %s", s->power[j] < 8 ? power[s->power[j]] : "?");
     fprintf(stderr, "; window %s, tool %s\n", s->window ? "yes" : "no", s->tool ? "yes" : "no");
+    fprintf(stderr,
+            PROG ": %s: host sessions %u; host frames refused: wrong source %u, no session %u, "
+            "duplicate %u, stale %u, decode errors %u\n",
+            when, s->link.sessions, s->link.wrong_source, s->link.no_session, s->link.duplicate,
+            s->link.stale, s->link.decode_errors);
     fprintf(stderr, PROG ": %s: wake latency histogram (us):", when);
     for (uint32_t i = 0; i < RT_HIST_BINS; i++) {
         const uint32_t e = rt_hist_edge_us(i);

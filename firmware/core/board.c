@@ -58,6 +58,7 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     drives_init(&b->drives);
     window_init(&b->window);
     haptics_init(&b->haptics);
+    host_session_init(&b->session);
     memset(&b->tool, 0, sizeof(b->tool));
     b->tool_valid = false;
     memset(b->impulse_ns, 0, sizeof(b->impulse_ns));
@@ -70,7 +71,7 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     b->since_heartbeat_us = 0;
     b->since_rt_stats_us = 0;
     rt_stats_init(&b->rt);
-    b->hello_due = true;
+    b->hello_due = false; /* the board speaks HELLO in answer to a host's */
     b->fault_reported = false;
     b->arm_pending_us = 0;
     b->wdog_level = false;
@@ -101,6 +102,17 @@ void board_rt_stats_msg(const board_t *b, proto_msg_t *m)
     memset(m, 0, sizeof(*m));
     m->type = MSG_RT_STATS;
     rt_stats_to_msg(&b->rt, b->cfg.tick_us * 1000u, b->time_us, &m->u.rt_stats);
+    board_link_counts(b, &m->u.rt_stats.link);
+}
+
+void board_link_counts(const board_t *b, proto_link_counts_t *c)
+{
+    c->decode_errors = b->stats.link_errors;
+    c->wrong_source = b->stats.transport_refused_source;
+    c->no_session = b->stats.refused_no_session + b->stats.transport_refused_no_session;
+    c->duplicate = b->stats.refused_duplicate;
+    c->stale = b->stats.refused_stale;
+    c->sessions = b->session.epoch;
 }
 
 vec3_t board_device_to_model(const board_t *b, vec3_t device_m)
@@ -131,9 +143,24 @@ typedef struct {
     bool nonfinite;
 } host_events_t;
 
+/* True when the host session admits m (counted by reason when not): nothing in a refused
+ * frame acts. */
+static bool session_admits(board_t *b, const proto_msg_t *m)
+{
+    const bool hello = m->type == MSG_HELLO && m->u.hello.role == PROTO_ROLE_HOST;
+    switch (host_session_admit(&b->session, hello, hello || m->type == MSG_HEARTBEAT, m->seq)) {
+    case HOST_FRAME_NO_SESSION: b->stats.refused_no_session++; return false;
+    case HOST_FRAME_DUPLICATE: b->stats.refused_duplicate++; return false;
+    case HOST_FRAME_STALE: b->stats.refused_stale++; return false;
+    default: return true;
+    }
+}
+
 /* Acts on one decoded frame from the host. */
 static void handle_frame(board_t *b, const proto_msg_t *m, host_events_t *ev)
 {
+    if (!session_admits(b, m))
+        return;
     b->stats.link_frames_rx++;
     switch (m->type) {
     case MSG_HELLO:
@@ -146,10 +173,14 @@ static void handle_frame(board_t *b, const proto_msg_t *m, host_events_t *ev)
         ev->heartbeat = true;
         b->host_window_version = m->u.heartbeat.window_version;
         b->host_impulse_ack = m->u.heartbeat.impulse_seq;
-        if (m->u.heartbeat.command == PROTO_CMD_ARM)
+        if (m->u.heartbeat.command == PROTO_CMD_ARM) {
             ev->arm = true;
-        else if (m->u.heartbeat.command == PROTO_CMD_DISARM)
+        } else if (m->u.heartbeat.command == PROTO_CMD_DISARM) {
             ev->disarm = true;
+        } else if (m->u.heartbeat.command == PROTO_CMD_END) {
+            ev->disarm = true;
+            host_session_end(&b->session);
+        }
         break;
     case MSG_WINDOW: {
         const proto_err_t we = window_feed_decoded(&b->window, &m->u.window);
@@ -436,9 +467,12 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     host_events_t ev = {false, false, false, false};
     if (in->can_rx)
         drives_receive(&b->drives, in->can_rx);
+    b->stats.transport_refused_source = in->link_refused_source;
+    b->stats.transport_refused_no_session = in->link_refused_no_session;
     receive_link(b, in, &ev,
                  b->impulse_pending && (b->since_impulse_us + dt_us >= b->cfg.impulse_period_us ||
                                         window_pending(&b->window)));
+    (void)host_session_process(&b->session, dt_us, b->cfg.safety.host_timeout_us);
     if (ev.arm) {
         drives_clear_emcy(&b->drives);
         /* Re-arm after a drive trip: reset the drives' faults (power stays off) and let the

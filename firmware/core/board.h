@@ -11,6 +11,7 @@
 
 #include "drives.h"
 #include "haptics.h"
+#include "host_session.h"
 #include "passivity.h"
 #include "rt_stats.h"
 #include "safety.h"
@@ -65,6 +66,9 @@ typedef struct {
     uint32_t prev_compute_ns;          /* measured compute time of the previous tick */
     uint32_t prev_wake_ns;             /* its wake-up latency (0 when the caller does not
                                         * sleep on a clock, as in the lockstep simulation) */
+    uint32_t link_refused_source;      /* the transport's own refusals so far: datagrams from an
+                                        * address other than the session host's (UDP), */
+    uint32_t link_refused_no_session;  /* … and datagrams with no session to belong to */
 } board_in_t;
 
 typedef struct {
@@ -80,6 +84,11 @@ typedef struct {
     uint32_t worst_compute_ns;
     uint32_t link_frames_rx;
     uint32_t link_errors;              /* frames the decoder refused */
+    uint32_t refused_no_session;       /* decoded host frames with no session (not a HELLO) */
+    uint32_t refused_duplicate;        /* … whose sequence number the session had accepted */
+    uint32_t refused_stale;            /* … older than the session's window */
+    uint32_t transport_refused_source; /* board_in_t's counts, as of the last tick */
+    uint32_t transport_refused_no_session;
     uint32_t link_tx_dropped;          /* frames that did not fit in a tick's output */
     uint32_t windows_swapped;
     uint32_t window_frames_deferred;   /* decoded a tick late: they came with an impulse flush */
@@ -97,6 +106,7 @@ typedef struct {
     drives_t drives;
     window_t window;
     haptics_t haptics;
+    host_session_t session;            /* the host whose frames may act */
     msg_tool_t tool;
     bool tool_valid;
     float impulse_ns[ARGIL_WINDOW_SAMPLES_MAX]; /* accumulated ∫f dt per active window node */
@@ -155,6 +165,9 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out);
 /* The RT_STATS message of the ticks so far (the board sends one every rt_stats_period_us;
  * a daemon may send one more when it stops). */
 void board_rt_stats_msg(const board_t *b, proto_msg_t *m);
+
+/* The host frames refused so far, by reason (the board's own and its transport's). */
+void board_link_counts(const board_t *b, proto_link_counts_t *c);
 
 /* Model-space tool position from a device-space tip under the current tool transform. */
 vec3_t board_device_to_model(const board_t *b, vec3_t device_m);

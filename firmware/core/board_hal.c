@@ -3,6 +3,15 @@
 
 #include <string.h>
 
+static hal_session_state_t session_state(const host_session_t *s)
+{
+    switch (s->state) {
+    case HOST_SESSION_LIVE: return HAL_SESSION_LIVE;
+    case HOST_SESSION_LAPSED: return HAL_SESSION_LAPSED;
+    default: return HAL_SESSION_NONE;
+    }
+}
+
 void board_io_init(board_io_t *io)
 {
     memset(io, 0, sizeof(*io));
@@ -19,6 +28,7 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     in.link_rx_len = hal_link_receive(hal, io->link_rx, sizeof(io->link_rx));
     in.prev_compute_ns = io->prev_compute_ns;
     in.prev_wake_ns = io->prev_wake_ns;
+    hal_link_refusals(hal, &in.link_refused_source, &in.link_refused_no_session);
     board_tick(b, &in, &io->out);
     if (hal_can_send(hal, &io->out.can_tx) != ARGIL_OK)
         io->can_tx_errors++;
@@ -26,6 +36,9 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     if (io->out.link_tx_len > 0 &&
         hal_link_send(hal, io->out.link_tx, io->out.link_tx_len) != ARGIL_OK)
         io->link_tx_errors++;
+    /* After this tick's frames are queued: a transport that unbinds on the session's end
+     * still carries the frames that went with it. */
+    hal_link_session(hal, session_state(&b->session), b->session.epoch);
     const uint64_t dt = hal_compute_clock_ns(hal) - t0;
     io->prev_compute_ns = dt > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)dt;
     return io->prev_compute_ns;

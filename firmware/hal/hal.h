@@ -24,6 +24,17 @@ void hal_gpio_write(hal_t *h, uint32_t levels);
 size_t hal_link_receive(hal_t *h, uint8_t *buf, size_t cap);
 /* Queues bytes of whole frames for the host; ARGIL_ERR_FULL when the link cannot take them. */
 argil_err_t hal_link_send(hal_t *h, const uint8_t *buf, size_t len);
+/* The core's host session, as the transport is told it after every tick (hal_link_session). */
+typedef enum {
+    HAL_SESSION_NONE = 0,   /* no host: the transport lets only a host's HELLO through */
+    HAL_SESSION_LIVE = 1,   /* serving the host that said HELLO: no one else gets through */
+    HAL_SESSION_LAPSED = 2  /* its host went quiet: another host's HELLO may take over */
+} hal_session_state_t;
+/* Tells the transport the core's host session; epoch counts the sessions started. */
+void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch);
+/* The transport's own refusals so far (datagrams it kept from the core): from another sender
+ * than the session's host, and with no session to belong to. 0 when it has one host (USB). */
+void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session);
 /* A monotonic nanosecond clock for measuring the tick's compute time. */
 uint64_t hal_compute_clock_ns(hal_t *h);
 

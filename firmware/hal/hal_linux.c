@@ -220,6 +220,30 @@ argil_err_t hal_link_send(hal_t *h, const uint8_t *buf, size_t len)
     return spsc_push(&h->link_tx, buf, len);
 }
 
+void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch)
+{
+    atomic_store_explicit(&h->link_session, (uint32_t)state | epoch << 2, memory_order_release);
+}
+
+void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session)
+{
+    *wrong_source = atomic_load_explicit(&h->link_refused_source, memory_order_relaxed);
+    *no_session = atomic_load_explicit(&h->link_refused_no_session, memory_order_relaxed);
+}
+
+void hal_linux_link_session_get(hal_t *h, hal_session_state_t *state, uint32_t *epoch)
+{
+    const uint32_t w = atomic_load_explicit(&h->link_session, memory_order_acquire);
+    *state = (hal_session_state_t)(w & 3u);
+    *epoch = w >> 2;
+}
+
+void hal_linux_link_refusals_set(hal_t *h, uint32_t wrong_source, uint32_t no_session)
+{
+    atomic_store_explicit(&h->link_refused_source, wrong_source, memory_order_relaxed);
+    atomic_store_explicit(&h->link_refused_no_session, no_session, memory_order_relaxed);
+}
+
 uint64_t hal_compute_clock_ns(hal_t *h)
 {
     (void)h;

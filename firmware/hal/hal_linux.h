@@ -5,6 +5,7 @@
 #ifndef ARGIL_HAL_LINUX_H
 #define ARGIL_HAL_LINUX_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -33,6 +34,9 @@ struct hal {
     /* host link */
     spsc_ring_t link_rx;           /* producer: link thread; consumer: fast loop */
     spsc_ring_t link_tx;           /* producer: fast loop; consumer: link thread */
+    _Atomic uint32_t link_session; /* the core's host session: state | epoch << 2 (fast loop) */
+    _Atomic uint32_t link_refused_source;     /* the link thread's refusals (link thread) */
+    _Atomic uint32_t link_refused_no_session;
     uint8_t link_rx_mem[HAL_LINUX_RX_RING_BYTES];
     uint8_t link_tx_mem[HAL_LINUX_TX_RING_BYTES];
     uint32_t link_rx_too_big;      /* records larger than the tick's buffer (dropped) */
@@ -48,6 +52,11 @@ argil_err_t hal_linux_open_sim(hal_t *h, const gpio_names_t *names, uint32_t tic
                                char *err, size_t err_len);
 
 void hal_linux_close(hal_t *h);
+
+/* The link thread's side of the session hand-over: the core's session as last told, and the
+ * transport's refusal counts for the core. */
+void hal_linux_link_session_get(hal_t *h, hal_session_state_t *state, uint32_t *epoch);
+void hal_linux_link_refusals_set(hal_t *h, uint32_t wrong_source, uint32_t no_session);
 
 /* Sends the frames in tx straight away (shutdown: quick stop / NMT stop). */
 argil_err_t hal_linux_can_flush(hal_t *h, const can_batch_t *tx);

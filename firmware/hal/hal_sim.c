@@ -8,6 +8,7 @@
 void hal_sim_init(hal_t *h)
 {
     memset(h, 0, sizeof(*h));
+    link_bind_init(&h->bind);
 }
 
 static uint32_t fifo_used(const hal_sim_fifo_t *q)
@@ -127,8 +128,27 @@ uint32_t hal_sim_gpio_out(const hal_t *h)
     return h->gpio_out;
 }
 
+void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch)
+{
+    h->link_now_us += 1000u;
+    link_bind_session(&h->bind, state, epoch, h->link_now_us);
+}
+
+void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session)
+{
+    *wrong_source = h->bind.refused_source;
+    *no_session = h->bind.refused_no_session;
+}
+
 argil_err_t hal_sim_host_send(hal_t *h, const uint8_t *frame, size_t len)
 {
+    return hal_sim_host_send_from(h, HAL_SIM_HOST, frame, len);
+}
+
+argil_err_t hal_sim_host_send_from(hal_t *h, uint64_t sender, const uint8_t *frame, size_t len)
+{
+    if (!link_bind_admit(&h->bind, sender, frame, len, h->link_now_us))
+        return ARGIL_OK; /* delivered to the board's transport, which dropped it */
     if (!fifo_put(&h->link_to_board, frame, len)) {
         h->link_dropped++;
         return ARGIL_ERR_FULL;

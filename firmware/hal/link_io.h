@@ -1,6 +1,6 @@
-/* The host link's transports for the board daemon's link thread: UDP (one frame per datagram,
- * replies go to whoever sent the last valid frame, so a restarted host is picked up at once)
- * and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
+/* The host link's transports for the board daemon's link thread: UDP (one frame per datagram;
+ * only the host whose HELLO started the core's session gets through, and gets the replies:
+ * link_bind.h) and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
  * the same frames back to back). A framer cuts a byte stream into whole protocol frames.
  * Linux only (hosted); nothing here runs in the fast loop. */
 #ifndef ARGIL_LINK_IO_H
@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "link_bind.h"
 #include "shared/argil_err.h"
 #include "shared/proto.h"
 
@@ -40,14 +41,18 @@ size_t link_framer_next(link_framer_t *fr, uint8_t *out, size_t cap);
 
 typedef struct {
     int fd;
-    struct sockaddr_in peer;
-    bool have_peer;
-    uint32_t peer_changes;       /* a (re)connecting host: the first frame from a new address */
-    uint32_t rx_datagrams;
+    link_bind_t bind;            /* the session's host (bind.peer is link_udp_key of peer) */
+    struct sockaddr_in peer;     /* its address, while bind.bound */
+    uint32_t peer_changes;       /* hosts bound: a HELLO from a new address with no live session */
+    uint32_t rx_datagrams;       /* datagrams passed on to the core */
     uint32_t rx_refused;         /* not starting with a frame header */
     uint32_t tx_datagrams;
     uint32_t tx_errors;
+    uint32_t tx_unbound;         /* frames dropped: no host bound */
 } link_udp_t;
+
+/* The sender key of an IPv4 address and port (link_bind.h). */
+uint64_t link_udp_key(const struct sockaddr_in *a);
 
 /* Parses "ADDR:PORT" (IPv4 dotted quad, port 1..65535). */
 argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
@@ -55,12 +60,17 @@ argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
 /* Binds a non-blocking UDP socket to spec ("ADDR:PORT"); one line into err on failure. */
 argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len);
 
-/* Receives one datagram into buf if one waits; returns its length, 0 when none. A datagram
- * that does not start with a frame header is refused (0, counted). */
-size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap);
+/* Takes the core's host session (hal_link_session, read on the link thread). */
+void link_udp_session(link_udp_t *u, hal_session_state_t state, uint32_t epoch, uint64_t now_us);
 
-/* Sends each whole frame of buf[0..len) as its own datagram to the current peer.
- * ARGIL_ERR_STATE when no host has spoken yet, ARGIL_ERR_IO on a send failure. */
+/* Receives datagrams until one may reach the core; returns its length, 0 when none waits. A
+ * datagram that does not start with a frame header, or that the session's binding refuses
+ * (another sender while the host's session lives; anything but a host HELLO with no host), is
+ * dropped and counted. */
+size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap, uint64_t now_us);
+
+/* Sends each whole frame of buf[0..len) as its own datagram to the session's host.
+ * ARGIL_ERR_STATE when no host is bound (counted), ARGIL_ERR_IO on a send failure. */
 argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len);
 
 void link_udp_close(link_udp_t *u);

@@ -1,4 +1,5 @@
-/* UDP transport of the host link: one frame per datagram, never blocking. */
+/* UDP transport of the host link: one frame per datagram, never blocking; only the session's
+ * host gets through (link_bind.h). */
 #include <arpa/inet.h>
 #include <errno.h>
 #include <stdio.h>
@@ -8,6 +9,8 @@
 #include <unistd.h>
 
 #include "link_io.h"
+
+#define LINK_UDP_REFUSED_PER_CALL 256u
 
 argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr)
 {
@@ -33,6 +36,7 @@ argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr)
 argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len)
 {
     memset(u, 0, sizeof(*u));
+    link_bind_init(&u->bind);
     u->fd = -1;
     struct sockaddr_in addr;
     if (link_udp_parse(spec, &addr) != ARGIL_OK) {
@@ -54,31 +58,50 @@ argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err
     return ARGIL_OK;
 }
 
-size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap)
+uint64_t link_udp_key(const struct sockaddr_in *a)
 {
-    struct sockaddr_in from;
-    socklen_t flen = sizeof(from);
-    const ssize_t n = recvfrom(u->fd, buf, cap, MSG_DONTWAIT, (struct sockaddr *)&from, &flen);
-    if (n <= 0)
-        return 0;
-    if (link_frame_size(buf, (size_t)n) == 0) {
-        u->rx_refused++;
-        return 0;
+    return (uint64_t)ntohl(a->sin_addr.s_addr) << 16 | ntohs(a->sin_port);
+}
+
+void link_udp_session(link_udp_t *u, hal_session_state_t state, uint32_t epoch, uint64_t now_us)
+{
+    link_bind_session(&u->bind, state, epoch, now_us);
+}
+
+size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap, uint64_t now_us)
+{
+    /* Bounded: a flood of refused datagrams gives the thread back to its other work. */
+    for (uint32_t k = 0; k < LINK_UDP_REFUSED_PER_CALL; k++) {
+        struct sockaddr_in from;
+        socklen_t flen = sizeof(from);
+        const ssize_t n =
+            recvfrom(u->fd, buf, cap, MSG_DONTWAIT, (struct sockaddr *)&from, &flen);
+        if (n <= 0)
+            return 0;
+        if (link_frame_size(buf, (size_t)n) == 0) {
+            u->rx_refused++;
+            continue;
+        }
+        const uint64_t key = link_udp_key(&from);
+        const uint32_t binds = u->bind.binds;
+        if (!link_bind_admit(&u->bind, key, buf, (size_t)n, now_us))
+            continue; /* counted by the binding */
+        if (u->bind.binds != binds) {
+            u->peer = from;
+            u->peer_changes++;
+        }
+        u->rx_datagrams++;
+        return (size_t)n;
     }
-    u->rx_datagrams++;
-    if (!u->have_peer || from.sin_addr.s_addr != u->peer.sin_addr.s_addr ||
-        from.sin_port != u->peer.sin_port) {
-        u->peer = from;
-        u->have_peer = true;
-        u->peer_changes++;
-    }
-    return (size_t)n;
+    return 0;
 }
 
 argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len)
 {
-    if (!u->have_peer)
+    if (!u->bind.bound) {
+        u->tx_unbound++;
         return ARGIL_ERR_STATE;
+    }
     size_t at = 0;
     argil_err_t rc = ARGIL_OK;
     while (at < len) {

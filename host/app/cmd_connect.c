@@ -171,26 +171,11 @@ static bool ring_send(void *ctx, const uint8_t *frame, size_t len)
     return spsc_push(&s->c->tx, frame, len) == ARGIL_OK;
 }
 
-static void send_simple(conn_solver_t *s, uint8_t type, uint8_t command)
+/* Refusals the board reported in its newest RT_STATS, all reasons together. */
+static uint32_t board_refusals(const peer_t *p)
 {
-    proto_msg_t m;
-    memset(&m, 0, sizeof(m));
-    m.type = type;
-    if (type == MSG_HELLO) {
-        m.u.hello.role = PROTO_ROLE_HOST;
-        m.u.hello.window_max = (uint16_t)s->peer.cfg.window_edge;
-        memcpy(m.u.hello.name, "argil connect", 13);
-    } else {
-        m.u.heartbeat.time_us = s->peer.time_us;
-        m.u.heartbeat.window_version = s->peer.have_current ? s->peer.current.version : 0u;
-        m.u.heartbeat.impulse_seq = s->peer.impulse_seq_applied;
-        m.u.heartbeat.command = command;
-    }
-    uint8_t buf[PROTO_FRAME_MAX];
-    size_t len = 0;
-    if (proto_encode(&m, s->peer.tx_seq, buf, sizeof(buf), &len) == PROTO_OK &&
-        ring_send(s, buf, len))
-        s->peer.tx_seq++;
+    const proto_link_counts_t *l = &p->last_rt.link;
+    return l->wrong_source + l->no_session + l->duplicate + l->stale + l->decode_errors;
 }
 
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
@@ -255,10 +240,11 @@ static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t r
         snprintf(rtt, sizeof(rtt), "-");
     fprintf(stderr,
             "%sconnect %6.1f s  link %-9s  board %-6s  loop %s  worst tick %4u us  "
-            "window rtt %s  force %.3f N  frames/s in %u out %u%s",
+            "window rtt %s  force %.3f N  frames/s in %u out %u  board refused %u%s",
             tty ? "\r" : "", elapsed_s, link_state_name(ls),
             s->have_tm ? safety_state_name((safety_state_t)t->state) : "-", loop,
-            s->worst_compute_ns / 1000u, rtt, fn, rx_per_s, tx_per_s, tty ? "  " : "\n");
+            s->worst_compute_ns / 1000u, rtt, fn, rx_per_s, tx_per_s, board_refusals(&s->peer),
+            tty ? "  " : "\n");
     fflush(stderr);
     s->worst_compute_ns = 0;
     if (s->have_tm) {
@@ -830,6 +816,11 @@ int cmd_connect(int argc, char **argv)
                 faults_at_loss = s->peer.stats.faults;
                 bad_before_loss = s->have_tm && (s->last_state == SAFETY_FAULT ||
                                                  s->last_state == SAFETY_ESTOP);
+                /* Say HELLO until the board answers: a restarted board, or one whose session
+                 * ended, serves no host until one does (it is silent to us until then). */
+                hello_wanted = true;
+                last_hello_us = 0;
+                hello_period_us = CONNECT_HELLO_PERIOD_US;
                 continue;
             }
             if (n > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO && frame[12] == PROTO_ROLE_BOARD) {
@@ -856,7 +847,7 @@ int cmd_connect(int argc, char **argv)
                 rearm_pending = o.arm;
         }
         if (hello_wanted && s->now_us - last_hello_us >= hello_period_us) {
-            send_simple(s, MSG_HELLO, 0);
+            (void)peer_send_hello(&s->peer, "argil connect");
             last_hello_us = s->now_us;
             if (hello_period_us < CONNECT_HELLO_PERIOD_MAX_US)
                 hello_period_us *= 2u;
@@ -876,7 +867,7 @@ int cmd_connect(int argc, char **argv)
                 rearm_pending = false; /* armed again (an IDLE board is armed by the peer) */
             } else if (bs == SAFETY_FAULT && host_lost && s->peer.have_current && !hello_wanted &&
                        s->now_us - last_rearm_us >= CONNECT_REARM_PERIOD_US) {
-                send_simple(s, MSG_HEARTBEAT, PROTO_CMD_ARM);
+                (void)peer_send_command(&s->peer, PROTO_CMD_ARM);
                 last_rearm_us = s->now_us;
             }
         }
@@ -922,9 +913,10 @@ int cmd_connect(int argc, char **argv)
         const struct timespec ts = {(time_t)(next_us / 1000000u), (long)(next_us % 1000000u) * 1000L};
         clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
     }
-    /* Tell the board we are going: disarm (forces off at once, not after the host-lost fade). */
+    /* Tell the board we are going: END disarms (forces off at once, not after the host-lost
+     * fade) and ends our session, so the next host need not wait for it to lapse. */
     if (s->have_tm)
-        send_simple(s, MSG_HEARTBEAT, PROTO_CMD_DISARM);
+        (void)peer_send_command(&s->peer, PROTO_CMD_END);
     atomic_store_explicit(&c->stop, true, memory_order_release);
     pthread_join(lt, NULL);
     /* Frames the link thread took in after the solver stopped reading. */
@@ -981,6 +973,16 @@ int cmd_connect(int argc, char **argv)
                s->have_tm ? safety_state_name((safety_state_t)s->last_state) : "never heard",
                s->active_entries, s->board_hellos, s->board_restarts, s->deadline_misses,
                (double)s->peak_force_n);
+        {
+            const proto_link_counts_t *l = &s->peer.last_rt.link;
+            if (s->peer.stats.rt_stats_frames > 0)
+                printf("  board link          host sessions %u; host frames refused: wrong source "
+                       "%u, no session %u, duplicate %u, stale %u, decode errors %u\n",
+                       l->sessions, l->wrong_source, l->no_session, l->duplicate, l->stale,
+                       l->decode_errors);
+            else
+                printf("  board link          no RT_STATS report from the board\n");
+        }
         printf("  protocol            telemetry rows %u (%.0f per s); decode errors %u; windows "
                "sent %u; impulse frames %u; faults %u%s%s%s\n",
                s->csv_rows, ran_s > 0 ? s->csv_rows / ran_s : 0.0,

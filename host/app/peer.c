@@ -97,6 +97,36 @@ static bool send_msg(peer_t *p, const proto_msg_t *m)
     return true;
 }
 
+bool peer_send_hello(peer_t *p, const char *name)
+{
+    proto_msg_t *m = &p->scratch;
+    memset(m, 0, sizeof(*m));
+    m->type = MSG_HELLO;
+    m->u.hello.role = PROTO_ROLE_HOST;
+    m->u.hello.window_max = (uint16_t)p->cfg.window_edge;
+    const size_t n = strlen(name);
+    memcpy(m->u.hello.name, name, n < PROTO_NAME_LEN ? n : PROTO_NAME_LEN);
+    return send_msg(p, m);
+}
+
+/* A heartbeat with the host's window version and impulse acknowledgement. */
+static void fill_heartbeat(const peer_t *p, proto_msg_t *m, uint8_t command)
+{
+    m->type = MSG_HEARTBEAT;
+    m->u.heartbeat.time_us = p->time_us;
+    m->u.heartbeat.window_version = p->have_current ? p->current.version : 0u;
+    m->u.heartbeat.impulse_seq = p->impulse_seq_applied;
+    m->u.heartbeat.command = command;
+}
+
+bool peer_send_command(peer_t *p, uint8_t command)
+{
+    proto_msg_t *m = &p->scratch;
+    memset(m, 0, sizeof(*m));
+    fill_heartbeat(p, m, command);
+    return send_msg(p, m);
+}
+
 static void mark_dirty(peer_t *p, const int32_t lo[3], const int32_t hi[3])
 {
     for (int a = 0; a < 3; a++) {
@@ -556,11 +586,7 @@ void peer_tick(peer_t *p, uint32_t dt_us)
         }
     }
     if (p->since_heartbeat_us >= p->cfg.heartbeat_period_us) {
-        m->type = MSG_HEARTBEAT;
-        m->u.heartbeat.time_us = p->time_us;
-        m->u.heartbeat.window_version = p->have_current ? p->current.version : 0u;
-        m->u.heartbeat.impulse_seq = p->impulse_seq_applied;
-        m->u.heartbeat.command = PROTO_CMD_NONE;
+        fill_heartbeat(p, m, PROTO_CMD_NONE);
         /* Arm once, when the board is idle and has a window: never re-arm after a fault
          * without the person asking. */
         if (p->want_armed && !p->arm_sent && p->have_current && p->have_tm &&

@@ -149,6 +149,14 @@ void peer_receive(peer_t *p, const uint8_t *bytes, size_t len);
 /* Changes the tool (sent to the board on the next tick). */
 void peer_set_tool(peer_t *p, const msg_tool_t *tool);
 
+/* Says HELLO as the host (name: up to PROTO_NAME_LEN bytes): the board starts a session for
+ * this host and answers with its HELLO. Every frame the peer sends carries the next number of
+ * one sequence (tx_seq), as the board's session requires. False when it could not be sent. */
+bool peer_send_hello(peer_t *p, const char *name);
+
+/* Sends a heartbeat now, carrying command (proto_cmd_t: ARM, DISARM, END). */
+bool peer_send_command(peer_t *p, uint8_t command);
+
 /* Asks the board to arm (once it reports IDLE) — the session's start. */
 void peer_request_arm(peer_t *p);
 

@@ -442,6 +442,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     bool started = false, finished = false;
     double started_at_s = 0.0, finished_at_s = 0.0;
     peer_request_arm(&s->peer);
+    (void)peer_send_hello(&s->peer, "argil sculpt"); /* the board serves a host that says HELLO */
     const double loop_real0_s = clock_s(CLOCK_MONOTONIC);
     uint64_t tick;
     for (tick = 0; tick < max_ticks; tick++) {

@@ -186,6 +186,7 @@ int main(int argc, char **argv)
     double finished_at_s = 0.0;
     uint64_t active_ticks = 0, tick;
     peer_request_arm(&b->peer);
+    (void)peer_send_hello(&b->peer, "bench");
     for (tick = 0; tick < max_ticks; tick++) {
         const double t_s = (double)tick * dt_s;
         if (!started && b->peer.have_tm && b->peer.last_tm.state == SAFETY_ACTIVE)

@@ -108,7 +108,11 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
                x->compute_max_ns == y->compute_max_ns && x->overruns == y->overruns &&
                x->worst_streak == y->worst_streak &&
                memcmp(x->wake_hist, y->wake_hist, sizeof x->wake_hist) == 0 &&
-               memcmp(x->compute_hist, y->compute_hist, sizeof x->compute_hist) == 0;
+               memcmp(x->compute_hist, y->compute_hist, sizeof x->compute_hist) == 0 &&
+               x->link.decode_errors == y->link.decode_errors &&
+               x->link.wrong_source == y->link.wrong_source &&
+               x->link.no_session == y->link.no_session && x->link.duplicate == y->link.duplicate &&
+               x->link.stale == y->link.stale && x->link.sessions == y->link.sessions;
     }
     default:
         return 0;
@@ -119,6 +123,8 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
  * proto.c's own checks: the ranges of docs/protocol.md. */
 static void check_ranges(const proto_msg_t *m)
 {
+    if (m->type == MSG_HEARTBEAT)
+        check(m->u.heartbeat.command <= 3u); /* none, arm, disarm, end (protocol v2) */
     if (m->type == MSG_RT_STATS) {
         const msg_rt_stats_t *r = &m->u.rt_stats;
         uint64_t wake = 0, comp = 0;

@@ -127,8 +127,13 @@ static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
         assert_int_equal(peer_init(&r->peer, &pc, &r->grid, rig_send, NULL, r), ARGIL_OK);
         peer_set_tool(&r->peer, &r->tool);
         peer_request_arm(&r->peer);
+        assert_true(peer_send_hello(&r->peer, "sil rig"));
     } else {
         proto_msg_t m;
+        memset(&m, 0, sizeof(m));
+        m.type = MSG_HELLO; /* the board serves the host that says HELLO */
+        m.u.hello.role = PROTO_ROLE_HOST;
+        rig_send_msg(r, &m);
         memset(&m, 0, sizeof(m));
         m.type = MSG_TOOL;
         m.u.tool = r->tool;

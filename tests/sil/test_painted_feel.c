@@ -66,7 +66,9 @@ static void press(float paint_scale, uint32_t window_period_us, press_t *out)
 {
     memset(out, 0, sizeof(*out));
     rig_t *r = rig_new(0.8f);
-    /* The rig's host uses the springs solve; painting needs the B-spline model. */
+    /* The rig's host uses the springs solve; painting needs the B-spline model. The new peer
+     * is the same host in the same session (the rig's HELLO): its frames number on. */
+    const uint32_t seq = r->peer.tx_seq;
     peer_free(&r->peer);
     peer_cfg_t pc;
     peer_cfg_default(&pc);
@@ -76,6 +78,7 @@ static void press(float paint_scale, uint32_t window_period_us, press_t *out)
     r->grid.material.damping = CLAY_DAMPING;
     r->grid.material.plastic_rate_hz = 0.0f;
     assert_int_equal(peer_init(&r->peer, &pc, &r->grid, rig_send, NULL, r), ARGIL_OK);
+    r->peer.tx_seq = seq;
     if (paint_scale != 1.0f)
         /* A wide ball, so the whole press sees ≥ 3.6× (linear falloff: 1 + 3 (1 − d / 40 mm)). */
         assert_int_equal(peer_paint_material(&r->peer, PEER_MAT_STIFFNESS,

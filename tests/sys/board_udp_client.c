@@ -52,22 +52,14 @@ static uint64_t now_us(void)
     return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
 }
 
+/* A HELLO or a heartbeat with a command, numbered in the peer's one sequence (the board's
+ * session refuses a number it has seen). */
 static void send_simple(host_t *h, uint8_t type, uint8_t command)
 {
-    proto_msg_t m;
-    memset(&m, 0, sizeof(m));
-    m.type = type;
-    if (type == MSG_HELLO) {
-        m.u.hello.role = PROTO_ROLE_HOST;
-        memcpy(m.u.hello.name, "udp-test-host", 13);
-    } else {
-        m.u.heartbeat.command = command;
-        m.u.heartbeat.window_version = h->peer.have_current ? h->peer.current.version : 0u;
-    }
-    uint8_t buf[PROTO_FRAME_MAX];
-    size_t len = 0;
-    if (proto_encode(&m, 0, buf, sizeof(buf), &len) == PROTO_OK)
-        (void)udp_send(h, buf, len);
+    if (type == MSG_HELLO)
+        (void)peer_send_hello(&h->peer, "udp-test-host");
+    else
+        (void)peer_send_command(&h->peer, command);
 }
 
 static void host_open(host_t *h, int port)

@@ -293,10 +293,9 @@ static void test_udp_link_loopback(void **st)
     assert_int_equal(sendto(h, "junk", 4, 0, (struct sockaddr *)&to, sizeof(to)), 4);
     assert_int_equal(sendto(h, frame, len, 0, (struct sockaddr *)&to, sizeof(to)), (ssize_t)len);
     usleep(20000);
-    assert_int_equal(link_udp_receive(&u, buf, sizeof(buf)), 0);   /* junk refused */
-    assert_int_equal(link_udp_receive(&u, buf, sizeof(buf)), len);
+    assert_int_equal(link_udp_receive(&u, buf, sizeof(buf), 0), len); /* junk refused first */
     assert_int_equal(u.rx_refused, 1);
-    assert_true(u.have_peer);
+    assert_true(u.bind.bound);
     /* Two frames back to back go out as two datagrams to that host. */
     memcpy(buf, frame, len);
     memcpy(buf + len, frame, len);
@@ -306,6 +305,126 @@ static void test_udp_link_loopback(void **st)
     assert_int_equal(recv(h, buf, sizeof(buf), MSG_DONTWAIT), (ssize_t)len);
     assert_int_equal(u.tx_datagrams, 2);
     close(h);
+    link_udp_close(&u);
+}
+
+/* A UDP socket on 127.0.0.1 with an ephemeral port; its address in *a. */
+static int udp_peer(struct sockaddr_in *a)
+{
+    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+    assert_true(fd >= 0);
+    struct sockaddr_in any = {.sin_family = AF_INET};
+    inet_pton(AF_INET, "127.0.0.1", &any.sin_addr);
+    assert_int_equal(bind(fd, (struct sockaddr *)&any, sizeof(any)), 0);
+    socklen_t len = sizeof(*a);
+    assert_int_equal(getsockname(fd, (struct sockaddr *)a, &len), 0);
+    return fd;
+}
+
+static size_t frame_of(uint8_t type, uint8_t command, uint32_t seq, uint8_t *buf)
+{
+    proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    m.type = type;
+    m.u.hello.role = PROTO_ROLE_HOST;
+    if (type == MSG_HEARTBEAT)
+        m.u.heartbeat.command = command;
+    size_t len = 0;
+    assert_int_equal(proto_encode(&m, seq, buf, PROTO_FRAME_MAX, &len), PROTO_OK);
+    return len;
+}
+
+/* Sends a frame from fd to the link and returns what one receive call gives the core (after
+ * the datagram has crossed loopback). */
+static size_t udp_deliver(link_udp_t *u, int fd, const struct sockaddr_in *to, uint8_t type,
+                          uint8_t command, uint32_t seq, uint64_t now_us)
+{
+    uint8_t f[PROTO_FRAME_MAX], buf[2 * PROTO_FRAME_MAX];
+    const size_t len = frame_of(type, command, seq, f);
+    assert_int_equal(sendto(fd, f, len, 0, (const struct sockaddr *)to, sizeof(*to)),
+                     (ssize_t)len);
+    usleep(5000);
+    return link_udp_receive(u, buf, sizeof(buf), now_us);
+}
+
+/* Whether fd got a datagram from the link (drains it). */
+static bool udp_got(int fd)
+{
+    uint8_t b[2 * PROTO_FRAME_MAX];
+    usleep(5000);
+    bool any = false;
+    while (recv(fd, b, sizeof(b), MSG_DONTWAIT) > 0)
+        any = true;
+    return any;
+}
+
+/* The binding over real sockets: the host whose HELLO came first is served until its session
+ * lapses or ends; a stranger's frames (another port) never reach the core, the board's frames
+ * never reach the stranger, and every refusal is counted by reason. */
+static void test_udp_link_serves_its_session_host_only(void **st)
+{
+    (void)st;
+    link_udp_t u;
+    char err[200];
+    assert_int_equal(link_udp_open(&u, "127.0.0.1:47313", err, sizeof(err)), ARGIL_OK);
+    struct sockaddr_in to, ha, sa;
+    assert_int_equal(link_udp_parse("127.0.0.1:47313", &to), ARGIL_OK);
+    const int host = udp_peer(&ha), stranger = udp_peer(&sa);
+    uint8_t f[PROTO_FRAME_MAX];
+    const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
+    uint64_t t = 1000000u;
+
+    /* no session: only a host's HELLO gets through */
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HEARTBEAT, PROTO_CMD_DISARM, 9, t), 0);
+    assert_int_equal(u.bind.refused_no_session, 1);
+    assert_int_equal(link_udp_send(&u, f, flen), ARGIL_ERR_STATE);
+    assert_true(udp_deliver(&u, host, &to, MSG_HELLO, 0, 1, t) > 0);
+    link_udp_session(&u, HAL_SESSION_LIVE, 1, t += 1000u); /* the core took the HELLO */
+    assert_int_equal(u.peer_changes, 1);
+
+    /* live: the stranger's HELLO and disarm are refused; the host's heartbeat passes */
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HELLO, 0, 50, t), 0);
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HEARTBEAT, PROTO_CMD_DISARM, 51, t), 0);
+    assert_int_equal(u.bind.refused_source, 2);
+    assert_true(udp_deliver(&u, host, &to, MSG_HEARTBEAT, 0, 2, t) > 0);
+    assert_int_equal(link_udp_send(&u, f, flen), ARGIL_OK);
+    assert_true(udp_got(host));
+    assert_false(udp_got(stranger));
+
+    /* the host went quiet (lapsed): its place is kept for a while, then another host's HELLO
+     * takes over and the first is refused */
+    link_udp_session(&u, HAL_SESSION_LAPSED, 1, t += 60000u);
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HELLO, 0, 52, t), 0);
+    t += LINK_BIND_TAKEOVER_US - 1u;
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HELLO, 0, 53, t), 0);
+    link_udp_session(&u, HAL_SESSION_LAPSED, 1, t += 1u);
+    assert_true(udp_deliver(&u, stranger, &to, MSG_HELLO, 0, 54, t) > 0);
+    assert_int_equal(u.peer_changes, 2);
+    /* until the core has started its session, no third host may take it */
+    const int third = udp_peer(&ha);
+    assert_int_equal(udp_deliver(&u, third, &to, MSG_HELLO, 0, 1, t), 0);
+    link_udp_session(&u, HAL_SESSION_LIVE, 2, t += 1000u);
+    assert_int_equal(udp_deliver(&u, host, &to, MSG_HEARTBEAT, 0, 3, t), 0);
+    assert_int_equal(u.bind.refused_source, 6);
+    assert_int_equal(link_udp_send(&u, f, flen), ARGIL_OK);
+    assert_true(udp_got(stranger));
+    assert_false(udp_got(host));
+
+    /* END: no host is bound any more; nothing goes out, nothing but a HELLO comes in */
+    link_udp_session(&u, HAL_SESSION_NONE, 2, t += 1000u);
+    assert_int_equal(link_udp_send(&u, f, flen), ARGIL_ERR_STATE);
+    assert_int_equal(udp_deliver(&u, stranger, &to, MSG_HEARTBEAT, 0, 55, t), 0);
+    assert_int_equal(u.bind.refused_no_session, 2);
+
+    /* a HELLO the core never takes up (lost on the way in) binds for a bounded time only */
+    assert_true(udp_deliver(&u, host, &to, MSG_HELLO, 0, 4, t) > 0);
+    link_udp_session(&u, HAL_SESSION_NONE, 2, t += LINK_BIND_PENDING_US / 2u);
+    assert_true(u.bind.bound);
+    link_udp_session(&u, HAL_SESSION_NONE, 2, t += LINK_BIND_PENDING_US);
+    assert_false(u.bind.bound);
+    close(host);
+    close(stranger);
+    close(third);
     link_udp_close(&u);
 }
 
@@ -428,6 +547,7 @@ int main(void)
         cmocka_unit_test(test_gpio_mapping_by_name),
         cmocka_unit_test(test_gpio_errors_name_the_line),
         cmocka_unit_test(test_udp_link_loopback),
+        cmocka_unit_test(test_udp_link_serves_its_session_host_only),
         cmocka_unit_test(test_framer_splits_a_stream),
         cmocka_unit_test(test_ffs_descriptors),
         cmocka_unit_test(test_spsc_ring_wraps_and_refuses),

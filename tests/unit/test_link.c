@@ -17,8 +17,10 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
+#include "host/app/peer.h"
 #include "host/link/link.h"
 #include "host/link/link_usb_desc.h"
+#include "host/model/grid.h"
 #include "shared/proto.h"
 
 /* ---- device strings ---- */
@@ -464,6 +466,108 @@ static void test_udp_frames_and_restart(void **state)
 
 /* ---- the simulated board ---- */
 
+typedef struct {
+    link_t *l;
+    uint32_t frames, first_seq, last_seq;
+    bool out_of_order;
+    uint32_t hellos_sent;
+} seq_probe_t;
+
+/* The host's frames on their way to the link: every one's number must be the last one's + 1. */
+static bool probe_send(void *ctx, const uint8_t *f, size_t len)
+{
+    seq_probe_t *p = ctx;
+    assert_true(len >= PROTO_HEADER_SIZE);
+    const uint32_t seq = (uint32_t)f[8] | (uint32_t)f[9] << 8 | (uint32_t)f[10] << 16 |
+                         (uint32_t)f[11] << 24;
+    if (p->frames == 0)
+        p->first_seq = seq;
+    else if (seq != p->last_seq + 1u)
+        p->out_of_order = true;
+    p->last_seq = seq;
+    p->frames++;
+    if (f[5] == MSG_HELLO)
+        p->hellos_sent++;
+    return link_send(p->l, f, len) == ARGIL_OK;
+}
+
+/* Runs the peer over the link for ms milliseconds of virtual time; returns board HELLOs seen. */
+static uint32_t run_peer(link_t *l, peer_t *peer, int ms, uint64_t *t)
+{
+    uint8_t f[PROTO_FRAME_MAX];
+    uint32_t hellos = 0;
+    for (int i = 0; i < ms; i++) {
+        link_poll(l, 0, *t += 1000u);
+        size_t n;
+        while ((n = link_recv(l, f, sizeof(f))) > 0) {
+            hellos += f[5] == MSG_HELLO;
+            peer_receive(peer, f, n);
+        }
+        peer_tick(peer, 1000);
+    }
+    return hellos;
+}
+
+/* The host's side of the board's session: the peer numbers every frame it sends (HELLO,
+ * tool, window chunks, heartbeats) in one increasing sequence, across a second HELLO (a
+ * reconnection starts a new session) too; the board, which refuses a repeated or old number,
+ * refuses none of them (its RT_STATS says so), and arms. */
+static void test_host_numbers_its_frames_in_one_sequence(void **state)
+{
+    (void)state;
+    static link_t l;
+    char err[256];
+    assert_int_equal(link_open(&l, "sim", err, sizeof(err)), ARGIL_OK);
+    static grid_t g;
+    const int32_t dims[3] = {24, 24, 24};
+    assert_int_equal(grid_init(&g, dims, 0.0025f, vec3(-0.03f, -0.03f, -0.03f)), ARGIL_OK);
+    grid_fill_sphere(&g, vec3(0, 0, 0), 0.02f);
+    seq_probe_t probe = {&l, 0, 0, 0, false, 0};
+    static peer_t peer;
+    peer_cfg_t pc;
+    peer_cfg_default(&pc);
+    assert_int_equal(peer_init(&peer, &pc, &g, probe_send, NULL, &probe), ARGIL_OK);
+    msg_tool_t t;
+    memset(&t, 0, sizeof(t));
+    t.radius_m = 0.004f;
+    t.axis[2] = 1.0f;
+    t.contact_stiffness_n_per_m = 800.0f;
+    t.max_force_n = 3.0f;
+    t.model_scale = 1.0f;
+    peer_set_tool(&peer, &t);
+    peer_request_arm(&peer);
+    uint64_t now = 1000u;
+    /* nothing before a HELLO: the peer waits for the board, the board for a host */
+    assert_int_equal(run_peer(&l, &peer, 50, &now), 0);
+    assert_int_equal(probe.frames, 0);
+    assert_true(peer_send_hello(&peer, "test"));
+    assert_int_equal(run_peer(&l, &peer, 1100, &now), 1);
+    assert_true(peer.stats.rt_stats_frames >= 1);
+    assert_int_equal(peer.last_rt.link.sessions, 1);
+    assert_true(peer.have_tm && peer.last_tm.state == SAFETY_ACTIVE);
+    /* a reconnection: HELLO again, the board answers and resends nothing it need not */
+    assert_true(peer_send_hello(&peer, "test"));
+    assert_int_equal(run_peer(&l, &peer, 1100, &now), 1);
+    assert_true(peer_send_command(&peer, PROTO_CMD_END));
+    assert_int_equal(run_peer(&l, &peer, 1100, &now), 0);
+    const proto_link_counts_t *c = &peer.last_rt.link;
+    printf("  %u frames numbered %u..%u; board: sessions %u, refused duplicate %u, stale %u, "
+           "no session %u\n", probe.frames, probe.first_seq, probe.last_seq, c->sessions,
+           c->duplicate, c->stale, c->no_session);
+    assert_false(probe.out_of_order);
+    assert_true(probe.frames > 300);
+    assert_int_equal(probe.hellos_sent, 2);
+    assert_int_equal(c->sessions, 2);
+    assert_int_equal(c->duplicate, 0);
+    assert_int_equal(c->stale, 0);
+    /* after END the peer's heartbeats find no session: refused, counted, and the arm is off */
+    assert_true(c->no_session > 50);
+    assert_int_equal(peer.last_tm.state, SAFETY_IDLE);
+    peer_free(&peer);
+    grid_free(&g);
+    link_close(&l);
+}
+
 static void test_sim_board_answers(void **state)
 {
     (void)state;
@@ -532,6 +636,7 @@ int main(void)
         cmocka_unit_test(test_link_fake_unplug_replug),
         cmocka_unit_test(test_udp_frames_and_restart),
         cmocka_unit_test(test_sim_board_answers),
+        cmocka_unit_test(test_host_numbers_its_frames_in_one_sequence),
         cmocka_unit_test(test_open_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

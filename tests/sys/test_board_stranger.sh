@@ -1,0 +1,55 @@
+#!/bin/sh
+# Only its host may command the arm: the real argil-board (--bus sim) over UDP on 127.0.0.1,
+# armed and ACTIVE under a real `argil connect`, while a stranger process on the same machine
+# sends CRC-valid DISARM and END heartbeats and HELLOs from another port for 3 s. The board must
+# stay ACTIVE, send the stranger nothing, and count every one of its datagrams as refused for
+# its sender (the daemon's exit statistics and connect's summary, from RT_STATS).
+set -eu
+tmp=$(mktemp -d)
+bpid=; cpid=
+trap '[ -n "$cpid" ] && kill "$cpid" 2>/dev/null; [ -n "$bpid" ] && kill "$bpid" 2>/dev/null; rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+version=${STRANGER_PROTO_VERSION:-2}
+port=$((21000 + $$ % 20000))
+"$REL/argil-board" --bus sim --link "udp:127.0.0.1:$port" --rt-priority 0 --overrun-streak 0 \
+    --stats-period-s 0 --duration-s 12 >"$tmp/board.out" 2>"$tmp/board.err" &
+bpid=$!
+sleep 0.3
+"$REL/argil" connect --device "udp:127.0.0.1:$port" --arm --seconds 8 --out "$tmp/s" \
+    --no-journal >"$tmp/connect.out" 2>"$tmp/connect.err" </dev/null &
+cpid=$!
+i=0
+until grep -q "board ACTIVE" "$tmp/connect.err" 2>/dev/null; do
+    i=$((i + 1))
+    [ "$i" -gt 50 ] && { cat "$tmp/connect.err"; fail "the board never went ACTIVE"; }
+    sleep 0.1
+done
+python3 tests/sys/udp_stranger.py "$port" 3 "$version" >"$tmp/stranger.out"
+cat "$tmp/stranger.out"
+st=0; wait "$cpid" || st=$?
+cpid=
+[ "$st" = 0 ] || { cat "$tmp/connect.err"; fail "argil connect exit $st"; }
+kill -TERM "$bpid"
+st=0; wait "$bpid" || st=$?
+bpid=
+[ "$st" = 0 ] || fail "daemon exit $st: $(cat "$tmp/board.err")"
+sent=$(sed -n 's/^sent \([0-9]*\) .*/\1/p' "$tmp/stranger.out")
+received=$(sed -n 's/.* received \([0-9]*\)$/\1/p' "$tmp/stranger.out")
+[ "$sent" -gt 1000 ] || fail "the stranger sent only $sent frames"
+[ "$received" = 0 ] || fail "the board sent the stranger $received datagrams"
+# No telemetry row from the first ACTIVE one until connect's own END (its last rows) is IDLE:
+# the stranger's DISARM and END never acted. (A FAULT, host lost, is this machine stalling the
+# host past the board's 50 ms timeout; connect re-arms it. It is reported, not failed.)
+rows=$(wc -l <"$tmp/s/telemetry.csv")
+awk -F, -v last="$((rows - 20))" 'NR > 1 && NR < last && $9 == "ACTIVE" { on = 1 }
+    on && NR < last && $9 == "IDLE" { idle++ } on && NR < last && $9 == "FAULT" { fault++ }
+    END { print idle + 0, fault + 0 }' "$tmp/s/telemetry.csv" >"$tmp/rows"
+read -r idle faults <"$tmp/rows"
+[ "$idle" = 0 ] || fail "$idle of $rows telemetry rows IDLE after the board armed: the stranger disarmed it"
+[ "$faults" = 0 ] || grep -q "last: host heartbeat lost" "$tmp/connect.out" ||
+    fail "$faults FAULT rows, and not host lost: $(grep faults "$tmp/connect.out")"
+grep "host sessions" "$tmp/board.err" || fail "no host-session statistics at the daemon's exit"
+grep "board link" "$tmp/connect.out" || fail "no board link line in connect's summary"
+grep -q "wrong source $sent," "$tmp/board.err" || fail "the board did not count all $sent datagrams as refused for their sender"
+grep -q "wrong source $sent," "$tmp/connect.out" || fail "connect's summary does not show all $sent refusals"
+echo "argil-board: a stranger's $sent CRC-valid DISARM/END/HELLO frames from another port were refused and counted; the board stayed ACTIVE for its host ($rows telemetry rows, 0 IDLE, $faults FAULT from host stalls)"
