@@ -64,7 +64,7 @@ for t in "$@"; do
             if [ -f "$f" ] && cmp -s "$unit" "$f"; then seed=$f; fi
         done
         if [ -n "$seed" ]; then
-            echo "fuzz: reproducer $unit is the committed seed $seed"
+            echo "fuzz: reproducer $unit is already the seed $seed"
         else
             seed="tests/fuzz/corpus/$t/crash-$(sha1sum "$unit" | cut -d' ' -f1)"
             mkdir -p "tests/fuzz/corpus/$t"
