@@ -3,6 +3,7 @@
 #   make run          install missing packages, build, run the default sculpting session
 #   make test         unit + SIL tests under ASan/UBSan, and file checks; ends with a summary
 #   make fuzz         every libFuzzer target for FUZZ_SECONDS (default 60) each
+#   make fuzz-long    every libFuzzer target to FUZZ_RUNS (default 10^7) executions
 #   make bench        figures for the 1 kHz path and the host
 #   make cross        aarch64 and Cortex-M builds (docs/board.md)
 #   make hil          the HIL VM rig: real argil-board on vcan/gpio-sim/FunctionFS (hil/README.md)
@@ -11,6 +12,8 @@
 BUILD ?= build
 CC ?= gcc
 FUZZ_SECONDS ?= 60
+FUZZ_RUNS ?= 10000000
+FUZZ_LONG_MAX_S ?= 14400
 OUT ?= out
 SCRIPT ?= scripts/default.scn
 
@@ -54,7 +57,7 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test fuzz bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all run test fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil $(REL)/argil-board check-freestanding
@@ -172,23 +175,34 @@ run: deps-build
 	@$(MAKE) --no-print-directory all
 	$(REL)/argil sculpt --device sim --script $(SCRIPT) --out $(OUT)
 
-# libFuzzer targets: clang, the same library sources compiled with the fuzzer's sanitizers.
-FUZZ_CFLAGS := $(CSTD) $(INC) -g -O1 -fsanitize=fuzzer,address,undefined
-$(FZ)/%: tests/fuzz/%.c $(LIB_SRC) $(FUZZ_EXTRA_SRC)
+# libFuzzer targets: clang. The library sources are compiled once, with the fuzzer's coverage
+# instrumentation and sanitizers, into $(FZ)/libargil.a; each target compiles its own .c and
+# links against it (-fsanitize=fuzzer adds libFuzzer's main at the link).
+FUZZ_CC := clang
+FUZZ_CFLAGS := $(CSTD) $(INC) -g -O1
+FUZZ_LIB_SRC := $(LIB_SRC) $(FUZZ_EXTRA_SRC)
+$(FZ)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
-	clang $(FUZZ_CFLAGS) $< $(LIB_SRC) $(FUZZ_EXTRA_SRC) -o $@ $(LDLIBS)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -MMD -MP -c $< -o $@
+
+$(FZ)/libargil.a: $(FUZZ_LIB_SRC:%.c=$(FZ)/obj/%.o)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(FUZZ_TARGETS:%=$(FZ)/%): $(FZ)/%: tests/fuzz/%.c $(FZ)/libargil.a
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer,address,undefined -MMD -MP $< $(FZ)/libargil.a -o $@ $(LDLIBS)
+
+fuzz-build: $(FUZZ_TARGETS:%=$(FZ)/%)
 
 fuzz: deps-fuzz
-	@$(MAKE) --no-print-directory $(FUZZ_TARGETS:%=$(FZ)/%)
-	@for t in $(FUZZ_TARGETS); do \
-	  mkdir -p $(FZ)/corpus/$$t; \
-	  seeds=tests/fuzz/corpus/$$t; [ -d $$seeds ] || seeds=; \
-	  echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
-	  $(FZ)/$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
-	     $(FZ)/corpus/$$t $$seeds >$(FZ)/$$t.log 2>&1; st=$$?; \
-	  grep -E '^(Done|stat::(number_of_executed_units|new_units_added|peak_rss_mb))' $(FZ)/$$t.log; \
-	  if [ $$st != 0 ]; then tail -n 40 $(FZ)/$$t.log; echo "fuzz: $$t FAILED (log: $(FZ)/$$t.log)"; exit 1; fi; \
-	done
+	@$(MAKE) --no-print-directory fuzz-build
+	@sh tests/fuzz.sh $(FZ) seconds $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+# Every target to FUZZ_RUNS executions, each cut at FUZZ_LONG_MAX_S; the table of counts goes
+# to $(FZ)/fuzz-runs.md (docs/files.md, "Fuzzing").
+fuzz-long: deps-fuzz
+	@$(MAKE) --no-print-directory fuzz-build
+	@sh tests/fuzz.sh $(FZ) runs $(FUZZ_RUNS) $(FUZZ_LONG_MAX_S) $(FUZZ_TARGETS)
 
 bench: deps-bench
 	@$(MAKE) --no-print-directory all
