@@ -683,7 +683,10 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
                      r->pass ? "held" : "reached only", MS(t_obs - t0), rpdos);
             return;
         }
-        r->pass = t_obs <= t_bound;
+        /* A tick writes its GPIO outputs after its SYNC: DRIVE_ENABLE of the bound's last tick
+         * falls before the next tick's SYNC, one SYNC later than that tick's RPDOs. */
+        r->pass = t_can <= t_bound &&
+                  (!fault || !gpio || t_obs <= bound_end(o, t0, e->within_us, link + 1));
         if (any_bad)
             snprintf(r->msg, sizeof(r->msg), "observed after %s (bound %s, %zu RPDOs%s)",
                      lat(la, sizeof(la), o, t0, t_obs), bnd(bo, sizeof(bo), o, e->within_us, link),

@@ -427,6 +427,47 @@ static void test_sync_marks_gpio_window_link_ticks(void **st)
     hil_obs_free(&o);
 }
 
+/* A tick writes DRIVE_ENABLE after its SYNC: a board whose RPDOs go off in the bound's last tick
+ * and whose DRIVE_ENABLE falls right after that tick's SYNC meets "fault within 2ms"; one that
+ * drops it a tick later does not. */
+static void test_gpio_edge_of_the_last_tick_follows_its_sync(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    synth_ticks(&o, 3000, 1050, 2, 200); /* 333 ticks/s; RPDOs off in the bound's last tick */
+    int64_t t_low = -1;
+    for (size_t k = 0; k < o.n_gpio; k++)
+        if (!o.gpio[k].drive_enable)
+            t_low = o.gpio[k].t_us - 100; /* synth_ticks logs it 100 us after the RPDOs */
+    assert_true(t_low > 0);
+    for (int late = 0; late < 2; late++) {
+        hil_obs_t g;
+        hil_obs_init(&g);
+        /* the edge between two samples 50 us apart just after that tick's SYNC (+200 us), or
+         * a tick (3 ms) later */
+        const int64_t seen = t_low + 300 + late * 3000, prev = seen - 50;
+        char ev[320];
+        snprintf(ev, sizeof(ev),
+                 "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+                 "(%lld.%06lld) gpio_out DRIVE_ENABLE=0 prev=(%lld.%06lld)\n",
+                 (long long)(seen / 1000000), (long long)(seen % 1000000),
+                 (long long)(prev / 1000000), (long long)(prev % 1000000));
+        uint32_t line = 0;
+        assert_int_equal(hil_obs_add_events(&g, &scn, ev, strlen(ev), &line), HIL_OK);
+        for (size_t k = 0; k < o.n_frames; k++)
+            assert_int_equal(hil_obs_push_frame(&g, o.frame[k].t_us, &o.frame[k].f), HIL_OK);
+        hil_result_t r;
+        hil_check_expect(&scn, &g, 2, &r); /* fault within 2ms */
+        if (late == 0 && !r.pass)
+            fail_msg("%s", r.msg);
+        if (late == 1)
+            assert_false(r.pass);
+        hil_obs_free(&g);
+    }
+    hil_obs_free(&o);
+}
+
 /* A 1 kHz log from 10 s: three drives beating every 100 ticks (drive 2 skips the beats in
  * skip[], as numbered from 1), RPDOs ENABLE_OP with torque until tick off_tick (0: never) and
  * QUICK_STOP with torque 0 after, or torque back on from tick on_again (0: never). */
@@ -565,6 +606,7 @@ int main(void)
         cmocka_unit_test(test_bounds_in_ticks),
         cmocka_unit_test(test_marks_anchor_expectations),
         cmocka_unit_test(test_sync_marks_gpio_window_link_ticks),
+        cmocka_unit_test(test_gpio_edge_of_the_last_tick_follows_its_sync),
         cmocka_unit_test(test_heartbeat_supervised),
         cmocka_unit_test(test_times_after_a_step_count_from_its_injection),
     };
