@@ -122,6 +122,8 @@ typedef struct {
     atomic_int unsupported;
     atomic_bool synced_flag, done;
     atomic_llong now_us;            /* scenario time, for the main loop's prints */
+    const char *ready_file;         /* written once the board is ACTIVE (argil-sim --start-when) */
+    bool ready_written;
 } shost_t;
 
 static void raw_send(shost_t *h, const uint8_t *f, size_t len)
@@ -350,6 +352,21 @@ static void shost_on_tm(void *ctx, const msg_telemetry_t *t)
                safety_state_name((safety_state_t)t->state));
         h->last_state = t->state;
     }
+    /* The board sculpts (drives enabled, window and tool in place): the scenario may start.
+     * argil-sim holds its clock at 0 until this file exists. */
+    if (h->ready_file != NULL && !h->ready_written && t->state == SAFETY_ACTIVE) {
+        h->ready_written = true;
+        const int fd = open(h->ready_file, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0) {
+            fprintf(stderr, "hil-host: cannot write %s (%s)\n", h->ready_file, strerror(errno));
+            return;
+        }
+        char line[64];
+        const int n = snprintf(line, sizeof(line), "ACTIVE tick=%u\n", t->tick);
+        (void)!write(fd, line, (size_t)n);
+        close(fd);
+        printf("%.6f tick=%u ready: wrote %s\n", realtime_s(), t->tick, h->ready_file);
+    }
 }
 
 static void shost_release_held(shost_t *h, bool all)
@@ -474,7 +491,7 @@ static int sync_can_open(const char *iface)
 /* Runs the scenario's host side for `seconds` from its time 0: when sync_fd >= 0, the first
  * drive frame on it (argil-sim's drives boot when its scenario starts), else at once. */
 static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, const char *path,
-                        int sync_fd, const char *follow, int beat_prio)
+                        int sync_fd, const char *follow, int beat_prio, const char *ready_file)
 {
     static scenario_t scn;
     scn_error_t err;
@@ -489,6 +506,7 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     h.fd = fd;
     h.board = *board;
     h.last_state = 0xFFu;
+    h.ready_file = ready_file;
     /* The SIL rig's clay and tool (tests/sil/rig.h): a 30 mm sphere at the model origin, the
      * stylus's home mapped 60 mm above its centre (the surface 26 mm under a 4 mm tool). */
     const int32_t dims[3] = {72, 72, 72};
@@ -641,7 +659,16 @@ int main(int argc, char **argv)
 {
     char *end1 = NULL, *end2 = NULL;
     /* "--sync IFACE" after the scenario: its clock starts at the first drive frame on IFACE. */
-    const char *sync_if = NULL, *follow = NULL;
+    const char *sync_if = NULL, *follow = NULL, *ready_file = NULL;
+    /* "--ready-file FILE" anywhere: written when the board goes ACTIVE (scenarios only). */
+    for (int i = 1; i + 1 < argc; i++)
+        if (strcmp(argv[i], "--ready-file") == 0) {
+            ready_file = argv[i + 1];
+            for (int k = i; k + 2 < argc; k++)
+                argv[k] = argv[k + 2];
+            argc -= 2;
+            break;
+        }
     if (argc == 8 && strcmp(argv[6], "--follow") == 0) {
         follow = argv[7];
         argc = 6;
@@ -655,7 +682,7 @@ int main(int argc, char **argv)
     const long seconds = args_ok ? strtol(argv[2], &end2, 10) : 0;
     if (!args_ok || *end1 || *end2 || port < 1 || port > 65535 || seconds < 1 || seconds > 3600) {
         fprintf(stderr, "usage: hil-host PORT SECONDS [SCENARIO [--sync CAN_IF [--follow "
-                        "EVENT_LOG]]] (port 1-65535, 1-3600 s)\n");
+                        "EVENT_LOG]]] [--ready-file FILE] (port 1-65535, 1-3600 s)\n");
         return 2;
     }
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
@@ -686,7 +713,8 @@ int main(int argc, char **argv)
             close(fd);
             return 1;
         }
-        const int st = run_scenario(fd, &board, seconds, argv[3], sync_fd, follow, prio);
+        const int st = run_scenario(fd, &board, seconds, argv[3], sync_fd, follow, prio,
+                                     ready_file);
         if (sync_fd >= 0)
             close(sync_fd);
         close(fd);

@@ -12,6 +12,8 @@ CANDUMP_PRIO=${CANDUMP_PRIO:-$PROBE_PRIO}
 HOST_PRIO=${HOST_PRIO:-60}
 # argil-sim in the scenarios (the arm); a rig config may put it under the board's link thread.
 SIM_PRIO=${SIM_PRIO:-$((HOST_PRIO - 1))}
+# How long a scenario waits for the board to be ready to sculpt before it gives up (s).
+START_TIMEOUT_S=${START_TIMEOUT_S:-60}
 
 # ---- results ----
 pass() { RESULT=PASS; DETAIL="$*"; }
@@ -556,8 +558,13 @@ check_scenario() {
     # hil-host's own log below.
     # With --follow it performs each host-side step when argil-sim's event log says argil-sim's
     # clock reached it: one clock for both sides.
-    HIL_FIFO_PRIO=$HOST_PRIO hil-host "$UDP_PORT" "$((dur * 20))" "$scn" --sync "$CAN_IF" \
-        --follow "$OUT/$CHECK.sim/events.log" >"$OUT/$CHECK.host.log" 2>&1 &
+    # Scenario time 0 is the board ready to sculpt (docs/sim.md): hil-host writes $CHECK.ready
+    # when the board's telemetry says ACTIVE, and argil-sim holds its clock at 0 until then
+    # (the drives boot and are enabled meanwhile), at most START_TIMEOUT_S.
+    ready="$OUT/$CHECK.ready"
+    rm -f "$ready"
+    HIL_FIFO_PRIO=$HOST_PRIO hil-host "$UDP_PORT" "$((dur * 20 + START_TIMEOUT_S))" "$scn" --sync "$CAN_IF" \
+        --follow "$OUT/$CHECK.sim/events.log" --ready-file "$ready" >"$OUT/$CHECK.host.log" 2>&1 &
     HOST_PID=$!
     st=0
     # argil-sim finds a gpio-sim chip by its device name (gpiochipN); a real rig's arm
@@ -570,10 +577,10 @@ check_scenario() {
     # it answers and the drives' heartbeats reached the board up to 90 ticks late.
     # SIM_CPU pins it to the CPU the board's loop does not own (the VM's vCPU 1).
     ${SIM_CPU:+taskset -c "$SIM_CPU"} hil-probe fifo "$SIM_PRIO" argil-sim --can "${SIM_CAN_IF:-$CAN_IF}" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
-        >"$OUT/$CHECK.sim.out" 2>&1 &
+        --start-when "$ready" --start-timeout "$START_TIMEOUT_S" >"$OUT/$CHECK.sim.out" 2>&1 &
     SIM_PID=$!
     i=0
-    while [ "$i" -lt 400 ] && kill -0 "$SIM_PID" 2>/dev/null && ! grep -q ' start scenario' "$OUT/$CHECK.sim/events.log" 2>/dev/null; do
+    while [ "$i" -lt $((START_TIMEOUT_S * 20 + 100)) ] && kill -0 "$SIM_PID" 2>/dev/null && ! grep -q ' start scenario' "$OUT/$CHECK.sim/events.log" 2>/dev/null; do
         sleep 0.05; i=$((i + 1))
     done
     [ -n "${SIM_RUN_PRIO:-}" ] && kill -0 "$SIM_PID" 2>/dev/null && hil-probe chrt "$SIM_RUN_PRIO" "$SIM_PID" >/dev/null
@@ -602,8 +609,13 @@ check_scenario() {
         skip "host-side step(s) hil-host cannot play over UDP: $(grep -o 'step line=[0-9]* .* unsupported' "$OUT/$CHECK.host.log" | tr '\n' '|'); checker: $res"
         return
     fi
-    [ "$cst" = 0 ] || { fail "$res: $bad"; return; }
-    pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged)"
+    # How long the board took to get ready, and how far behind the board the arm stand-in fell
+    # at least (the most SYNCs it took in one read of at most 32 frames): the figures to look
+    # at when a bound is near.
+    pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\).*/ready after \1 board ticks (\2 ms)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
+    lag=$(sed -n 's/.* end .*max_syncs_per_read=\([0-9]*\).*/, arm stand-in >= \1 ticks behind at worst/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
+    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag]"; return; }
+    pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag)"
 }
 
 # can_controller NAME: scenario NAME on real CAN controller drivers instead of vcan, as a user

@@ -98,7 +98,7 @@ typedef struct {
     int64_t observed_ticks;        /* the same in board ticks (SYNCs), −1 when not counted */
     uint32_t tolerated;            /* heartbeat_supervised: heartbeat gaps longer than one
                                       producer period that the board rode through */
-    char msg[160];                 /* one line: what was seen */
+    char msg[256];                 /* one line: what was seen */
 } hil_result_t;
 
 /* Decides expectation i of s from o. */

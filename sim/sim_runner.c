@@ -109,17 +109,17 @@ static uint32_t watch_outputs(sim_runner_t *r, uint32_t gpio_out, uint32_t dt_us
     const uint32_t kick = GPIO_OUT_WDOG_KICK, en = GPIO_OUT_DRIVE_ENABLE;
     if (!r->have_gpio_out || ((gpio_out ^ r->last_gpio_out) & kick) != 0 || dt_us > 1500u ||
         r->outputs_reused)
-        r->last_kick_us = r->now_us;
+        r->last_kick_us = r->device_us;
     if (!r->have_gpio_out || ((gpio_out ^ r->last_gpio_out) & en) != 0) {
         emit(r, (gpio_out & en) ? "gpio_out DRIVE_ENABLE=1" : "gpio_out DRIVE_ENABLE=0");
         if (gpio_out & en)
-            r->last_kick_us = r->now_us;
+            r->last_kick_us = r->device_us;
     }
     r->have_gpio_out = true;
     r->last_gpio_out = gpio_out;
     if (!(gpio_out & en)) {
         r->wdog_expired = false;
-    } else if (!r->wdog_expired && r->now_us - r->last_kick_us > SIM_WDOG_TIMEOUT_US) {
+    } else if (!r->wdog_expired && r->device_us - r->last_kick_us > SIM_WDOG_TIMEOUT_US) {
         r->wdog_expired = true;
         emit(r, "note watchdog expired: WDOG_KICK stale with DRIVE_ENABLE high, power cut");
     }
@@ -129,7 +129,7 @@ static uint32_t watch_outputs(sim_runner_t *r, uint32_t gpio_out, uint32_t dt_us
 void sim_runner_tick(sim_runner_t *r, const can_batch_t *from_board, uint32_t gpio_out,
                      can_batch_t *to_board, uint32_t dt_us)
 {
-    if (r->scn) {
+    if (r->scn && !r->holding) {
         while (r->next_step < r->scn->n_steps && r->scn->step[r->next_step].t_us <= r->now_us)
             apply(r, &r->scn->step[r->next_step++]);
     }
@@ -144,10 +144,17 @@ void sim_runner_tick(sim_runner_t *r, const can_batch_t *from_board, uint32_t gp
         r->dev.btn2 = r->btn2;
     }
     can_batch_t to_drives, from_drives;
-    can_faults_from_board(&r->faults, from_board, &to_drives, r->now_us);
+    can_faults_from_board(&r->faults, from_board, &to_drives, r->device_us);
     sim_device_step(&r->dev, &to_drives, levels, &from_drives, dt_us);
-    can_faults_to_board(&r->faults, &from_drives, to_board, r->now_us);
-    r->now_us += dt_us;
+    can_faults_to_board(&r->faults, &from_drives, to_board, r->device_us);
+    r->device_us += dt_us;
+    if (!r->holding)
+        r->now_us += dt_us;
+}
+
+void sim_runner_hold(sim_runner_t *r, bool hold)
+{
+    r->holding = hold;
 }
 
 uint32_t sim_runner_gpio_in(const sim_runner_t *r)

@@ -36,9 +36,13 @@ typedef struct {
                                      that toggles every tick cannot be judged from it */
     bool have_gpio_out;
     uint32_t last_gpio_out;
-    int64_t last_kick_us;         /* WDOG_KICK last changed */
+    int64_t last_kick_us;         /* WDOG_KICK last changed (device clock) */
     bool wdog_expired;            /* the device's watchdog cut the drives' power */
-    int64_t now_us;
+    bool holding;                 /* before the scenario's start: the device runs, its clock and
+                                     script wait (sim_runner_hold) */
+    int64_t now_us;               /* scenario time */
+    int64_t device_us;            /* the device's own time: every tick, held or not (the
+                                     watchdog and the CAN fault layer run on it) */
     sim_log_fn log;
     void *log_ctx;
 } sim_runner_t;
@@ -54,6 +58,12 @@ void sim_runner_init(sim_runner_t *r, const sim_params_t *p, const scenario_t *s
  * to_board (cleared first). gpio_out: the board's GPIO_OUT_* levels now. */
 void sim_runner_tick(sim_runner_t *r, const can_batch_t *from_board, uint32_t gpio_out,
                      can_batch_t *to_board, uint32_t dt_us);
+
+/* Holds the scenario before its start (hold true): the device keeps answering the board
+ * (boot, NMT, drives, the hand at home) while the scenario clock stays at 0 and no step is
+ * applied; false starts it. A rig holds until the board is ready to sculpt (docs/sim.md,
+ * "Scenario time 0"). */
+void sim_runner_hold(sim_runner_t *r, bool hold);
 
 /* GPIO_IN_* levels for the board now (device levels, with a scenario's DRIVE_FAULT_N pull). */
 uint32_t sim_runner_gpio_in(const sim_runner_t *r);

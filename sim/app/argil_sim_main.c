@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -33,6 +34,7 @@
 #define TICK_US 1000u
 #define EXIT_RUN 1   /* could not open the bus or GPIO, or I/O failed while running */
 #define EXIT_USAGE 2 /* bad option or scenario */
+#define EXIT_NOT_READY 3 /* --start-when: the board was not ready in time, nothing played */
 
 static volatile sig_atomic_t stop_requested;
 
@@ -45,7 +47,8 @@ static void on_signal(int sig)
 static void usage(FILE *to)
 {
     fputs("usage: argil-sim --can IFACE [--gpio-chip CHIP] [--scenario FILE] [--log-dir DIR]\n"
-          "                 [--seconds S] [--clock ticks|wall] [--help]\n"
+          "                 [--seconds S] [--clock ticks|wall] [--start-when FILE]\n"
+          "                 [--start-timeout S] [--help]\n"
           "  The simulated arm (3 CiA 402 drives, arm dynamics, GPIO, a scripted hand) on a\n"
           "  SocketCAN interface, one 1 ms step per SYNC of the board (--clock).\n"
           "  --can IFACE       CAN interface the board is on (vcan0, can0)\n"
@@ -61,7 +64,12 @@ static void usage(FILE *to)
           "                    the scenario keep the board's time even when it ticks slower than\n"
           "                    1 kHz; the wall clock while the bus has no SYNC for 400 ms\n"
           "  --clock wall      1 ms steps on the wall clock, whatever the board does\n"
-          "exit: 0 ran to the end, 1 bus/GPIO could not be opened or failed, 2 bad usage\n",
+          "  --start-when FILE hold the scenario at time 0 (the device answers the board, the\n"
+          "                    hand at home) until FILE exists: the rig's host writes it when the\n"
+          "                    board is ACTIVE (docs/sim.md, \"Scenario time 0\")\n"
+          "  --start-timeout S give up when FILE has not appeared after S s (default 60)\n"
+          "exit: 0 ran to the end, 1 bus/GPIO could not be opened or failed, 2 bad usage,\n"
+          "      3 --start-when's FILE never appeared (the board never got ready)\n",
           to);
 }
 
@@ -89,9 +97,16 @@ static void write_event(const struct timespec *ts, int64_t t_us, const char *eve
             ts->tv_nsec / 1000, event, t_us / 1000000, t_us % 1000000);
 }
 
+static bool preroll;               /* before the start line: events are not logged */
+static uint32_t preroll_events;
+
 static void log_event(void *ctx, int64_t t_us, const char *event)
 {
     (void)ctx;
+    if (preroll) {
+        preroll_events++;
+        return;
+    }
     if (defer_events) {
         if (n_pending_ev == EVENTS_MAX) {
             lost_ev++;
@@ -321,6 +336,16 @@ static argil_err_t can_send_all(int fd, const can_batch_t *tx, can_socket_stats_
     return data.n ? can_socket_send(fd, &data, st) : ARGIL_OK;
 }
 
+/* CPU time this process used (user + system), ms. */
+static double cpu_ms(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return -1.0;
+    return (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) * 1e3 +
+           (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) / 1e3;
+}
+
 static int64_t mono_us(void)
 {
     struct timespec ts;
@@ -339,13 +364,15 @@ static void add_us(struct timespec *t, uint32_t us)
 
 int main(int argc, char **argv)
 {
-    const char *iface = NULL, *chip = NULL, *scn_path = NULL, *log_dir = NULL;
-    double seconds = -1.0;
+    const char *iface = NULL, *chip = NULL, *scn_path = NULL, *log_dir = NULL, *gate = NULL;
+    double seconds = -1.0, start_timeout_s = 60.0;
     bool clock_ticks = true;
     static const struct option opts[] = {
         {"can", required_argument, NULL, 'c'},      {"gpio-chip", required_argument, NULL, 'g'},
         {"scenario", required_argument, NULL, 's'}, {"log-dir", required_argument, NULL, 'l'},
         {"seconds", required_argument, NULL, 't'},  {"clock", required_argument, NULL, 'k'},
+        {"start-when", required_argument, NULL, 'w'},
+        {"start-timeout", required_argument, NULL, 'T'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     opterr = 0;
@@ -372,6 +399,17 @@ int main(int argc, char **argv)
             }
             clock_ticks = strcmp(optarg, "ticks") == 0;
             break;
+        case 'w': gate = optarg; break;
+        case 'T': {
+            char *end = NULL;
+            start_timeout_s = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(start_timeout_s > 0.0) ||
+                start_timeout_s > 3600.0) {
+                fprintf(stderr, "argil-sim: --start-timeout '%s': expected 0-3600 s\n", optarg);
+                return EXIT_USAGE;
+            }
+            break;
+        }
         case 'h': usage(stdout); return 0;
         default:
             fprintf(stderr, "argil-sim: unknown or incomplete option '%s' (try --help)\n",
@@ -442,17 +480,27 @@ int main(int argc, char **argv)
                            : scn_path ? scn.duration_us
                                       : INT64_MAX;
     char line[256];
-    {   /* frames queued before the start line are not counted: SYNCs count from here */
+    const char *gpio_name =
+        gpio.mode == GPIO_SYSFS ? "gpio-sim" : gpio.mode == GPIO_GPIOD ? "gpiod" : "none";
+    /* With --start-when the device runs from here (the drives boot, the board arms them), the
+     * scenario waits at time 0 and its start line is written when FILE exists; else now. */
+    preroll = gate != NULL;
+    sim_runner_hold(&run, preroll);
+    if (!preroll) {
+        /* frames queued before the start line are not counted: SYNCs count from here */
         can_batch_t stale;
         do {
             can_socket_stats_t ignored = {0};
             if (can_socket_receive(fd, &stale, &ignored) != ARGIL_OK)
                 break;
         } while (stale.n == CAN_BATCH_MAX);
+        snprintf(line, sizeof(line), "start scenario %s can %s gpio %s",
+                 scn_path ? scn.name : "none", iface, gpio_name);
+        log_event(NULL, 0, line);
     }
-    snprintf(line, sizeof(line), "start scenario %s can %s gpio %s", scn_path ? scn.name : "none",
-             iface, gpio.mode == GPIO_SYSFS ? "gpio-sim" : gpio.mode == GPIO_GPIOD ? "gpiod" : "none");
-    log_event(NULL, 0, line);
+    const int64_t preroll_t0_us = mono_us();
+    bool gate_seen = false;
+    uint32_t max_syncs_per_read = 0;
 
     can_socket_stats_t st;
     memset(&st, 0, sizeof(st));
@@ -482,7 +530,17 @@ int main(int argc, char **argv)
     struct timespec next;
     clock_gettime(CLOCK_MONOTONIC, &next);
     defer_events = true;
-    while (!stop_requested && clk.now_us < end_us && rc == 0) {
+    while (!stop_requested && (preroll || clk.now_us < end_us) && rc == 0) {
+        if (preroll && !gate_seen) {
+            gate_seen = access(gate, F_OK) == 0;
+            if (!gate_seen && mono_us() - preroll_t0_us > (int64_t)(start_timeout_s * 1e6)) {
+                fprintf(stderr, "argil-sim: %s did not appear within %.0f s: the board never got "
+                        "ready to sculpt (%u SYNCs seen), the scenario was not played\n",
+                        gate, start_timeout_s, clk.syncs);
+                rc = EXIT_NOT_READY;
+                break;
+            }
+        }
         if (clock_ticks) {
             /* The board's SYNC starts each step: wait for frames (1 ms at most, so a silent
              * bus still lets the wall clock take over). */
@@ -501,6 +559,8 @@ int main(int argc, char **argv)
                    !stop_requested) {
             }
         }
+        struct timespec t_before_read;
+        clock_gettime(CLOCK_REALTIME, &t_before_read);
         can_batch_t rx;
         if (can_socket_receive(fd, &rx, &st) != ARGIL_OK) {
             fprintf(stderr, "argil-sim: CAN %s: receive failed (%s)\n", iface,
@@ -517,16 +577,36 @@ int main(int argc, char **argv)
         }
         struct timespec t_read;
         clock_gettime(CLOCK_REALTIME, &t_read);
+        if (preroll && gate_seen && rx.n == 0) {
+            /* The board is ready and nothing is queued: the scenario starts here. Its start
+             * line is stamped before this (empty) read, so every SYNC the checker counts after
+             * it is one this clock counts. */
+            preroll = false;
+            snprintf(line, sizeof(line),
+                     "start scenario %s can %s gpio %s preroll_syncs=%u preroll_ms=%lld",
+                     scn_path ? scn.name : "none", iface, gpio_name, clk.syncs,
+                     (long long)((mono_us() - preroll_t0_us) / 1000));
+            write_event(&t_before_read, 0, line);
+            fflush(event_log);
+            scn_clock_init(&clk, clock_ticks, mono_us());
+            max_syncs_per_read = 0; /* the backlog of the scenario, not of the start-up */
+            sim_runner_hold(&run, false);
+            run.have_gpio_out = false; /* the next tick logs DRIVE_ENABLE's level */
+            continue;
+        }
         /* One device step per SYNC (with the frames the board sent before it), or one on the
          * wall clock when the bus has been silent; frames after the last SYNC wait for it. */
-        uint32_t steps_this_read = 0;
+        uint32_t steps_this_read = 0, syncs_this_read = 0;
         for (uint32_t i = 0; i <= rx.n && rc == 0; i++) {
             uint32_t dt_us = 0;
             if (i < rx.n) {
                 const can_frame_t *f = &rx.f[i];
                 (void)can_batch_push(&held, f);
-                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
+                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u) {
                     dt_us = scn_clock_sync(&clk, mono_us());
+                    if (++syncs_this_read > max_syncs_per_read)
+                        max_syncs_per_read = syncs_this_read;
+                }
                 else if (held.n < CAN_BATCH_MAX)
                     continue;
                 /* a full batch without SYNC is handed over with a step of 0 */
@@ -538,7 +618,8 @@ int main(int argc, char **argv)
                     late_ticks++;
             }
             /* host-side steps are the host rig's; log them so the record is complete */
-            while (scn_path && next_host < scn.n_steps && scn.step[next_host].t_us <= run.now_us) {
+            while (!preroll && scn_path && next_host < scn.n_steps &&
+                   scn.step[next_host].t_us <= run.now_us) {
                 const scn_step_t *s = &scn.step[next_host++];
                 if (scenario_action_is_host_side(s->action)) {
                     snprintf(line, sizeof(line), "host line=%u (for the host side) %s",
@@ -546,7 +627,7 @@ int main(int argc, char **argv)
                     log_event(NULL, run.now_us, line);
                 }
             }
-            while (next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
+            while (!preroll && next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
                 /* sync=N: this step began at the board's N-th SYNC since the start line, the
                  * instant the checker anchors on (this line is stamped later, after the I/O) */
                 if (i < rx.n)
@@ -575,12 +656,12 @@ int main(int argc, char **argv)
                 rc = EXIT_RUN;
             }
             flush_events(&t_read);
-            if (clk.now_us >= end_us)
+            if (!preroll && clk.now_us >= end_us)
                 break;
         }
         prev_read = t_read;
     }
-    while (scn_path && next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
+    while (!preroll && scn_path && next_mark < n_marks && mark_us[next_mark] <= run.now_us) {
         snprintf(line, sizeof(line), "mark at %" PRId64 ".%06" PRId64,
                  mark_us[next_mark] / 1000000, mark_us[next_mark] % 1000000);
         log_event(NULL, run.now_us, line);
@@ -597,10 +678,10 @@ int main(int argc, char **argv)
                 lost_ev, EVENTS_MAX);
     snprintf(line, sizeof(line),
              "end frames_rx=%u frames_tx=%u tx_busy=%u late_ticks=%u dropped=%u/%u silenced=%u "
-             "clock %s syncs=%u wall_steps=%u",
+             "clock %s syncs=%u wall_steps=%u max_syncs_per_read=%u cpu_ms=%.0f",
              st.rx_frames, st.tx_frames, st.tx_busy, late_ticks, run.faults.dropped_to_board,
              run.faults.dropped_from_board, run.faults.silenced, clock_ticks ? "ticks" : "wall",
-             clk.syncs, clk.wall_steps);
+             clk.syncs, clk.wall_steps, max_syncs_per_read, cpu_ms());
     log_event(NULL, run.now_us, line);
     if (event_log != stdout)
         fclose(event_log);

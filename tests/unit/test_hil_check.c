@@ -278,6 +278,80 @@ static void synth_ticks(hil_obs_t *o, int64_t tick_us, int64_t phase_us, int rea
     assert_true(o->n_syncs > 0);
 }
 
+/* A rearm at 1 kHz with SYNCs: the board answers each drive statusword react_ticks later with
+ * the next controlword (0x06, 0x07, 0x0F), each drive answers a controlword lag_ticks later with
+ * its next state (TPDO after each SYNC). */
+static void synth_enable(hil_obs_t *o, int react_ticks, int lag_ticks)
+{
+    hil_obs_init(o);
+    const int64_t t0 = 10000000, rearm = t0 + 2000000;
+    const char ev[] = "(10.000000) start scenario t\n(11.000000) inject line=3 estop\n"
+                      "(11.001000) gpio_out DRIVE_ENABLE=0\n(12.000000) inject line=4 rearm\n"
+                      "(12.000900) gpio_out DRIVE_ENABLE=1\n";
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(o, &scn, ev, strlen(ev), &line), HIL_OK);
+    static const uint16_t cws[4] = {CIA402_CW_DISABLE_VOLTAGE, 0x06u, 0x07u, CIA402_CW_ENABLE_OP};
+    static const cia402_state_t states[4] = {CIA402_SWITCH_ON_DISABLED, CIA402_READY_TO_SWITCH_ON,
+                                             CIA402_SWITCHED_ON, CIA402_OPERATION_ENABLED};
+    int cw_step = 0, drive_step = 0;
+    int64_t next_cw_tick = -1, next_state_tick = -1;
+    for (int64_t tick = 0; tick < 3000; tick++) {
+        const int64_t t = t0 + tick * 1000 + 500;
+        if (t > rearm && next_cw_tick < 0 && cw_step == 0)
+            next_cw_tick = tick + react_ticks;
+        if (cw_step < 3 && tick == next_cw_tick) {
+            cw_step++;
+            next_state_tick = tick + lag_ticks;
+        }
+        if (drive_step < cw_step && tick == next_state_tick) {
+            drive_step = cw_step;
+            if (cw_step < 3)
+                next_cw_tick = tick + react_ticks;
+        }
+        can_frame_t f;
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_rpdo_encode(&f, n, t < rearm ? CIA402_CW_QUICK_STOP : cws[cw_step], 0);
+            assert_int_equal(hil_obs_push_frame(o, t, &f), HIL_OK);
+        }
+        f = (can_frame_t){.id = CANOPEN_COB_SYNC, .len = 0};
+        assert_int_equal(hil_obs_push_frame(o, t + 200, &f), HIL_OK);
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_tpdo_encode(&f, n, cia402_statusword(states[drive_step]), 0, 0);
+            assert_int_equal(hil_obs_push_frame(o, t + 300, &f), HIL_OK);
+        }
+    }
+}
+
+/* "enabled within" bounds the board's ticks: the ticks its controlwords waited for the drives'
+ * answers are the drives' (a lagging arm stand-in), the rest the board's. */
+static void test_enabled_counts_the_boards_ticks_not_the_drives(void **st)
+{
+    (void)st;
+    load_scn();
+    hil_obs_t o;
+    hil_result_t r;
+    synth_enable(&o, 2, 200);  /* drives answer 200 ticks late: 406 ticks in all */
+    hil_check_expect(&scn, &o, 6, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    assert_true(r.observed_ticks >= 2 && r.observed_ticks <= 9); /* 3 x 2, as SYNCs fall */
+    assert_true(r.observed_us > 400000);
+    assert_non_null(strstr(r.msg, "406 ticks: the drives answered in 402, the board took 4"));
+    hil_obs_free(&o);
+
+    synth_enable(&o, 110, 1);  /* the board waits 110 ticks after each answer: 332 of its own */
+    hil_check_expect(&scn, &o, 6, &r);
+    assert_false(r.pass);
+    assert_true(r.observed_ticks > 300);
+    hil_obs_free(&o);
+
+    synth_enable(&o, 95, 30);  /* 285 of the board's, 60 of the drives': passes */
+    hil_check_expect(&scn, &o, 6, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    hil_obs_free(&o);
+}
+
 /* With SYNCs in the log, bounds count board ticks: a board at 333 ticks/s that reacts one tick
  * after the one in flight meets "within 1ms" though 3 ms of wall time passed; one more fails. */
 static void test_bounds_in_ticks(void **st)
@@ -609,6 +683,7 @@ int main(void)
         cmocka_unit_test(test_gpio_edge_of_the_last_tick_follows_its_sync),
         cmocka_unit_test(test_heartbeat_supervised),
         cmocka_unit_test(test_times_after_a_step_count_from_its_injection),
+        cmocka_unit_test(test_enabled_counts_the_boards_ticks_not_the_drives),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

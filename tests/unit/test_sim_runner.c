@@ -198,6 +198,42 @@ static void test_runner_applies_steps_on_time(void **st)
     assert_false(sim_runner_done(&r));
 }
 
+/* Held before its start, the device answers (the drives boot and send heartbeats) while the
+ * scenario waits at time 0; released, its steps apply on the scenario's own clock. */
+static void test_runner_holds_the_scenario_until_released(void **st)
+{
+    (void)st;
+    static const char text[] = "name h\nduration 1s\n"
+                               "at 0.000 hand 0 0 0\n"
+                               "at 0.010 estop press\n";
+    static scenario_t s;
+    scn_error_t err;
+    assert_int_equal(scenario_parse(&s, text, sizeof(text) - 1, &err), SCN_OK);
+    static sim_runner_t r;
+    static log_t log;
+    sim_params_t p;
+    sim_params_default(&p);
+    sim_runner_init(&r, &p, &s, false, log_fn, &log);
+    sim_runner_hold(&r, true);
+    can_batch_t out;
+    uint32_t frames = 0;
+    for (int ms = 0; ms < 300; ms++) {
+        sim_runner_tick(&r, NULL, 0, &out, 1000);
+        frames += out.n;
+    }
+    assert_true(frames >= 3u);                   /* boot-up and heartbeats of three drives */
+    assert_int_equal(r.now_us, 0);               /* the scenario waits at 0 */
+    assert_int_equal(r.device_us, 300000);
+    assert_int_equal(log.n, 0);                  /* no step applied */
+    assert_true(sim_runner_gpio_in(&r) & GPIO_IN_ESTOP_N);
+    sim_runner_hold(&r, false);
+    for (int ms = 0; ms <= 10; ms++)
+        sim_runner_tick(&r, NULL, 0, &out, 1000);
+    assert_false(sim_runner_gpio_in(&r) & GPIO_IN_ESTOP_N);
+    assert_int_equal(log.n, 2);
+    assert_string_equal(log.lines[1], "10000 inject line=4 at 0.010 estop press");
+}
+
 static void test_watchdog_cuts_power_when_the_kick_stops(void **st)
 {
     (void)st;
@@ -236,6 +272,7 @@ int main(void)
         cmocka_unit_test(test_delay_holds_frames_in_order),
         cmocka_unit_test(test_bus_off_heartbeat_and_encoder),
         cmocka_unit_test(test_runner_applies_steps_on_time),
+        cmocka_unit_test(test_runner_holds_the_scenario_until_released),
         cmocka_unit_test(test_watchdog_cuts_power_when_the_kick_stops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
