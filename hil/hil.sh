@@ -13,6 +13,9 @@
 #      one vCPU under TCG they starve each other and the scenarios see "host lost"/"drive
 #      heartbeat lost" before sculpting. The bounds are in board ticks, so the two vCPUs
 #      stalling independently does not matter).
+#      HIL_QEMU_ARGS: more qemu options, e.g. "-icount shift=0,sleep=off" with HIL_SMP=1
+#      (instruction-counted guest time, independent of the host's load; qemu 7.2 hangs
+#      bringing up a second vCPU under -icount).
 # Besides vcan0 the VM has two emulated Kvaser PCIcan (SJA1000) controllers on one emulated CAN
 # bus: can0 and can1 with the kernel's real controller drivers (check can_controller).
 set -eu
@@ -54,7 +57,7 @@ for rig in $rigs; do
         -m "${HIL_MEM_MB:-256}" -nodefaults -nographic -no-reboot -net none -serial stdio \
         -device isa-debug-exit,iobase=0xf4,iosize=0x04 \
         -object can-bus,id=canbus0 -device kvaser_pci,canbus=canbus0 -device kvaser_pci,canbus=canbus0 \
-        -kernel "$b/$kv/vmlinux" -initrd "$img" \
+        ${HIL_QEMU_ARGS:-} -kernel "$b/$kv/vmlinux" -initrd "$img" \
         -append "console=ttyS0 quiet loglevel=3 panic=-1 noirqdebug argil.rig=$rig" </dev/null 2>&1 || st=$?
       echo "HIL-QEMU-STATUS $st"; } | tr -d '\r' | tee "$run/console.log" |
         grep --line-buffered -E '^(PASS|FAIL|SKIP|HIL-INIT|[0-9]+ passed)' | sed -u "s/^/  [$rig] /"

@@ -572,18 +572,16 @@ check_scenario() {
     if [ "$STIM" = gpio-sim ]; then simchip=$(cat "$GPIO_SIM_CONFIGFS/bank0/chip_name"); else simchip=$LOOP_CHIP; fi
     # The arm is its own hardware: it must not wait behind the daemon's SCHED_FIFO loop. It
     # starts at SIM_PRIO, under the board's link thread (its start-up is heavy under TCG and the
-    # host's heartbeats must get in), and runs at SIM_RUN_PRIO once its clock starts: above the
-    # rig's host and the board's link thread, or it fell up to 90 board ticks behind the SYNCs
-    # it answers and the drives' heartbeats reached the board up to 90 ticks late.
+    # host's heartbeats must get in), and raises itself to SIM_RUN_PRIO (--run-prio) before it
+    # answers the first SYNC: above the rig's host and the board's link thread, or it fell up
+    # to 90 board ticks behind the SYNCs it answers and the drives' heartbeats reached the board
+    # up to 90 ticks late (raised only at the scenario's start, under load it starved while the
+    # drives booted and the board faulted "drive heartbeat lost" before time 0).
     # SIM_CPU pins it to the CPU the board's loop does not own (the VM's vCPU 1).
     ${SIM_CPU:+taskset -c "$SIM_CPU"} hil-probe fifo "$SIM_PRIO" argil-sim --can "${SIM_CAN_IF:-$CAN_IF}" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
-        --start-when "$ready" --start-timeout "$START_TIMEOUT_S" >"$OUT/$CHECK.sim.out" 2>&1 &
+        --start-when "$ready" --start-timeout "$START_TIMEOUT_S" ${SIM_RUN_PRIO:+--run-prio "$SIM_RUN_PRIO"} \
+        >"$OUT/$CHECK.sim.out" 2>&1 &
     SIM_PID=$!
-    i=0
-    while [ "$i" -lt $((START_TIMEOUT_S * 20 + 100)) ] && kill -0 "$SIM_PID" 2>/dev/null && ! grep -q ' start scenario' "$OUT/$CHECK.sim/events.log" 2>/dev/null; do
-        sleep 0.05; i=$((i + 1))
-    done
-    [ -n "${SIM_RUN_PRIO:-}" ] && kill -0 "$SIM_PID" 2>/dev/null && hil-probe chrt "$SIM_RUN_PRIO" "$SIM_PID" >/dev/null
     wait "$SIM_PID" || st=$?; SIM_PID=
     hst=0; wait "$HOST_PID" || hst=$?; HOST_PID=
     can_log_stop
@@ -614,7 +612,9 @@ check_scenario() {
     # at when a bound is near.
     pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\).*/ready after \1 board ticks (\2 ms)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     lag=$(sed -n 's/.* end .*max_syncs_per_read=\([0-9]*\).*/, arm stand-in >= \1 ticks behind at worst/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
-    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag]"; return; }
+    # The board's states as it logged them, for a failure: "ACTIVE FAULT(drive heartbeat lost)".
+    states=$(sed -n 's/^[0-9.]* argil-board: state \([A-Z]*\)\( — \(.*\)\)*$/\1(\3)/p' "$OUT/$CHECK.board.log" | sed 's/()//' | tr '\n' ' ')
+    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag; board: $states]"; return; }
     pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag)"
 }
 

@@ -13,6 +13,7 @@
 #include <gpiod.h>
 #include <inttypes.h>
 #include <poll.h>
+#include <sched.h>
 #include <linux/can.h>
 #include <signal.h>
 #include <stdio.h>
@@ -48,7 +49,7 @@ static void usage(FILE *to)
 {
     fputs("usage: argil-sim --can IFACE [--gpio-chip CHIP] [--scenario FILE] [--log-dir DIR]\n"
           "                 [--seconds S] [--clock ticks|wall] [--start-when FILE]\n"
-          "                 [--start-timeout S] [--help]\n"
+          "                 [--start-timeout S] [--run-prio N] [--help]\n"
           "  The simulated arm (3 CiA 402 drives, arm dynamics, GPIO, a scripted hand) on a\n"
           "  SocketCAN interface, one 1 ms step per SYNC of the board (--clock).\n"
           "  --can IFACE       CAN interface the board is on (vcan0, can0)\n"
@@ -68,6 +69,8 @@ static void usage(FILE *to)
           "                    hand at home) until FILE exists: the rig's host writes it when the\n"
           "                    board is ACTIVE (docs/sim.md, \"Scenario time 0\")\n"
           "  --start-timeout S give up when FILE has not appeared after S s (default 60)\n"
+          "  --run-prio N      SCHED_FIFO priority N (1-98) once set up, before the first SYNC\n"
+          "                    is answered: the arm is its own hardware and answers in time\n"
           "exit: 0 ran to the end, 1 bus/GPIO could not be opened or failed, 2 bad usage,\n"
           "      3 --start-when's FILE never appeared (the board never got ready)\n",
           to);
@@ -366,6 +369,7 @@ int main(int argc, char **argv)
 {
     const char *iface = NULL, *chip = NULL, *scn_path = NULL, *log_dir = NULL, *gate = NULL;
     double seconds = -1.0, start_timeout_s = 60.0;
+    int run_prio = 0;
     bool clock_ticks = true;
     static const struct option opts[] = {
         {"can", required_argument, NULL, 'c'},      {"gpio-chip", required_argument, NULL, 'g'},
@@ -373,6 +377,7 @@ int main(int argc, char **argv)
         {"seconds", required_argument, NULL, 't'},  {"clock", required_argument, NULL, 'k'},
         {"start-when", required_argument, NULL, 'w'},
         {"start-timeout", required_argument, NULL, 'T'},
+        {"run-prio", required_argument, NULL, 'P'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     opterr = 0;
@@ -408,6 +413,16 @@ int main(int argc, char **argv)
                 fprintf(stderr, "argil-sim: --start-timeout '%s': expected 0-3600 s\n", optarg);
                 return EXIT_USAGE;
             }
+            break;
+        }
+        case 'P': {
+            char *end = NULL;
+            const long v = strtol(optarg, &end, 10);
+            if (end == optarg || *end != '\0' || v < 1 || v > 98) {
+                fprintf(stderr, "argil-sim: --run-prio '%s': expected 1-98\n", optarg);
+                return EXIT_USAGE;
+            }
+            run_prio = (int)v;
             break;
         }
         case 'h': usage(stdout); return 0;
@@ -497,6 +512,14 @@ int main(int argc, char **argv)
         snprintf(line, sizeof(line), "start scenario %s can %s gpio %s",
                  scn_path ? scn.name : "none", iface, gpio_name);
         log_event(NULL, 0, line);
+    }
+    /* Set up (its heavy start-up under emulation done at the caller's priority): from the
+     * first SYNC on the arm answers like hardware, ahead of the rig's host and logger. */
+    if (run_prio > 0) {
+        const struct sched_param fifo = {.sched_priority = run_prio};
+        if (sched_setscheduler(0, SCHED_FIFO, &fifo) != 0)
+            fprintf(stderr, "argil-sim: --run-prio %d: %s (running on)\n", run_prio,
+                    strerror(errno));
     }
     const int64_t preroll_t0_us = mono_us();
     bool gate_seen = false;
