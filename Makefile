@@ -237,8 +237,12 @@ bench: deps-bench
 A64 := $(BUILD)/aarch64
 A64_CC := aarch64-linux-gnu-gcc
 A64_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
-A64_UNIT := $(filter $(UNIT_TESTS),test_safety test_safety_table test_safety_transitions test_drives test_canopen test_spsc_ring test_rt_stats test_window test_arm_kin)
-A64_SIL := $(filter $(SIL_TESTS),test_board_sim)
+# The core's tests: test_safety_table is the full transition table, test_board_hal holds the
+# SPSC ring's test (with the Linux HAL's), test_host_session the board's RT-stats message.
+A64_UNIT := test_safety test_safety_table test_drives test_canopen test_board_hal test_host_session test_window test_arm_kin
+A64_SIL := test_board_sim
+A64_MISSING := $(filter-out $(UNIT_TESTS),$(A64_UNIT)) $(filter-out $(SIL_TESTS),$(A64_SIL))
+$(if $(strip $(A64_MISSING)),$(error A64_UNIT/A64_SIL name no file in tests/unit or tests/sil: $(A64_MISSING)))
 CM := $(BUILD)/cortexm
 CM_CC := arm-none-eabi-gcc
 CM_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
@@ -260,6 +264,11 @@ $(A64)/argil-board: $(A64)/firmware/board/main.o $(BOARD_LIB_SRC:%.c=$(A64)/%.o)
 $(A64)/tests/%: tests/unit/%.c $(LIB_SRC:%.c=$(A64)/%.o)
 	@mkdir -p $(dir $@)
 	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(LDLIBS)
+
+# As on the host, tests of the daemon's Linux side link against the board's sources.
+$(A64)/tests/test_board_%: tests/unit/test_board_%.c $(BOARD_LIB_SRC:%.c=$(A64)/%.o)
+	@mkdir -p $(dir $@)
+	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(BOARD_LDLIBS)
 
 $(A64)/sil/%: tests/sil/%.c $(LIB_SRC:%.c=$(A64)/%.o)
 	@mkdir -p $(dir $@)
