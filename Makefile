@@ -1,11 +1,14 @@
 # argil — the one entry point. See README.md.
 #   make / make all   build everything (release flags) and check the freestanding parts
 #   make run          install missing packages, build, run the default sculpting session
-#   make test         unit + SIL tests under ASan/UBSan, and file checks; ends with a summary
+#   make test         every tier below (CI); ends with "N passed, N failed, N skipped"
+#   make unit         cmocka unit tests under ASan/UBSan, and the test runner's own test
+#   make sil          the SIL scenarios under ASan/UBSan (lockstep, virtual clock)
+#   make sys          tests/sys: the programs and their files (not cross, not hil)
 #   make fuzz         every libFuzzer target for FUZZ_SECONDS (default 60) each
 #   make fuzz-long    every libFuzzer target to FUZZ_RUNS (default 10^7) executions
 #   make bench        figures for the 1 kHz path and the host
-#   make cross        aarch64 and Cortex-M builds (docs/board.md)
+#   make cross        aarch64 and Cortex-M builds, run under qemu (docs/board.md)
 #   make hil          the HIL VM rig: real argil-board on vcan/gpio-sim/FunctionFS (hil/README.md)
 #   make clean
 
@@ -57,7 +60,7 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil $(REL)/argil-board check-freestanding
@@ -167,9 +170,26 @@ check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil \
              $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/hil-host
 
+# Test tiers (README.md, "Tests"): each builds what it needs and runs through tests/run_all.sh,
+# which counts every test and check and ends with "N passed, N failed, N skipped".
+RUN_TESTS := sh tests/run_all.sh $(SAN) $(REL)
+SYS_BINS := $(SAN)/argil $(REL)/argil $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client
+
 test: deps-test deps-cross deps-hil
 	@$(MAKE) --no-print-directory tests-build cross-build check-freestanding
-	@sh tests/run_all.sh $(SAN) $(REL)
+	@$(RUN_TESTS) unit sil sys cross hil
+
+unit: deps-test
+	@$(MAKE) --no-print-directory $(UNIT_TESTS:%=$(SAN)/tests/%)
+	@$(RUN_TESTS) unit
+
+sil: deps-test
+	@$(MAKE) --no-print-directory $(SIL_TESTS:%=$(SAN)/sil/%)
+	@$(RUN_TESTS) sil
+
+sys: deps-test
+	@$(MAKE) --no-print-directory $(SYS_BINS) check-freestanding
+	@$(RUN_TESTS) sys
 
 run: deps-build
 	@$(MAKE) --no-print-directory all
@@ -217,8 +237,12 @@ bench: deps-bench
 A64 := $(BUILD)/aarch64
 A64_CC := aarch64-linux-gnu-gcc
 A64_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
-A64_UNIT := $(filter $(UNIT_TESTS),test_safety test_safety_table test_safety_transitions test_drives test_canopen test_spsc_ring test_rt_stats test_window test_arm_kin)
-A64_SIL := $(filter $(SIL_TESTS),test_board_sim)
+# The core's tests: test_safety_table is the full transition table, test_board_hal holds the
+# SPSC ring's test (with the Linux HAL's), test_host_session the board's RT-stats message.
+A64_UNIT := test_safety test_safety_table test_drives test_canopen test_board_hal test_host_session test_window test_arm_kin
+A64_SIL := test_board_sim
+A64_MISSING := $(filter-out $(UNIT_TESTS),$(A64_UNIT)) $(filter-out $(SIL_TESTS),$(A64_SIL))
+$(if $(strip $(A64_MISSING)),$(error A64_UNIT/A64_SIL name no file in tests/unit or tests/sil: $(A64_MISSING)))
 CM := $(BUILD)/cortexm
 CM_CC := arm-none-eabi-gcc
 CM_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
@@ -240,6 +264,11 @@ $(A64)/argil-board: $(A64)/firmware/board/main.o $(BOARD_LIB_SRC:%.c=$(A64)/%.o)
 $(A64)/tests/%: tests/unit/%.c $(LIB_SRC:%.c=$(A64)/%.o)
 	@mkdir -p $(dir $@)
 	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(LDLIBS)
+
+# As on the host, tests of the daemon's Linux side link against the board's sources.
+$(A64)/tests/test_board_%: tests/unit/test_board_%.c $(BOARD_LIB_SRC:%.c=$(A64)/%.o)
+	@mkdir -p $(dir $@)
+	$(A64_CC) $(A64_CFLAGS) $^ -o $@ -lcmocka $(BOARD_LDLIBS)
 
 $(A64)/sil/%: tests/sil/%.c $(LIB_SRC:%.c=$(A64)/%.o)
 	@mkdir -p $(dir $@)
@@ -273,18 +302,20 @@ cross-build: $(A64)/argil-board $(A64_UNIT:%=$(A64)/tests/%) $(A64_SIL:%=$(A64)/
              $(CM)/argil-m4.elf $(CM)/argil-m7.elf $(CM)/tick_ref
 
 cross: deps-cross
-	@$(MAKE) --no-print-directory cross-build
+	@$(MAKE) --no-print-directory cross-build $(REL)/board_udp_client
 	@file $(A64)/argil-board | sed 's/, BuildID.*//'
 	@arm-none-eabi-size $(CM)/argil-m4.elf $(CM)/argil-m7.elf
+	@$(RUN_TESTS) cross
 
 # The HIL rig (hil/README.md): Debian's kernel debs -> a qemu VM with vcan, gpio-sim and a
-# FunctionFS gadget on dummy_hcd, the real argil-board in it; ends with "N passed, N failed".
+# FunctionFS gadget on dummy_hcd, the real argil-board in it; through tests/run_all.sh (each VM
+# check one test), ends with "N passed, N failed, N skipped".
 # argil-sim and argil-hil-check play hil/scenarios/*.scn in the VM; argil is the USB host.
 HIL_BINS := $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/hil-host \
             $(REL)/argil-sim $(REL)/argil-hil-check $(REL)/argil
 hil: deps-hil
 	@$(MAKE) --no-print-directory $(HIL_BINS)
-	@sh hil/hil.sh $(BUILD)
+	@$(RUN_TESTS) hil
 
 clean:
 	rm -rf $(BUILD) $(OUT)

@@ -30,6 +30,13 @@ say() { echo "hil: $*"; }
 t_start=$(date +%s.%N)
 since() { awk -v a="$t_start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f s", b - a }'; }
 
+# What each rig will run, before anything can fail: tests/sys/test_hil.sh counts a planned check
+# that never reports (a VM that died, a kernel that did not build) as failed.
+for rig in $rigs; do
+    say "rig '$rig' plans $(awk -v r="$rig" '$1 == r || $1 == "*" { n++ } END { print n + 0 }' \
+        "${HIL_PLAN:-$here/plan.txt}") checks"
+done
+
 if [ -z "${HIL_CACHE:-}" ]; then
     if [ "$(id -u)" = 0 ]; then HIL_CACHE=/var/cache/argil-hil; else HIL_CACHE=$b/debs; fi
 fi

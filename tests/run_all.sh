@@ -1,74 +1,71 @@
 #!/bin/sh
-# Runs every test tier that runs on this machine and ends with one summary line:
-#   N passed, N failed
-# Usage: tests/run_all.sh SAN_BUILD_DIR REL_BUILD_DIR
+# Runs the test tiers named (default: all) and ends with one summary line:
+#   N passed, N failed, N skipped
+# Usage: tests/run_all.sh SAN_BUILD_DIR REL_BUILD_DIR [unit] [sil] [sys] [cross] [hil]
+#   unit   the cmocka binaries SAN/tests/test_* (ASan + UBSan) and tests/runner/test_*.sh
+#   sil    the SIL scenarios SAN/sil/test_*
+#   sys    tests/sys/test_*.sh but test_cross.sh and test_hil.sh
+#   cross  tests/sys/test_cross.sh (aarch64 under qemu-user, Cortex-M on qemu-system-arm)
+#   hil    tests/sys/test_hil.sh (the VM rig; its output is shown as it runs)
+# Every cmocka test and every check a script reports (tests/lib/report.sh) is one counted test;
+# how crashes, time-outs and exit status 77 (skip) count: tests/lib/run.sh. Each test runs under
+# a time limit: the tier's (unit 300 s, sil 600 s, sys 300 s, cross 900 s, hil 1500 s), else
+# tests/timeouts (NAME SECONDS lines), else $TEST_TIMEOUT_<NAME> or $TEST_TIMEOUT in seconds.
 set -u
 # Tests that want a display make their own (xvfb-run); without this, every other `argil sculpt`
 # would open a window on the caller's display and run at real-time pace.
 unset DISPLAY WAYLAND_DISPLAY
-san=$1
-rel=$2
-passed=0
-failed=0
-failed_names=""
-log_dir="$san/test-logs"
-mkdir -p "$log_dir"
+SAN=$1
+REL=$2
+shift 2
+export SAN REL
+tiers=${*:-unit sil sys cross hil}
+. tests/lib/run.sh
+run_init "$SAN/test-logs"
 
-# A cmocka binary: count its own PASSED/FAILED lines (summary goes to stderr).
-run_cmocka() {
-    bin=$1
-    name=$(basename "$bin")
-    log="$log_dir/$name.log"
-    "$bin" >"$log" 2>&1
-    rc=$?
-    p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n 1)
-    f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n 1)
-    p=${p:-0}
-    f=${f:-0}
-    if [ "$rc" != 0 ] && [ "$f" = 0 ]; then
-        f=1 # crashed or sanitizer abort before cmocka could count
-    fi
-    passed=$((passed + p))
-    failed=$((failed + f))
-    if [ "$f" != 0 ]; then
-        failed_names="$failed_names $name"
-        echo "FAIL $name ($p passed, $f failed) — log: $log"
-        grep -E '^\[  (FAILED|ERROR) |ERROR|error|Sanitizer|runtime error' "$log" | head -n 20 | sed 's/^/    /'
-    else
-        echo "ok   $name ($p tests)"
-    fi
+# limit NAME TIER_DEFAULT: tests/timeouts first, then the environment (run_timeout).
+limit() {
+    lim=$(awk -v n="$1" '$1 == n && $2 ~ /^[0-9]+$/ { print $2 }' tests/timeouts 2>/dev/null | tail -n 1)
+    run_timeout "$1" "${lim:-$2}"
 }
 
-# A shell-level test: one test, pass on exit 0.
-run_sys() {
-    script=$1
-    name=$(basename "$script" .sh)
-    log="$log_dir/$name.log"
-    if SAN="$san" REL="$rel" sh "$script" >"$log" 2>&1; then
-        passed=$((passed + 1))
-        echo "ok   $name"
-    else
-        failed=$((failed + 1))
-        failed_names="$failed_names $name"
-        echo "FAIL $name — log: $log"
-        tail -n 20 "$log" | sed 's/^/    /'
-    fi
-}
+for tier in $tiers; do
+    case "$tier" in
+    unit)
+        echo "== unit tests (ASan + UBSan)"
+        for t in "$SAN"/tests/test_*; do
+            [ -x "$t" ] && run_test cmocka "$t" "$(limit "$(basename "$t")" 300)"
+        done
+        for t in tests/runner/test_*.sh; do
+            [ -f "$t" ] && run_test script "$t" "$(limit "$(basename "$t" .sh)" 300)"
+        done
+        ;;
+    sil)
+        echo "== SIL scenarios (lockstep, virtual clock)"
+        for t in "$SAN"/sil/test_*; do
+            [ -x "$t" ] && run_test cmocka "$t" "$(limit "$(basename "$t")" 600)"
+        done
+        ;;
+    sys)
+        echo "== system tests (the argil program and its files)"
+        for t in tests/sys/test_*.sh; do
+            case "$t" in */test_cross.sh|*/test_hil.sh) continue ;; esac
+            [ -f "$t" ] && run_test script "$t" "$(limit "$(basename "$t" .sh)" 300)"
+        done
+        ;;
+    cross)
+        echo "== cross (aarch64 under qemu-user, Cortex-M on qemu-system-arm)"
+        run_test script tests/sys/test_cross.sh "$(limit test_cross 900)"
+        ;;
+    hil)
+        echo "== HIL rig (qemu VM, real argil-board)"
+        run_test script tests/sys/test_hil.sh "$(limit test_hil 1500)" live
+        ;;
+    *)
+        echo "run_all.sh: unknown tier '$tier' (unit, sil, sys, cross, hil)" >&2
+        exit 2
+        ;;
+    esac
+done
 
-echo "== unit tests (ASan + UBSan)"
-for t in "$san"/tests/test_*; do
-    [ -x "$t" ] && run_cmocka "$t"
-done
-echo "== SIL scenarios (lockstep, virtual clock)"
-for t in "$san"/sil/test_*; do
-    [ -x "$t" ] && run_cmocka "$t"
-done
-echo "== system tests (the argil program and its files)"
-for t in tests/sys/test_*.sh; do
-    [ -f "$t" ] && run_sys "$t"
-done
-
-echo
-[ -n "$failed_names" ] && echo "failed:$failed_names"
-echo "$passed passed, $failed failed"
-[ "$failed" = 0 ]
+run_summary

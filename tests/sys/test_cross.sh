@@ -6,13 +6,22 @@
 #   state, fault, CAN frame count, GPIO levels, link bytes: identical;
 #   commanded torque: within 1 per mille; rendered force: within 2 mN per axis
 # (newlib's and glibc's sinf/cosf differ in the last bit; fused multiply-add is off).
+# Each aarch64 cmocka test and each other step is one check reported to the runner
+# (tests/lib/report.sh): aarch64/BINARY/TEST, then the names below; the first failed step ends
+# the script and the steps after it count as failed (PLAN).
 set -eu
+. tests/lib/report.sh
 root=$(dirname "$REL")
 a64="$root/aarch64"
 cm="$root/cortexm"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+# The steps after the aarch64 cmocka binaries, in order; each reports PASS through ok, and the
+# first that fails reports FAIL through fail and ends the script.
+report_plan 7
+step=a64-board-help
+ok() { report PASS "$step" "$*"; }
+fail() { report FAIL "$step" "$*"; exit 1; }
 # The loader (-L: ld-linux-aarch64.so.1 of libc6-arm64-cross, the glibc the cross gcc links
 # against) and libc.so.6 must come from the same glibc build: the cross sysroot's lib first, then
 # Debian's arm64 multiarch directory for libgpiod and libcmocka only. With the multiarch
@@ -21,24 +30,36 @@ fail() { echo "FAIL: $*"; exit 1; }
 # (docs/board.md, "aarch64 under qemu-user").
 QEMU_A64="qemu-aarch64 -L /usr/aarch64-linux-gnu -E LD_LIBRARY_PATH=/usr/aarch64-linux-gnu/lib:/usr/lib/aarch64-linux-gnu"
 
-n=0
+# Every test of every binary is a check; one that crashes or hangs has its unrun tests failed.
+n=0 bad=""
 for t in "$a64"/tests/test_* "$a64"/sil/test_*; do
     [ -x "$t" ] || continue
-    timeout -s KILL 300 $QEMU_A64 "$t" >"$tmp/out" 2>&1 || { tail -n 20 "$tmp/out"; fail "aarch64 $(basename "$t")"; }
-    echo "aarch64 $(basename "$t"): $(grep -E '^\[  PASSED  \]' "$tmp/out")"
+    st=0
+    timeout -s KILL 300 $QEMU_A64 "$t" >"$tmp/out" 2>&1 || st=$?
+    cmocka_results "aarch64/$(basename "$t")/" <"$tmp/out" >"$tmp/res"
+    [ -z "${RESULTS_FILE:-}" ] || cat "$tmp/res" >>"$RESULTS_FILE"
+    echo "aarch64 $(basename "$t"): $(grep -c '^PASS' "$tmp/res") passed, $(grep -c '^FAIL' "$tmp/res") failed, $(grep -c '^SKIP' "$tmp/res") skipped (status $st)"
+    [ "$st" = 0 ] || { tail -n 20 "$tmp/out"; bad="$bad $(basename "$t")"; }
+    # Dead before cmocka said how many tests it has: one failed check for the binary.
+    [ "$st" = 0 ] || grep -q '^PLAN' "$tmp/res" || report FAIL "aarch64/$(basename "$t")" "status $st before its first test"
     n=$((n + 1))
 done
-[ "$n" -ge 2 ] || fail "no aarch64 tests were built"
+[ "$n" -ge 2 ] || { report FAIL aarch64-tests "no aarch64 tests were built"; exit 1; }
+[ -z "$bad" ] || echo "aarch64 tests failed:$bad"
 
 timeout -s KILL 60 $QEMU_A64 "$a64/argil-board" --help >"$tmp/help" || fail "aarch64 argil-board --help"
 grep -q -- '--rate-hz' "$tmp/help" || fail "aarch64 --help incomplete"
+ok "aarch64 argil-board --help lists --rate-hz"
+step=a64-board-bad-port
 st=0
 timeout -s KILL 60 $QEMU_A64 "$a64/argil-board" --bus sim --link udp:127.0.0.1:0 >/dev/null 2>"$tmp/err" || st=$?
 [ "$st" = 2 ] || fail "aarch64 argil-board: bad port gave status $st"
+ok "port 0 refused with status 2"
 
 # The aarch64 daemon's real loop (SCHED_FIFO 80, mlockall, absolute clock_nanosleep, the UDP link
 # thread) under qemu-user, with the native host peer over real UDP: HELLO, window, arm, ACTIVE;
 # host loss; reconnection. Emulated ticks overrun now and then, so no overrun-streak fault here.
+step=a64-udp-session
 port=$((40000 + $$ % 20000))
 $QEMU_A64 "$a64/argil-board" --bus sim --link "udp:127.0.0.1:$port" --duration-s 60 \
     --stats-period-s 0 --overrun-streak 0 >"$tmp/a64d.out" 2>"$tmp/a64d.err" &
@@ -60,8 +81,11 @@ grep -q "^phase 1: ACTIVE after [0-9]* ms" "$tmp/a64c.out" || { cat "$tmp/a64d.e
 [ "$dst" = 0 ] || { cat "$tmp/a64d.err"; fail "aarch64 daemon exit $dst after SIGTERM"; }
 grep "exit: [0-9]* ticks" "$tmp/a64d.err" | cut -c1-160 | sed 's/^/aarch64 /'
 trap 'rm -rf "$tmp"' EXIT
+ok "$(grep "^phase 1: ACTIVE after" "$tmp/a64c.out" | head -n 1); host loss and reconnection"
 
+step=tick-ref
 "$cm/tick_ref" >"$tmp/ref.txt" || fail "host tick reference"
+ok "$(tail -n 1 "$tmp/ref.txt")"
 compare() {
     awk -v name="$1" '
         FNR == NR { ref[FNR] = $0; nref = FNR; next }
@@ -84,15 +108,18 @@ compare() {
 }
 for board in m4:mps2-an386 m7:mps2-an500; do
     cpu=${board%%:*}; machine=${board#*:}
+    step=cortex-$cpu-ticks
     start=$(date +%s.%N)
     timeout -s KILL 60 qemu-system-arm -M "$machine" -nographic -semihosting -kernel "$cm/argil-$cpu.elf" \
         >"$tmp/$cpu.txt" 2>"$tmp/$cpu.err" || { tail -n 5 "$tmp/$cpu.txt" "$tmp/$cpu.err"; fail "$cpu image on $machine"; }
     end=$(date +%s.%N)
-    compare "cortex-$cpu on $machine ($(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f s", b - a }'))" "$tmp/$cpu.txt" || fail "cortex-$cpu results"
+    compare "cortex-$cpu on $machine ($(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f s", b - a }'))" "$tmp/$cpu.txt" >"$tmp/cmp" ||
+        { cat "$tmp/cmp"; fail "cortex-$cpu results: $(head -n 1 "$tmp/cmp")"; }
+    ok "$(cat "$tmp/cmp")"
 done
-tail -n 1 "$tmp/ref.txt"
 
 # The MCU link refuses the heap and printf in the core.
+step=cortex-m-no-malloc
 printf '#include <stdlib.h>\nvoid *core_bad(void);\nvoid *core_bad(void) { return malloc(8); }\n' >"$tmp/bad.c"
 arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -c "$tmp/bad.c" -o "$tmp/bad.o"
 arm-none-eabi-ld -r -o "$tmp/core.o" "$tmp/bad.o" "$cm/m4/core.o"
@@ -104,4 +131,6 @@ if arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard 
     fail "the Cortex-M link accepted malloc in the core"
 fi
 grep -q argil_core_must_not_call_malloc "$tmp/link.err" || fail "no clear link error: $(cat "$tmp/link.err")"
-echo "cortex-m: a core that calls malloc does not link ($(grep -o "undefined reference to .argil_core_must_not_call_malloc." "$tmp/link.err" | head -1))"
+ok "a core that calls malloc does not link ($(grep -o "undefined reference to .argil_core_must_not_call_malloc." "$tmp/link.err" | head -1))"
+# A failed aarch64 test fails the script as well as its own check.
+[ -z "$bad" ] || exit 1
