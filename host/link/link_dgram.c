@@ -1,6 +1,8 @@
 /* UDP transport of the host link: a connected, non-blocking socket to the board; every frame
- * is one datagram each way. A board that restarts on the same address is simply heard again
- * (the link state machine turns that into a reconnection). */
+ * is one datagram each way. With a key every datagram is sealed (the board's session nonce,
+ * learned from each verified datagram of the board; 0 on a HELLO) and every datagram from the
+ * board verified (firmware/hal/link_auth.h). A board that restarts on the same address is
+ * simply heard again (the link state machine turns that into a reconnection). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <netdb.h>
@@ -11,18 +13,36 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "firmware/hal/link_auth.h"
 #include "firmware/hal/link_io.h"
 #include "host/link/link.h"
+
+_Static_assert(LINK_KEY_SIZE == LINK_KEY_BYTES, "one key size");
 
 typedef struct {
     int fd;
     uint8_t dgram[65536];      /* the datagram being handed out frame by frame */
     size_t len, at;
+    uint64_t nonce;            /* keyed: the board's session nonce, 0 until a datagram told it */
+    uint8_t sealed[LINK_AUTH_DGRAM_MAX];
 } dgram_t;
 
 static argil_err_t dgram_send(link_t *l, const uint8_t *frame, size_t len)
 {
     dgram_t *d = l->impl;
+    if (l->keyed) {
+        const bool hello = len > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO;
+        if (!hello && d->nonce == 0)
+            return ARGIL_ERR_STATE; /* no session yet: the board would refuse it (bad nonce) */
+        link_key_t k;
+        memcpy(k.k, l->key, sizeof(k.k));
+        len = link_auth_seal(&k, LINK_AUTH_HOST_TO_BOARD, hello ? 0u : d->nonce, frame, len,
+                             d->sealed, sizeof(d->sealed));
+        memset(&k, 0, sizeof(k));
+        if (len == 0)
+            return ARGIL_ERR_ARG;
+        frame = d->sealed;
+    }
     ssize_t w = send(d->fd, frame, len, MSG_DONTWAIT | MSG_NOSIGNAL);
     /* ECONNREFUSED reports an earlier datagram that found the board's port closed (it was
      * restarting); this one may well pass: try it once more. */
@@ -60,6 +80,22 @@ static size_t dgram_recv(link_t *l, uint8_t *buf, size_t cap)
             return 0;
         d->len = (size_t)n;
         d->at = 0;
+        if (l->keyed) {
+            link_key_t k;
+            memcpy(k.k, l->key, sizeof(k.k));
+            size_t flen = 0;
+            uint64_t nonce = 0;
+            const link_auth_err_t ae =
+                link_auth_open(&k, LINK_AUTH_BOARD_TO_HOST, d->dgram, d->len, &flen, &nonce);
+            memset(&k, 0, sizeof(k));
+            if (ae != LINK_AUTH_OK) {
+                l->stats.auth_refused++;
+                d->len = 0;
+                continue;
+            }
+            d->nonce = nonce; /* the board's: a new session's arrives with its first answer */
+            d->len = flen;
+        }
     }
 }
 
