@@ -88,6 +88,38 @@ uint64_t link_auth_new_nonce(void)
     return n;
 }
 
+void link_auth_host_init(link_auth_host_t *h, const link_key_t *key)
+{
+    memset(h, 0, sizeof(*h));
+    h->key = *key;
+}
+
+size_t link_auth_host_seal(link_auth_host_t *h, const uint8_t *frame, size_t len, uint8_t *out,
+                           size_t cap)
+{
+    const bool hello = len > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO;
+    if (!hello && h->nonce == 0) {
+        h->held++;
+        return 0;
+    }
+    return link_auth_seal(&h->key, LINK_AUTH_HOST_TO_BOARD, hello ? 0u : h->nonce, frame, len,
+                          out, cap);
+}
+
+link_auth_err_t link_auth_host_open(link_auth_host_t *h, const uint8_t *dgram, size_t len,
+                                    size_t *frame_len)
+{
+    uint64_t nonce = 0;
+    const link_auth_err_t e =
+        link_auth_open(&h->key, LINK_AUTH_BOARD_TO_HOST, dgram, len, frame_len, &nonce);
+    if (e != LINK_AUTH_OK) {
+        h->refused++;
+        return e;
+    }
+    h->nonce = nonce;
+    return LINK_AUTH_OK;
+}
+
 const char *link_auth_err_text(link_auth_err_t e)
 {
     switch (e) {

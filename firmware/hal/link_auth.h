@@ -54,6 +54,29 @@ bool link_auth_nonce_ok(uint64_t session_nonce, uint64_t nonce, const uint8_t *f
 /* A fresh random nonce, never 0 (libsodium's randombytes_buf). */
 uint64_t link_auth_new_nonce(void);
 
+/* A host's side of the envelope: its key and the board's session nonce as last heard (0 until a
+ * datagram from the board told it). The host's UDP link and the test hosts use it. */
+typedef struct {
+    link_key_t key;
+    uint64_t nonce;
+    uint32_t refused;            /* datagrams from the board whose tag did not verify */
+    uint32_t held;               /* frames not sealed: no nonce known yet, and not a HELLO */
+} link_auth_host_t;
+
+void link_auth_host_init(link_auth_host_t *h, const link_key_t *key);
+
+/* Seals a host frame into out: a HELLO with nonce 0 (it starts a session whose nonce the host
+ * cannot know), anything else with the board's nonce. 0 (counted in held) for a non-HELLO frame
+ * while no nonce is known: the board would refuse it; 0 too when it does not fit. */
+size_t link_auth_host_seal(link_auth_host_t *h, const uint8_t *frame, size_t len, uint8_t *out,
+                           size_t cap);
+
+/* Verifies a datagram from the board and learns its nonce (each session's arrives with the
+ * board's answer to the HELLO). On LINK_AUTH_OK the frame is dgram[0 … *frame_len); a refusal
+ * is counted in refused. */
+link_auth_err_t link_auth_host_open(link_auth_host_t *h, const uint8_t *dgram, size_t len,
+                                    size_t *frame_len);
+
 /* Verdict names for logs and tests ("bad tag"). */
 const char *link_auth_err_text(link_auth_err_t e);
 

@@ -23,24 +23,19 @@ typedef struct {
     int fd;
     uint8_t dgram[65536];      /* the datagram being handed out frame by frame */
     size_t len, at;
-    uint64_t nonce;            /* keyed: the board's session nonce, 0 until a datagram told it */
+    bool keyed;
+    link_auth_host_t auth;     /* keyed: the key and the board's session nonce */
     uint8_t sealed[LINK_AUTH_DGRAM_MAX];
 } dgram_t;
 
 static argil_err_t dgram_send(link_t *l, const uint8_t *frame, size_t len)
 {
     dgram_t *d = l->impl;
-    if (l->keyed) {
-        const bool hello = len > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO;
-        if (!hello && d->nonce == 0)
-            return ARGIL_ERR_STATE; /* no session yet: the board would refuse it (bad nonce) */
-        link_key_t k;
-        memcpy(k.k, l->key, sizeof(k.k));
-        len = link_auth_seal(&k, LINK_AUTH_HOST_TO_BOARD, hello ? 0u : d->nonce, frame, len,
-                             d->sealed, sizeof(d->sealed));
-        memset(&k, 0, sizeof(k));
+    if (d->keyed) {
+        /* none before the board told its session's nonce: it would refuse them (bad nonce) */
+        len = link_auth_host_seal(&d->auth, frame, len, d->sealed, sizeof(d->sealed));
         if (len == 0)
-            return ARGIL_ERR_ARG;
+            return ARGIL_ERR_STATE;
         frame = d->sealed;
     }
     ssize_t w = send(d->fd, frame, len, MSG_DONTWAIT | MSG_NOSIGNAL);
@@ -80,22 +75,14 @@ static size_t dgram_recv(link_t *l, uint8_t *buf, size_t cap)
             return 0;
         d->len = (size_t)n;
         d->at = 0;
-        if (l->keyed) {
-            link_key_t k;
-            memcpy(k.k, l->key, sizeof(k.k));
-            size_t flen = 0;
-            uint64_t nonce = 0;
-            const link_auth_err_t ae =
-                link_auth_open(&k, LINK_AUTH_BOARD_TO_HOST, d->dgram, d->len, &flen, &nonce);
-            memset(&k, 0, sizeof(k));
-            if (ae != LINK_AUTH_OK) {
-                l->stats.auth_refused++;
-                d->len = 0;
-                continue;
-            }
-            d->nonce = nonce; /* the board's: a new session's arrives with its first answer */
-            d->len = flen;
+        size_t flen = 0;
+        if (d->keyed && link_auth_host_open(&d->auth, d->dgram, d->len, &flen) != LINK_AUTH_OK) {
+            l->stats.auth_refused = d->auth.refused;
+            d->len = 0;
+            continue;
         }
+        if (d->keyed)
+            d->len = flen; /* one frame, the trailer off */
     }
 }
 
@@ -151,6 +138,13 @@ argil_err_t link_dgram_open(link_t *l, char *err, size_t err_len)
         return ARGIL_ERR_IO;
     }
     freeaddrinfo(ai);
+    if (l->keyed) {
+        link_key_t k;
+        memcpy(k.k, l->key, sizeof(k.k));
+        link_auth_host_init(&d->auth, &k);
+        memset(&k, 0, sizeof(k));
+        d->keyed = true;
+    }
     /* Room for a burst of telemetry and impulses while the link thread is descheduled. */
     const int rcvbuf = 1 << 20;
     (void)setsockopt(d->fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof(rcvbuf));
