@@ -85,6 +85,20 @@ echo "  (Table 1 carves fresh material every time: the with- and without-undo co
 echo "  (wall = elapsed, cpu = this thread's CPU time: on a shared machine the wall medians also hold other processes' turns;"
 echo "   the load average is printed first; instruction counts per row: docs/model.md, measured with callgrind)"
 
+echo "== UDP link envelope (tests/bench/bench_link_auth.c: libsodium keyed BLAKE2b-128, release build)"
+ba="$tmp/bench_link_auth"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_link_auth.c "$rel/libargil.a" -lsodium -lm -o "$ba"
+"$ba"
+if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/null 2>&1; then
+    for size in 33 80 1024; do
+        valgrind --tool=callgrind --toggle-collect=link_auth_seal --toggle-collect=link_auth_open \
+            --callgrind-out-file="$tmp/la.$size" "$ba" once "$size" >/dev/null 2>&1
+        ir=$(callgrind_annotate "$tmp/la.$size" 2>/dev/null | sed -n 's/^ *\([0-9,]*\) .*PROGRAM TOTALS.*/\1/p' | tr -d ,)
+        printf '  %4s-byte frame: %s instructions per seal + open (callgrind, inclusive, mean of 1000)\n' \
+            "$size" "$(awk -v a="$ir" 'BEGIN { printf "%d", a / 1000 }')"
+    done
+fi
+
 echo "== board tick by tick (tests/bench/bench_ticks.c: the default session, board_run_tick only)"
 # Instructions: callgrind collects only inside board_run_tick and dumps after every tick
 # (--combine-dumps: one part per tick in one file); -z now resolves every PLT entry at start-up,
