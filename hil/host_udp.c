@@ -696,17 +696,14 @@ int main(int argc, char **argv)
                         "EVENT_LOG]]] (port 1-65535, 1-3600 s)\n");
         return 2;
     }
-    const char *key_file = getenv("ARGIL_LINK_KEY");
-    if (key_file && key_file[0] != '\0') {
-        link_key_t key;
-        char err[400] = "libsodium cannot start";
-        if (!link_auth_init() || link_key_load(key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
-            fprintf(stderr, "hil-host: ARGIL_LINK_KEY: %s\n", err);
-            return 2;
-        }
-        link_auth_host_init(&g_auth, &key);
-        g_keyed = true;
+    link_key_t key;
+    char err[400];
+    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "hil-host: ARGIL_LINK_KEY: %s\n", err);
+        return 2;
     }
+    if (g_keyed)
+        link_auth_host_init(&g_auth, &key);
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
     if (fd < 0) {
         perror("hil-host: socket");

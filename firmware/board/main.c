@@ -531,29 +531,35 @@ static void print_stats(const char *when, const snapshot_t *s, const board_daemo
 /* One log line when datagrams with a bad tag, or ARM commands, start being refused after a
  * quiet second: a burst is logged once, not once per datagram. */
 typedef struct {
-    uint32_t bad_mac, arm_refused;       /* counts as of the last change */
-    uint64_t bad_mac_ns, arm_refused_ns; /* when they last changed */
+    uint32_t count;   /* as of the last change */
+    uint64_t at_ns;   /* when it last changed */
+} refusal_burst_t;
+
+typedef struct {
+    refusal_burst_t bad_mac, arm_refused;
 } refusal_bursts_t;
+
+/* True when count starts a new burst (it changed after a quiet second). */
+static bool burst_starts(refusal_burst_t *b, uint32_t count, uint64_t now)
+{
+    if (count == b->count)
+        return false;
+    const bool starts = now - b->at_ns >= 1000000000u;
+    b->count = count;
+    b->at_ns = now;
+    return starts;
+}
 
 static void log_refusal_bursts(const snapshot_t *s, refusal_bursts_t *b, uint64_t now)
 {
-    const uint64_t quiet_ns = 1000000000u;
-    if (s->link.bad_mac != b->bad_mac) {
-        if (now - b->bad_mac_ns >= quiet_ns)
-            fprintf(stderr, PROG ": refusing UDP datagrams whose tag does not verify (%u so far): "
-                    "a sender with another key or none; the host needs this board's key file "
-                    "(argil connect --key FILE)\n", s->link.bad_mac);
-        b->bad_mac = s->link.bad_mac;
-        b->bad_mac_ns = now;
-    }
-    if (s->link.arm_refused != b->arm_refused) {
-        if (now - b->arm_refused_ns >= quiet_ns)
-            fprintf(stderr, PROG ": ARM refused (%u so far): the board refuses to arm over UDP "
-                    "without a link key: start it with --key FILE (argil keygen FILE), or "
-                    "--insecure\n", s->link.arm_refused);
-        b->arm_refused = s->link.arm_refused;
-        b->arm_refused_ns = now;
-    }
+    if (burst_starts(&b->bad_mac, s->link.bad_mac, now))
+        fprintf(stderr, PROG ": refusing UDP datagrams whose tag does not verify (%u so far): a "
+                "sender with another key or none; the host needs this board's key file "
+                "(argil connect --key FILE)\n", s->link.bad_mac);
+    if (burst_starts(&b->arm_refused, s->link.arm_refused, now))
+        fprintf(stderr, PROG ": ARM refused (%u so far): the board refuses to arm over UDP "
+                "without a link key: start it with --key FILE (argil keygen FILE), or "
+                "--insecure\n", s->link.arm_refused);
 }
 
 int main(int argc, char **argv)

@@ -2,25 +2,16 @@
 #define _POSIX_C_SOURCE 200809L
 #include "link_key.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <stdlib.h>
 #include <sodium.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static int hex_value(char c)
-{
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F')
-        return c - 'A' + 10;
-    return -1;
-}
 
 static bool is_blank(char c)
 {
@@ -50,21 +41,18 @@ link_key_err_t link_key_parse(const char *text, size_t len, link_key_t *key, uin
         while (b > a && is_blank(text[b - 1u]))
             b--;
         if (a < b) {
-            size_t digits = 0;
-            for (size_t i = a; i < b && rc == LINK_KEY_OK; i++) {
-                const int v = hex_value(text[i]);
-                if (v < 0)
+            for (size_t i = a; i < b && rc == LINK_KEY_OK; i++)
+                if (!isxdigit((unsigned char)text[i]))
                     rc = LINK_KEY_ERR_HEX;
-                else if (digits >= 2u * LINK_KEY_BYTES)
-                    rc = LINK_KEY_ERR_LONG;
-                else if (digits++ % 2u == 0u)
-                    k[digits / 2u] = (uint8_t)(v << 4);
-                else
-                    k[(digits - 1u) / 2u] |= (uint8_t)v;
-            }
+            size_t got = 0;
             if (rc == LINK_KEY_OK && have)
                 rc = LINK_KEY_ERR_EXTRA;
-            else if (rc == LINK_KEY_OK && digits < 2u * LINK_KEY_BYTES)
+            else if (rc == LINK_KEY_OK && b - a > 2u * LINK_KEY_BYTES)
+                rc = LINK_KEY_ERR_LONG;
+            else if (rc == LINK_KEY_OK &&
+                     (b - a < 2u * LINK_KEY_BYTES ||
+                      sodium_hex2bin(k, sizeof(k), text + a, b - a, NULL, &got, NULL) != 0 ||
+                      got != LINK_KEY_BYTES))
                 rc = LINK_KEY_ERR_SHORT;
             have = true;
         }
@@ -143,6 +131,20 @@ link_key_err_t link_key_load(const char *path, link_key_t *key, char *err, size_
         snprintf(err, err_len, "key file '%s':%u: %s (a key file is one line of 64 hex digits; "
                  "make a new one with 'argil keygen FILE')", path, line, link_key_err_text(rc));
     return rc;
+}
+
+link_key_err_t link_key_load_env(const char *var, link_key_t *key, bool *found, char *err,
+                                 size_t err_len)
+{
+    const char *path = getenv(var);
+    *found = path != NULL && path[0] != '\0';
+    if (!*found)
+        return LINK_KEY_OK;
+    if (!link_auth_init()) {
+        snprintf(err, err_len, "%s: libsodium cannot start", var);
+        return LINK_KEY_ERR_OPEN;
+    }
+    return link_key_load(path, key, err, err_len);
 }
 
 link_key_err_t link_key_create(const char *path, char *err, size_t err_len)

@@ -5,6 +5,7 @@
 #ifndef ARGIL_LINK_KEY_H
 #define ARGIL_LINK_KEY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -34,6 +35,11 @@ link_key_err_t link_key_parse(const char *text, size_t len, link_key_t *key, uin
 /* Reads and parses path; refuses a file that is not regular, that group or others may read or
  * write, or that is too large. One line into err naming the file and the fix. */
 link_key_err_t link_key_load(const char *path, link_key_t *key, char *err, size_t err_len);
+
+/* As link_key_load, for the file named by the environment variable var (the test hosts'
+ * ARGIL_LINK_KEY); *found false and LINK_KEY_OK when var is unset or empty. Starts libsodium. */
+link_key_err_t link_key_load_env(const char *var, link_key_t *key, bool *found, char *err,
+                                 size_t err_len);
 
 /* Makes a new key file at path from 32 random bytes (libsodium): created with O_EXCL and mode
  * 0600, never over an existing file. One line into err on failure. */

@@ -169,17 +169,14 @@ int main(int argc, char **argv)
     const int link_ticks = argc == 3 ? atoi(argv[2]) : 1;
     if (link_ticks < 0 || link_ticks > 50)
         return 2;
-    const char *key_file = getenv("ARGIL_LINK_KEY");
-    if (key_file && key_file[0] != '\0') {
-        link_key_t key;
-        char err[400] = "libsodium cannot start";
-        if (!link_auth_init() || link_key_load(key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
-            fprintf(stderr, "board_udp_client: ARGIL_LINK_KEY: %s\n", err);
-            return 2;
-        }
-        link_auth_host_init(&g_auth, &key);
-        g_keyed = true;
+    link_key_t key;
+    char err[400];
+    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "board_udp_client: ARGIL_LINK_KEY: %s\n", err);
+        return 2;
     }
+    if (g_keyed)
+        link_auth_host_init(&g_auth, &key);
     static host_t h;
     host_open(&h, port);
     const int t1 = until_active(&h, 4000, false);

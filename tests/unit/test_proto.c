@@ -823,7 +823,9 @@ static void test_other_protocol_versions_are_refused(void **state)
                      PROTO_ERR_VERSION);
     assert_int_equal(decode_patched_u8(golden_hello, sizeof golden_hello, 4, 1),
                      PROTO_ERR_VERSION); /* v1: before host sessions */
-    assert_int_equal(decode_patched_u8(golden_hello, sizeof golden_hello, 4, 3),
+    assert_int_equal(decode_patched_u8(golden_hello, sizeof golden_hello, 4, 2),
+                     PROTO_ERR_VERSION); /* v2: before the authenticated link's counts */
+    assert_int_equal(decode_patched_u8(golden_hello, sizeof golden_hello, 4, 4),
                      PROTO_ERR_VERSION);
     assert_int_equal(decode_patched_u8(golden_hello, sizeof golden_hello, 4, 0xFF),
                      PROTO_ERR_VERSION);
@@ -1801,11 +1803,12 @@ static void test_rt_stats_fields_that_contradict_each_other_are_refused(void **s
     memcpy(f, g, n);
     put_u32(f + RT_AT(48), 2101u);
     put_u32(f + RT_AT(48 + 4 * 11), 0xFFFFFFFFu);
-    reseal(f, 168u);
+    reseal(f, 180u);
     assert_int_equal(decode_err(f, n), PROTO_ERR_VALUE);
-    /* the wrong payload length for the type */
-    assert_int_equal(decode_resized(g, n, 167u), PROTO_ERR_PAYLOAD);
-    assert_int_equal(decode_resized(g, n, 169u), PROTO_ERR_PAYLOAD);
+    /* the wrong payload length for the type (168: a v2 report) */
+    assert_int_equal(decode_resized(g, n, 168u), PROTO_ERR_PAYLOAD);
+    assert_int_equal(decode_resized(g, n, 179u), PROTO_ERR_PAYLOAD);
+    assert_int_equal(decode_resized(g, n, 181u), PROTO_ERR_PAYLOAD);
     /* the encoder refuses the same */
     proto_msg_t m = golden_msg(MSG_RT_STATS);
     m.u.rt_stats.compute_hist[0] = 1u;
@@ -1816,7 +1819,7 @@ static void test_rt_stats_fields_that_contradict_each_other_are_refused(void **s
     /* an empty record (no tick measured yet) is valid: all zeros but the period */
     memset(&m.u.rt_stats, 0, sizeof m.u.rt_stats);
     m.u.rt_stats.period_ns = 250000u;
-    assert_int_equal(round_trip(&m), 12u + 168u + 4u);
+    assert_int_equal(round_trip(&m), 12u + 180u + 4u);
 }
 
 static void test_decoded_chunk_assembles_the_same_without_repeated_checks(void **state)
