@@ -30,7 +30,9 @@ INC := -I.
 REL_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
 SAN_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 TEST_CFLAGS := $(CSTD) $(WARN) $(INC) -O1 -g $(SAN_FLAGS)
-LDLIBS := -lm
+# libsodium: the UDP link's keyed BLAKE2b tags and its key file (firmware/hal/link_auth.c,
+# link_key.c; docs/link.md "Link key"); never in firmware/core or shared/.
+LDLIBS := -lsodium -lm
 
 SHARED_SRC := $(wildcard shared/*.c)
 CORE_SRC := $(wildcard firmware/core/*.c)
@@ -39,16 +41,18 @@ SIM_SRC := $(wildcard sim/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 # The host's USB link cuts its byte stream with the board's own framer (host/link/link_usb.c).
 HOST_FRAMER_SRC := firmware/hal/link_framer.c
-LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(HOST_FRAMER_SRC) $(SIM_SRC) $(HOST_SRC)
+# The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
+LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
+LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(HOST_FRAMER_SRC) $(LINK_AUTH_SRC) $(SIM_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
 BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
                  firmware/hal/gpio_gpiod.c firmware/hal/link_framer.c firmware/hal/link_udp.c \
-                 firmware/hal/link_bind.c firmware/hal/link_ffs.c
+                 firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
-BOARD_LDLIBS := -lgpiod -lpthread -lm
+BOARD_LDLIBS := -lgpiod -lsodium -lpthread -lm
 # Sources a fuzz target may need beyond LIB_SRC (the board's config parser; no libgpiod).
 FUZZ_EXTRA_SRC := firmware/board/board_config.c firmware/hal/gpio_port.c
 

@@ -7,7 +7,9 @@
  * DRIVE_ENABLE high and every fault take it down. At the end it prints the time of its last
  * heartbeat ("T last-heartbeat") and falls silent, as a host that is unplugged.
  * Usage: hil-host PORT SECONDS [SCENARIO]. With HIL_FIFO_PRIO=N it runs SCHED_FIFO at N so a
- * busy rig does not starve it. Exit 0 when the board answered, 1 when it never did, 2 usage.
+ * busy rig does not starve it; with ARGIL_LINK_KEY=FILE every datagram is sealed with that link
+ * key and the board's verified (docs/link.md). Exit 0 when the board answered, 1 when it never
+ * did, 2 usage.
  *
  * With a SCENARIO (a hil/scenarios file) it is the scenario's host side instead: the host's
  * protocol peer (host/app/peer.c: tool, windows around the tool over a clay sphere, heartbeats,
@@ -43,6 +45,7 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
+#include "firmware/hal/link_key.h"
 #include "host/app/peer.h"
 #include "host/model/grid.h"
 #include "shared/crc32c.h"
@@ -65,12 +68,47 @@ static uint64_t mono_us(void)
     return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
 }
 
+/* ARGIL_LINK_KEY given: every datagram sealed, every one from the board verified (from any
+ * thread: the heartbeats' and the peer's). */
+static bool g_keyed;
+static link_auth_host_t g_auth;
+static pthread_mutex_t g_auth_mu = PTHREAD_MUTEX_INITIALIZER;
+
+static void udp_out(int fd, const struct sockaddr_in *to, const uint8_t *f, size_t len)
+{
+    uint8_t sealed[LINK_AUTH_DGRAM_MAX];
+    if (g_keyed) {
+        pthread_mutex_lock(&g_auth_mu);
+        len = link_auth_host_seal(&g_auth, f, len, sealed, sizeof(sealed));
+        pthread_mutex_unlock(&g_auth_mu);
+        f = sealed;
+    }
+    if (len > 0)
+        (void)sendto(fd, f, len, 0, (const struct sockaddr *)to, sizeof(*to));
+}
+
+/* The next datagram's frames from the board (keyed: verified, the trailer off); <= 0: none. */
+static ssize_t udp_in(int fd, uint8_t *buf, size_t cap)
+{
+    for (;;) {
+        const ssize_t n = recv(fd, buf, cap, 0);
+        if (n <= 0 || !g_keyed)
+            return n;
+        size_t flen = 0;
+        pthread_mutex_lock(&g_auth_mu);
+        const link_auth_err_t e = link_auth_host_open(&g_auth, buf, (size_t)n, &flen);
+        pthread_mutex_unlock(&g_auth_mu);
+        if (e == LINK_AUTH_OK)
+            return (ssize_t)flen;
+    }
+}
+
 static void send_msg(int fd, const struct sockaddr_in *to, proto_msg_t *m, uint32_t *seq)
 {
     uint8_t buf[PROTO_FRAME_MAX];
     size_t len = 0;
     if (proto_encode(m, (*seq)++, buf, sizeof(buf), &len) == PROTO_OK)
-        (void)sendto(fd, buf, len, 0, (const struct sockaddr *)to, sizeof(*to));
+        udp_out(fd, to, buf, len);
 }
 
 
@@ -128,7 +166,7 @@ typedef struct {
 
 static void raw_send(shost_t *h, const uint8_t *f, size_t len)
 {
-    (void)sendto(h->fd, f, len, 0, (const struct sockaddr *)&h->board, sizeof(h->board));
+    udp_out(h->fd, &h->board, f, len);
     h->frames_sent++;
 }
 
@@ -592,7 +630,7 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     uint32_t last_tm_print = 0, rearm_ms = 0;
     for (uint32_t ms = 0; mono_us() < t_end && !atomic_load(&h.done); ms++) {
         ssize_t n;
-        while ((n = recv(fd, buf, sizeof(buf), 0)) > 0)
+        while ((n = udp_in(fd, buf, sizeof(buf))) > 0)
             if (!h.lost)
                 peer_receive(&peer, buf, (size_t)n);
         /* What the board renders, every 250 of its ticks: enough to see a press that gives
@@ -685,6 +723,14 @@ int main(int argc, char **argv)
                         "EVENT_LOG]]] [--ready-file FILE] (port 1-65535, 1-3600 s)\n");
         return 2;
     }
+    link_key_t key;
+    char err[400];
+    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "hil-host: ARGIL_LINK_KEY: %s\n", err);
+        return 2;
+    }
+    if (g_keyed)
+        link_auth_host_init(&g_auth, &key);
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
     if (fd < 0) {
         perror("hil-host: socket");
@@ -732,7 +778,7 @@ int main(int argc, char **argv)
     const uint64_t t_end = mono_us() + (uint64_t)seconds * 1000000u;
     for (uint32_t ms = 0; mono_us() < t_end; ms++) {
         ssize_t n;
-        while ((n = recv(fd, buf, sizeof(buf), 0)) > 0) {
+        while ((n = udp_in(fd, buf, sizeof(buf))) > 0) {
             size_t used = 0;
             if (proto_decode(buf, (size_t)n, &rx, &used) != PROTO_OK || rx.type != MSG_TELEMETRY)
                 continue;

@@ -83,8 +83,9 @@ board_start() {
     STAMP_PID=$!
     chip="--gpio-chip $GPIO_CHIP"
     case " $* " in *" --bus sim "*) chip= ;; esac
+    key=; case " $* " in *" udp:"*) [ -n "${ARGIL_LINK_KEY:-}" ] && key="--key $ARGIL_LINK_KEY" ;; esac
     # shellcheck disable=SC2086
-    argil-board $chip $BOARD_EXTRA "$@" >"$OUT/board.fifo" 2>&1 &
+    argil-board $chip $BOARD_EXTRA $key "$@" >"$OUT/board.fifo" 2>&1 &
     BOARD_PID=$!
     board_wait "running at" 20 >/dev/null || return 1
 }

@@ -18,7 +18,7 @@
 #define WINDOW_SAMPLE_SIZE 4u
 #define TOOL_SIZE 72u
 #define FAULT_SIZE 15u
-#define RT_STATS_SIZE (48u + 8u * PROTO_RT_HIST_BINS + 24u)
+#define RT_STATS_SIZE (48u + 8u * PROTO_RT_HIST_BINS + 36u)
 
 _Static_assert(IMPULSE_HEAD_SIZE + IMPULSE_ENTRY_SIZE * PROTO_IMPULSE_MAX <= PROTO_PAYLOAD_MAX,
                "a full IMPULSE frame must fit in PROTO_FRAME_MAX");
@@ -404,6 +404,9 @@ static void put_payload(wire_writer_t *w, const proto_msg_t *msg)
         wire_put_u32(w, r->link.duplicate);
         wire_put_u32(w, r->link.stale);
         wire_put_u32(w, r->link.sessions);
+        wire_put_u32(w, r->link.bad_mac);
+        wire_put_u32(w, r->link.bad_nonce);
+        wire_put_u32(w, r->link.arm_refused);
         break;
     }
     default:
@@ -538,6 +541,9 @@ static proto_err_t get_fixed(wire_reader_t *r, size_t plen, proto_msg_t *msg)
         s->link.duplicate = wire_get_u32(r);
         s->link.stale = wire_get_u32(r);
         s->link.sessions = wire_get_u32(r);
+        s->link.bad_mac = wire_get_u32(r);
+        s->link.bad_nonce = wire_get_u32(r);
+        s->link.arm_refused = wire_get_u32(r);
         return PROTO_OK;
     }
     default:

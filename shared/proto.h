@@ -11,7 +11,7 @@
 #include "argil_limits.h"
 
 #define PROTO_MAGIC 0x4C475241u        /* bytes 'A' 'R' 'G' 'L' on the wire */
-#define PROTO_VERSION 2u
+#define PROTO_VERSION 3u
 #define PROTO_HEADER_SIZE 12u          /* magic u32, version u8, type u8, length u16, seq u32 */
 #define PROTO_CRC_SIZE 4u              /* CRC-32C of header + payload */
 #define PROTO_FRAME_MAX 1024u          /* no frame is larger: a WINDOW chunk fits in 1 KiB */
@@ -193,7 +193,8 @@ typedef struct {
 
 #define PROTO_RT_HIST_BINS 12u      /* histogram bins of RT_STATS (firmware/core/rt_stats.h) */
 
-/* The host frames the board refused since it started, by reason (RT_STATS, from version 2). */
+/* The host frames the board refused since it started, by reason (RT_STATS: the first six from
+ * version 2, the last three from version 3). */
 typedef struct {
     uint32_t decode_errors;  /* refused by the decoder: CRC, torn frame, garbage, a bad field */
     uint32_t wrong_source;   /* from an address other than the session host's (UDP) */
@@ -201,6 +202,10 @@ typedef struct {
     uint32_t duplicate;      /* a sequence number the session already accepted (replay) */
     uint32_t stale;          /* a sequence number older than the session's window */
     uint32_t sessions;       /* host sessions started (host HELLOs accepted) */
+    uint32_t bad_mac;        /* UDP datagrams whose tag did not verify (a wrong key, a forgery, no
+                              * tag to a keyed board, or a tag to a board without a key) */
+    uint32_t bad_nonce;      /* UDP datagrams with a valid tag but another session's nonce */
+    uint32_t arm_refused;    /* ARM commands refused: UDP without a key and without --insecure */
 } proto_link_counts_t;
 
 /* RT_STATS: board → host once a second (and when the board stops): the fast loop's deadline

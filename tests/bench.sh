@@ -48,7 +48,7 @@ fi
 
 echo "== haptic rendering (tests/bench/bench_haptics.c on the simulated arm)"
 hb="$tmp/bench_haptics"
-cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_haptics.c "$rel/libargil.a" -lm -o "$hb"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_haptics.c "$rel/libargil.a" -lsodium -lm -o "$hb"
 echo "  Z-width: a relaxed hand (100 N/m grip) drives 10 mm into a wall at 100 mm/s; stable ="
 echo "  still ACTIVE and < 0.05 mm peak-to-peak 0.5-1.0 s after the impact"
 "$hb" zwidth
@@ -67,7 +67,7 @@ if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/nu
 fi
 
 echo "== meshing and fitting (tests/bench/bench_mesh.c, one core; ends with 30,000-point scans with holes, edges, noise)"
-if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_mesh.c "$rel/libargil.a" -o "$tmp/bench_mesh" -lm; then
+if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_mesh.c "$rel/libargil.a" -o "$tmp/bench_mesh" -lsodium -lm; then
     "$tmp/bench_mesh"
 else
     echo "  bench_mesh did not build: skipped"
@@ -76,7 +76,7 @@ fi
 echo "  the same 256^3 sphere field in third-party meshers (Debian's python3-skimage, python3-openvdb):"
 /usr/bin/python3 tests/bench/compare_mc.py || echo "  comparison failed to run"
 echo "== host model (host/model): Hua & Qin Tables 1-2 and Ferley et al.'s table, 3 runs"
-cc -O2 -I. tests/bench/bench_model.c "$rel/libargil.a" -lm -o "$tmp/bench_model"
+cc -O2 -I. tests/bench/bench_model.c "$rel/libargil.a" -lsodium -lm -o "$tmp/bench_model"
 for i in 1 2 3; do "$tmp/bench_model" >"$tmp/model.$i"; done
 # each run already prints medians of 9-15 repetitions per row; all three runs are shown
 for i in 1 2 3; do echo "  -- run $i"; cat "$tmp/model.$i"; done
@@ -85,12 +85,26 @@ echo "  (Table 1 carves fresh material every time: the with- and without-undo co
 echo "  (wall = elapsed, cpu = this thread's CPU time: on a shared machine the wall medians also hold other processes' turns;"
 echo "   the load average is printed first; instruction counts per row: docs/model.md, measured with callgrind)"
 
+echo "== UDP link envelope (tests/bench/bench_link_auth.c: libsodium keyed BLAKE2b-128, release build)"
+ba="$tmp/bench_link_auth"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_link_auth.c "$rel/libargil.a" -lsodium -lm -o "$ba"
+"$ba"
+if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/null 2>&1; then
+    for size in 33 80 1024; do
+        valgrind --tool=callgrind --toggle-collect=link_auth_seal --toggle-collect=link_auth_open \
+            --callgrind-out-file="$tmp/la.$size" "$ba" once "$size" >/dev/null 2>&1
+        ir=$(callgrind_annotate "$tmp/la.$size" 2>/dev/null | sed -n 's/^ *\([0-9,]*\) .*PROGRAM TOTALS.*/\1/p' | tr -d ,)
+        printf '  %4s-byte frame: %s instructions per seal + open (callgrind, inclusive, mean of 1000)\n' \
+            "$size" "$(awk -v a="$ir" 'BEGIN { printf "%d", a / 1000 }')"
+    done
+fi
+
 echo "== board tick by tick (tests/bench/bench_ticks.c: the default session, board_run_tick only)"
 # Instructions: callgrind collects only inside board_run_tick and dumps after every tick
 # (--combine-dumps: one part per tick in one file); -z now resolves every PLT entry at start-up,
 # so no tick pays for the dynamic linker. Wall time: the same program natively, 3 runs.
 bt="$tmp/bench_ticks"
-cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_ticks.c "$rel/libargil.a" -lm -Wl,-z,now -o "$bt"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_ticks.c "$rel/libargil.a" -lsodium -lm -Wl,-z,now -o "$bt"
 # The third row: the same session with the B-spline solve and the clay's stiffness painted 4x
 # round the pushed pole, so the board's windows carry per-node stiffness (two channels).
 for row in 16 32 "16 --paint-stiffness 4"; do
@@ -154,7 +168,7 @@ awk -v sim="$sim_s" -v rec="$1" -v kib="$2" -v syncs="$3" -v ms="$(median <"$tmp
 }'
 
 echo "== live window (host/render, host/app/sculpt_window.c): frame time and change-to-screen latency"
-if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_render.c "$rel/libargil.a" -o "$tmp/bench_render" -lm; then
+if cc -std=c11 -D_DEFAULT_SOURCE -O2 -I. tests/bench/bench_render.c "$rel/libargil.a" -o "$tmp/bench_render" -lsodium -lm; then
     "$tmp/bench_render" 30 || echo "  bench_render failed"
 else
     echo "  bench_render did not build: skipped"

@@ -31,6 +31,12 @@ const board_setting_t board_settings[] = {
     {"link", "heartbeat_timeout_ms", "host-timeout-ms", "MS",
      "host heartbeat silence that stops sculpting and fades the force (50)"},
     {"link", "fade_ms", "host-fade-ms", "MS", "force fade to zero after the host is lost (20)"},
+    {"link", "key", "key", "FILE",
+     "UDP link key file (argil keygen FILE; mode 0600): every datagram carries its tag. With no "
+     "key the board refuses to arm over UDP (none)"},
+    {"link", "insecure", "insecure", NULL,
+     "UDP without a key may arm: anyone who reaches the port may command the arm; logged at "
+     "start and in every stats line (file: insecure = yes; default no)"},
     {"loop", "rate_hz", "rate-hz", "HZ", "loop rate: 1000, 2000 or 4000 (1000)"},
     {"loop", "rt_priority", "rt-priority", "PRIO",
      "SCHED_FIFO priority of the fast loop, 1-99; 0 = no real-time scheduling (80)"},
@@ -189,6 +195,22 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
         if (parse_long(v, 0, 1000, &x) != ARGIL_OK)
             return BAD("link.fade_ms '%s': expected 0-1000", v);
         c->host_fade_ms = (uint32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("link", "key")) {
+        if (v[0] == '\0' || strlen(v) >= BOARD_CFG_STR)
+            return BAD("link.key '%s': expected a key file's path of 1-%u characters", v,
+                       BOARD_CFG_STR - 1u);
+        copy_str(c->link_key, sizeof(c->link_key), v);
+        return ARGIL_OK;
+    }
+    if (IS("link", "insecure")) {
+        if (strcmp(v, "yes") == 0)
+            c->link_insecure = true;
+        else if (strcmp(v, "no") == 0)
+            c->link_insecure = false;
+        else
+            return BAD("link.insecure '%s': expected yes or no", v);
         return ARGIL_OK;
     }
     if (IS("loop", "rate_hz")) {
@@ -352,6 +374,16 @@ argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size
 
 argil_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len)
 {
+    if (c->link_key[0] != '\0' && c->link_insecure) {
+        snprintf(why, why_len, "link.key and link.insecure together: a keyed link is never "
+                 "insecure; drop one");
+        return ARGIL_ERR_ARG;
+    }
+    if (c->link == BOARD_LINK_FFS && (c->link_key[0] != '\0' || c->link_insecure)) {
+        snprintf(why, why_len, "link.%s is for the UDP link: USB (FunctionFS) is a cable to one "
+                 "host and needs no key", c->link_key[0] != '\0' ? "key" : "insecure");
+        return ARGIL_ERR_ARG;
+    }
     if (c->host_fade_ms > c->host_timeout_ms * 10u) {
         snprintf(why, why_len, "link.fade_ms (%u) must not exceed ten host timeouts (%u ms)",
                  c->host_fade_ms, c->host_timeout_ms * 10u);

@@ -24,6 +24,8 @@ typedef struct {
     gpio_names_t gpio;
     board_link_t link;
     char link_target[BOARD_CFG_STR]; /* "ADDR:PORT" or the FunctionFS mount directory */
+    char link_key[BOARD_CFG_STR];    /* UDP link key file; "" = none (docs/link.md "Link key") */
+    bool link_insecure;              /* UDP without a key may arm (explicit, logged) */
     uint32_t host_timeout_ms;
     uint32_t host_fade_ms;
     uint32_t rate_hz;                /* 1000, 2000 or 4000 (100 … 10000 accepted) */
@@ -43,7 +45,8 @@ typedef struct {
     const char *section;
     const char *key;
     const char *flag;                /* long option without "--" */
-    const char *arg;                 /* argument name for --help */
+    const char *arg;                 /* argument name for --help; NULL: a flag (--NAME alone is
+                                      * "yes"; in the file: yes or no) */
     const char *help;
 } board_setting_t;
 

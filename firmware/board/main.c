@@ -21,9 +21,10 @@
 #include "firmware/core/rt_stats.h"
 #include "firmware/hal/hal_linux.h"
 #include "firmware/hal/link_io.h"
+#include "firmware/hal/link_key.h"
 
 #define PROG "argil-board"
-#define VERSION "argil-board 1 (protocol v1)"
+#define VERSION "argil-board 1 (protocol v3)"
 #define PREFAULT_STACK_BYTES (256u * 1024u)
 
 /* ---- command line ---- */
@@ -47,7 +48,7 @@ static void usage(FILE *out)
             section = s->section;
         }
         char left[64];
-        snprintf(left, sizeof(left), "--%s %s", s->flag, s->arg);
+        snprintf(left, sizeof(left), "--%s%s%s", s->flag, s->arg ? " " : "", s->arg ? s->arg : "");
         fprintf(out, "  %-24s %s\n  %-24s   (file: %s = ...)\n", left, s->help, "", s->key);
     }
     fprintf(out, "\nExit status: 0 after a clean stop (SIGINT/SIGTERM or --duration-s), 2 for a\n"
@@ -160,7 +161,9 @@ static int parse_args(board_daemon_cfg_t *c, int argc, char **argv)
         const board_setting_t *s = setting_by_flag(name, n);
         if (s == NULL)
             return fail(2, "unknown option '%s' (see --help)%s", a, "");
-        if (!value) {
+        if (!value && s->arg == NULL) {
+            value = "yes"; /* a flag */
+        } else if (!value) {
             if (i + 1 >= argc)
                 return fail(2, "option '%s' needs a value (%s)", a, s->arg);
             value = argv[++i];
@@ -362,8 +365,10 @@ static void *udp_thread(void *arg)
         const uint64_t now_us = now_ns() / 1000u;
         while ((n = link_udp_receive(&d->udp, rx, sizeof(rx), now_us)) > 0)
             (void)spsc_push(&d->hal->link_rx, rx, n);
-        hal_linux_link_refusals_set(d->hal, d->udp.bind.refused_source,
-                                    d->udp.bind.refused_no_session);
+        const hal_link_refusals_t refused = {d->udp.bind.refused_source,
+                                             d->udp.bind.refused_no_session, d->udp.bad_mac,
+                                             d->udp.bad_nonce};
+        hal_linux_link_refusals_set(d->hal, &refused);
         /* Frames first, then the session: those of the tick that ended it still go out. */
         drain_tx(d, tx, sizeof(tx));
         hal_session_state_t state;
@@ -470,8 +475,24 @@ static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg, int prio, 
     return 0;
 }
 
-static void print_stats(const char *when, const snapshot_t *s, uint32_t rate_hz)
+/* What the UDP link checks, for the start line and every stats line; NULL when nothing to say. */
+static const char *link_auth_note(const board_daemon_cfg_t *c)
 {
+    if (c->link != BOARD_LINK_UDP || c->link_key[0] != '\0')
+        return NULL;
+    return c->link_insecure
+               ? "INSECURE: the UDP link has no key and may arm (--insecure): anyone who can "
+                 "reach its port may command the arm"
+               : "the UDP link has no key: ARM over it is refused (start with --key FILE, made "
+                 "by 'argil keygen FILE'; or --insecure)";
+}
+
+static void print_stats(const char *when, const snapshot_t *s, const board_daemon_cfg_t *cfg)
+{
+    const uint32_t rate_hz = cfg->rate_hz;
+    const char *note = link_auth_note(cfg);
+    if (note)
+        fprintf(stderr, PROG ": %s: %s\n", when, note);
     const rt_series_t *w = &s->stats.wake, *c = &s->stats.compute;
     fprintf(stderr,
             PROG ": %s: %u ticks at %u Hz, state %s (last fault: %s); wake latency min/mean/max "
@@ -491,9 +512,11 @@ static void print_stats(const char *when, const snapshot_t *s, uint32_t rate_hz)
     fprintf(stderr, "; window %s, tool %s\n", s->window ? "yes" : "no", s->tool ? "yes" : "no");
     fprintf(stderr,
             PROG ": %s: host sessions %u; host frames refused: wrong source %u, no session %u, "
-            "duplicate %u, stale %u, decode errors %u\n",
+            "duplicate %u, stale %u, decode errors %u, bad tag %u, bad nonce %u; ARM refused "
+            "%u\n",
             when, s->link.sessions, s->link.wrong_source, s->link.no_session, s->link.duplicate,
-            s->link.stale, s->link.decode_errors);
+            s->link.stale, s->link.decode_errors, s->link.bad_mac, s->link.bad_nonce,
+            s->link.arm_refused);
     fprintf(stderr, PROG ": %s: wake latency histogram (us):", when);
     for (uint32_t i = 0; i < RT_HIST_BINS; i++) {
         const uint32_t e = rt_hist_edge_us(i);
@@ -503,6 +526,40 @@ static void print_stats(const char *when, const snapshot_t *s, uint32_t rate_hz)
             fprintf(stderr, " >=%u:%u", rt_hist_edge_us(i - 1u), w->hist[i]);
     }
     fputc('\n', stderr);
+}
+
+/* One log line when datagrams with a bad tag, or ARM commands, start being refused after a
+ * quiet second: a burst is logged once, not once per datagram. */
+typedef struct {
+    uint32_t count;   /* as of the last change */
+    uint64_t at_ns;   /* when it last changed */
+} refusal_burst_t;
+
+typedef struct {
+    refusal_burst_t bad_mac, arm_refused;
+} refusal_bursts_t;
+
+/* True when count starts a new burst (it changed after a quiet second). */
+static bool burst_starts(refusal_burst_t *b, uint32_t count, uint64_t now)
+{
+    if (count == b->count)
+        return false;
+    const bool starts = now - b->at_ns >= 1000000000u;
+    b->count = count;
+    b->at_ns = now;
+    return starts;
+}
+
+static void log_refusal_bursts(const snapshot_t *s, refusal_bursts_t *b, uint64_t now)
+{
+    if (burst_starts(&b->bad_mac, s->link.bad_mac, now))
+        fprintf(stderr, PROG ": refusing UDP datagrams whose tag does not verify (%u so far): a "
+                "sender with another key or none; the host needs this board's key file "
+                "(argil connect --key FILE)\n", s->link.bad_mac);
+    if (burst_starts(&b->arm_refused, s->link.arm_refused, now))
+        fprintf(stderr, PROG ": ARM refused (%u so far): the board refuses to arm over UDP "
+                "without a link key: start it with --key FILE (argil keygen FILE), or "
+                "--insecure\n", s->link.arm_refused);
 }
 
 int main(int argc, char **argv)
@@ -522,6 +579,13 @@ int main(int argc, char **argv)
     sigaddset(&sigs, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &sigs, NULL);
 
+    if (!link_auth_init())
+        return fail(3, "libsodium cannot start (no random source?)%s%s", "", "");
+    link_key_t key;
+    if (c->link == BOARD_LINK_UDP && c->link_key[0] != '\0' &&
+        link_key_load(c->link_key, &key, why, sizeof(why)) != LINK_KEY_OK)
+        return fail(2, "%s%s", why, "");
+
     d.hal = calloc(1, sizeof(*d.hal));
     d.board = calloc(1, sizeof(*d.board));
     if (!d.hal || !d.board)
@@ -538,12 +602,16 @@ int main(int argc, char **argv)
         hal_linux_close(d.hal);
         return fail(rc == ARGIL_ERR_ARG ? 2 : 3, "%s%s", why, "");
     }
+    if (c->link == BOARD_LINK_UDP && c->link_key[0] != '\0')
+        link_udp_set_key(&d.udp, &key);
+    memset(&key, 0, sizeof(key));
 
     board_cfg_t bc;
     board_cfg_default(&bc);
     bc.tick_us = tick_us;
     bc.max_force_n = c->max_force_n;
     bc.max_velocity_m_s = c->max_velocity_m_s;
+    bc.refuse_arm = c->link == BOARD_LINK_UDP && c->link_key[0] == '\0' && !c->link_insecure;
     bc.safety.host_timeout_us = c->host_timeout_ms * 1000u;
     bc.safety.host_fade_us = c->host_fade_ms * 1000u;
     bc.safety.overrun_streak = c->overrun_streak;
@@ -583,6 +651,11 @@ int main(int argc, char **argv)
     fprintf(stderr, PROG ": running at %u Hz, bus %s, link %s:%s, rt priority %d, cpu %d\n",
             c->rate_hz, c->bus == BOARD_BUS_SIM ? "sim" : c->can_if,
             c->link == BOARD_LINK_UDP ? "udp" : "ffs", c->link_target, c->rt_priority, c->cpu);
+    if (c->link == BOARD_LINK_UDP && c->link_key[0] != '\0')
+        fprintf(stderr, PROG ": UDP link key %s: every datagram carries a BLAKE2b tag\n",
+                c->link_key);
+    else if (link_auth_note(c))
+        fprintf(stderr, PROG ": %s\n", link_auth_note(c));
 
     /* Main thread: signals, state changes and periodic statistics; never touches the loop. */
     uint32_t last_state = 0xFFFFFFFFu;
@@ -590,6 +663,8 @@ int main(int argc, char **argv)
     const struct timespec wait = {0, 20000000};
     snapshot_t s;
     memset(&s, 0, sizeof(s));
+    refusal_bursts_t bursts;
+    memset(&bursts, 0, sizeof(bursts));
     while (!atomic_load(&d.stop)) {
         const int sig = sigtimedwait(&sigs, NULL, &wait);
         if (sig == SIGINT || sig == SIGTERM) {
@@ -604,8 +679,9 @@ int main(int argc, char **argv)
                         ? safety_fault_name((fault_code_t)s.fault) : "");
             last_state = s.state;
         }
+        log_refusal_bursts(&s, &bursts, now_ns());
         if (c->stats_period_s > 0 && now_ns() >= next_stats) {
-            print_stats("stats", &s, c->rate_hz);
+            print_stats("stats", &s, c);
             next_stats += (uint64_t)c->stats_period_s * 1000000000u;
         }
     }
@@ -613,7 +689,7 @@ int main(int argc, char **argv)
     if (c->link == BOARD_LINK_UDP)
         pthread_join(link_t, NULL); /* the FFS threads may sit in a bulk read: exit leaves them */
     read_snapshot(&d, &s);
-    print_stats("exit", &s, c->rate_hz);
+    print_stats("exit", &s, c);
     const int status = atomic_load(&d.loop_status);
     if (status != 0)
         fprintf(stderr, PROG ": %s\n", d.loop_err);

@@ -113,6 +113,9 @@ void board_link_counts(const board_t *b, proto_link_counts_t *c)
     c->duplicate = b->stats.refused_duplicate;
     c->stale = b->stats.refused_stale;
     c->sessions = b->session.epoch;
+    c->bad_mac = b->stats.transport_refused_bad_mac;
+    c->bad_nonce = b->stats.transport_refused_bad_nonce;
+    c->arm_refused = b->stats.refused_arm;
 }
 
 vec3_t board_device_to_model(const board_t *b, vec3_t device_m)
@@ -173,7 +176,9 @@ static void handle_frame(board_t *b, const proto_msg_t *m, host_events_t *ev)
         ev->heartbeat = true;
         b->host_window_version = m->u.heartbeat.window_version;
         b->host_impulse_ack = m->u.heartbeat.impulse_seq;
-        if (m->u.heartbeat.command == PROTO_CMD_ARM) {
+        if (m->u.heartbeat.command == PROTO_CMD_ARM && b->cfg.refuse_arm) {
+            b->stats.refused_arm++; /* the person's host is not known to have sent it */
+        } else if (m->u.heartbeat.command == PROTO_CMD_ARM) {
             ev->arm = true;
         } else if (m->u.heartbeat.command == PROTO_CMD_DISARM) {
             ev->disarm = true;
@@ -469,6 +474,8 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
         drives_receive(&b->drives, in->can_rx);
     b->stats.transport_refused_source = in->link_refused_source;
     b->stats.transport_refused_no_session = in->link_refused_no_session;
+    b->stats.transport_refused_bad_mac = in->link_refused_bad_mac;
+    b->stats.transport_refused_bad_nonce = in->link_refused_bad_nonce;
     receive_link(b, in, &ev,
                  b->impulse_pending && (b->since_impulse_us + dt_us >= b->cfg.impulse_period_us ||
                                         window_pending(&b->window)));

@@ -52,6 +52,8 @@ typedef struct {
     float accel_limit;                 /* density-spring |acceleration| (1/s²) that halves the step */
     float velocity_filter;             /* 0…1: weight of the newest velocity sample */
     float max_velocity_m_s;            /* tool speed (device space) that is a fault; 0 = none */
+    bool refuse_arm;                   /* the link cannot tell who sent a frame (UDP without a
+                                        * key): ARM commands are refused and counted */
     safety_cfg_t safety;
     drives_cfg_t drives;
     arm_desc_t arm;
@@ -68,7 +70,9 @@ typedef struct {
                                         * sleep on a clock, as in the lockstep simulation) */
     uint32_t link_refused_source;      /* the transport's own refusals so far: datagrams from an
                                         * address other than the session host's (UDP), */
-    uint32_t link_refused_no_session;  /* … and datagrams with no session to belong to */
+    uint32_t link_refused_no_session;  /* … datagrams with no session to belong to, */
+    uint32_t link_refused_bad_mac;     /* … datagrams whose tag did not verify (keyed UDP), */
+    uint32_t link_refused_bad_nonce;   /* … and those with another session's nonce */
 } board_in_t;
 
 typedef struct {
@@ -89,6 +93,9 @@ typedef struct {
     uint32_t refused_stale;            /* … older than the session's window */
     uint32_t transport_refused_source; /* board_in_t's counts, as of the last tick */
     uint32_t transport_refused_no_session;
+    uint32_t transport_refused_bad_mac;
+    uint32_t transport_refused_bad_nonce;
+    uint32_t refused_arm;              /* ARM commands refused (cfg.refuse_arm) */
     uint32_t link_tx_dropped;          /* frames that did not fit in a tick's output */
     uint32_t windows_swapped;
     uint32_t window_frames_deferred;   /* decoded a tick late: they came with an impulse flush */

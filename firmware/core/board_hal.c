@@ -28,7 +28,12 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     in.link_rx_len = hal_link_receive(hal, io->link_rx, sizeof(io->link_rx));
     in.prev_compute_ns = io->prev_compute_ns;
     in.prev_wake_ns = io->prev_wake_ns;
-    hal_link_refusals(hal, &in.link_refused_source, &in.link_refused_no_session);
+    hal_link_refusals_t refused;
+    hal_link_refusals(hal, &refused);
+    in.link_refused_source = refused.wrong_source;
+    in.link_refused_no_session = refused.no_session;
+    in.link_refused_bad_mac = refused.bad_mac;
+    in.link_refused_bad_nonce = refused.bad_nonce;
     board_tick(b, &in, &io->out);
     if (hal_can_send(hal, &io->out.can_tx) != ARGIL_OK)
         io->can_tx_errors++;

@@ -32,9 +32,15 @@ typedef enum {
 } hal_session_state_t;
 /* Tells the transport the core's host session; epoch counts the sessions started. */
 void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch);
-/* The transport's own refusals so far (datagrams it kept from the core): from another sender
- * than the session's host, and with no session to belong to. 0 when it has one host (USB). */
-void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session);
+/* The transport's own refusals so far (datagrams it kept from the core), by reason. All 0 when
+ * it has one host (USB); bad_mac and bad_nonce only on an authenticated link (keyed UDP). */
+typedef struct {
+    uint32_t wrong_source;  /* from another sender than the session's host */
+    uint32_t no_session;    /* with no session to belong to */
+    uint32_t bad_mac;       /* whose tag did not verify */
+    uint32_t bad_nonce;     /* with a valid tag but another session's nonce */
+} hal_link_refusals_t;
+void hal_link_refusals(hal_t *h, hal_link_refusals_t *r);
 /* A monotonic nanosecond clock for measuring the tick's compute time. */
 uint64_t hal_compute_clock_ns(hal_t *h);
 

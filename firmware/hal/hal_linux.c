@@ -225,10 +225,12 @@ void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch)
     atomic_store_explicit(&h->link_session, (uint32_t)state | epoch << 2, memory_order_release);
 }
 
-void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session)
+void hal_link_refusals(hal_t *h, hal_link_refusals_t *r)
 {
-    *wrong_source = atomic_load_explicit(&h->link_refused_source, memory_order_relaxed);
-    *no_session = atomic_load_explicit(&h->link_refused_no_session, memory_order_relaxed);
+    r->wrong_source = atomic_load_explicit(&h->link_refused_source, memory_order_relaxed);
+    r->no_session = atomic_load_explicit(&h->link_refused_no_session, memory_order_relaxed);
+    r->bad_mac = atomic_load_explicit(&h->link_refused_bad_mac, memory_order_relaxed);
+    r->bad_nonce = atomic_load_explicit(&h->link_refused_bad_nonce, memory_order_relaxed);
 }
 
 void hal_linux_link_session_get(hal_t *h, hal_session_state_t *state, uint32_t *epoch)
@@ -238,10 +240,12 @@ void hal_linux_link_session_get(hal_t *h, hal_session_state_t *state, uint32_t *
     *epoch = w >> 2;
 }
 
-void hal_linux_link_refusals_set(hal_t *h, uint32_t wrong_source, uint32_t no_session)
+void hal_linux_link_refusals_set(hal_t *h, const hal_link_refusals_t *r)
 {
-    atomic_store_explicit(&h->link_refused_source, wrong_source, memory_order_relaxed);
-    atomic_store_explicit(&h->link_refused_no_session, no_session, memory_order_relaxed);
+    atomic_store_explicit(&h->link_refused_source, r->wrong_source, memory_order_relaxed);
+    atomic_store_explicit(&h->link_refused_no_session, r->no_session, memory_order_relaxed);
+    atomic_store_explicit(&h->link_refused_bad_mac, r->bad_mac, memory_order_relaxed);
+    atomic_store_explicit(&h->link_refused_bad_nonce, r->bad_nonce, memory_order_relaxed);
 }
 
 uint64_t hal_compute_clock_ns(hal_t *h)

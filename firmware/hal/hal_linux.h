@@ -37,6 +37,8 @@ struct hal {
     _Atomic uint32_t link_session; /* the core's host session: state | epoch << 2 (fast loop) */
     _Atomic uint32_t link_refused_source;     /* the link thread's refusals (link thread) */
     _Atomic uint32_t link_refused_no_session;
+    _Atomic uint32_t link_refused_bad_mac;
+    _Atomic uint32_t link_refused_bad_nonce;
     uint8_t link_rx_mem[HAL_LINUX_RX_RING_BYTES];
     uint8_t link_tx_mem[HAL_LINUX_TX_RING_BYTES];
     uint32_t link_rx_too_big;      /* records larger than the tick's buffer (dropped) */
@@ -56,7 +58,7 @@ void hal_linux_close(hal_t *h);
 /* The link thread's side of the session hand-over: the core's session as last told, and the
  * transport's refusal counts for the core. */
 void hal_linux_link_session_get(hal_t *h, hal_session_state_t *state, uint32_t *epoch);
-void hal_linux_link_refusals_set(hal_t *h, uint32_t wrong_source, uint32_t no_session);
+void hal_linux_link_refusals_set(hal_t *h, const hal_link_refusals_t *r);
 
 /* Sends the frames in tx straight away (shutdown: quick stop / NMT stop). */
 argil_err_t hal_linux_can_flush(hal_t *h, const can_batch_t *tx);

@@ -134,10 +134,12 @@ void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch)
     link_bind_session(&h->bind, state, epoch, h->link_now_us);
 }
 
-void hal_link_refusals(hal_t *h, uint32_t *wrong_source, uint32_t *no_session)
+void hal_link_refusals(hal_t *h, hal_link_refusals_t *r)
 {
-    *wrong_source = h->bind.refused_source;
-    *no_session = h->bind.refused_no_session;
+    r->wrong_source = h->bind.refused_source;
+    r->no_session = h->bind.refused_no_session;
+    r->bad_mac = 0; /* the simulated link has no envelope */
+    r->bad_nonce = 0;
 }
 
 argil_err_t hal_sim_host_send(hal_t *h, const uint8_t *frame, size_t len)

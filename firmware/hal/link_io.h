@@ -1,6 +1,6 @@
 /* The host link's transports for the board daemon's link thread: UDP (one frame per datagram;
- * only the host whose HELLO started the core's session gets through, and gets the replies:
- * link_bind.h) and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
+ * with a key each sealed and verified here, link_auth.h; only the host whose HELLO started the
+ * core's session gets through, and gets the replies: link_bind.h) and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
  * the same frames back to back). A framer cuts a byte stream into whole protocol frames.
  * Linux only (hosted); nothing here runs in the fast loop. */
 #ifndef ARGIL_LINK_IO_H
@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "link_auth.h"
 #include "link_bind.h"
 #include "shared/argil_err.h"
 #include "shared/proto.h"
@@ -49,6 +50,13 @@ typedef struct {
     uint32_t tx_datagrams;
     uint32_t tx_errors;
     uint32_t tx_unbound;         /* frames dropped: no host bound */
+    bool keyed;                  /* every datagram sealed and verified with key (link_auth.h) */
+    link_key_t key;
+    uint64_t nonce;              /* the bound session's nonce, drawn at each new session */
+    uint32_t nonces;             /* nonces drawn */
+    uint32_t bad_mac;            /* datagrams whose tag did not verify (keyed), or that carried
+                                  * a trailer to this keyless link */
+    uint32_t bad_nonce;          /* tag right, nonce not the session's (nor 0 on a HELLO) */
 } link_udp_t;
 
 /* The sender key of an IPv4 address and port (link_bind.h). */
@@ -60,16 +68,23 @@ argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
 /* Binds a non-blocking UDP socket to spec ("ADDR:PORT"); one line into err on failure. */
 argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len);
 
+/* From now on every datagram is sealed with key, and one whose tag or nonce is wrong is
+ * dropped and counted (docs/protocol.md "Authenticated UDP"). Call before the first receive. */
+void link_udp_set_key(link_udp_t *u, const link_key_t *key);
+
 /* Takes the core's host session (hal_link_session, read on the link thread). */
 void link_udp_session(link_udp_t *u, hal_session_state_t state, uint32_t epoch, uint64_t now_us);
 
-/* Receives datagrams until one may reach the core; returns its length, 0 when none waits. A
- * datagram that does not start with a frame header, or that the session's binding refuses
- * (another sender while the host's session lives; anything but a host HELLO with no host), is
- * dropped and counted. */
+/* Receives datagrams until one may reach the core; returns the length of its frames (a keyed
+ * link's trailer taken off), 0 when none waits. A datagram that does not start with a frame
+ * header, whose tag or nonce is wrong (keyed), that carries a trailer to a keyless link, or
+ * that the session's binding refuses (another sender while the host's session lives; anything
+ * but a host HELLO with no host), is dropped and counted. A new session's binding draws a new
+ * nonce, as does a HELLO that restarts a lapsed session. */
 size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap, uint64_t now_us);
 
-/* Sends each whole frame of buf[0..len) as its own datagram to the session's host.
+/* Sends each whole frame of buf[0..len) as its own datagram to the session's host (keyed:
+ * sealed with the session's nonce).
  * ARGIL_ERR_STATE when no host is bound (counted), ARGIL_ERR_IO on a send failure. */
 argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len);
 

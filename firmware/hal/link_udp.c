@@ -1,5 +1,6 @@
-/* UDP transport of the host link: one frame per datagram, never blocking; only the session's
- * host gets through (link_bind.h). */
+/* UDP transport of the host link: one frame per datagram, never blocking; with a key every
+ * datagram sealed and verified here, in the link thread (link_auth.h); only the session's host
+ * gets through (link_bind.h). */
 #include <arpa/inet.h>
 #include <errno.h>
 #include <stdio.h>
@@ -58,6 +59,12 @@ argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err
     return ARGIL_OK;
 }
 
+void link_udp_set_key(link_udp_t *u, const link_key_t *key)
+{
+    u->keyed = true;
+    u->key = *key;
+}
+
 uint64_t link_udp_key(const struct sockaddr_in *a)
 {
     return (uint64_t)ntohl(a->sin_addr.s_addr) << 16 | ntohs(a->sin_port);
@@ -78,20 +85,46 @@ size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap, uint64_t now_us
             recvfrom(u->fd, buf, cap, MSG_DONTWAIT, (struct sockaddr *)&from, &flen);
         if (n <= 0)
             return 0;
-        if (link_frame_size(buf, (size_t)n) == 0) {
+        const size_t first = link_frame_size(buf, (size_t)n);
+        if (first == 0) {
             u->rx_refused++;
+            continue;
+        }
+        size_t len = (size_t)n;
+        uint64_t nonce = 0;
+        if (u->keyed) {
+            if (link_auth_open(&u->key, LINK_AUTH_HOST_TO_BOARD, buf, (size_t)n, &len, &nonce) !=
+                LINK_AUTH_OK) {
+                u->bad_mac++;
+                continue;
+            }
+            if (!link_auth_nonce_ok(u->bind.bound ? u->nonce : 0u, nonce, buf, len)) {
+                u->bad_nonce++;
+                continue;
+            }
+        } else if ((size_t)n == first + LINK_AUTH_TRAILER_BYTES) {
+            u->bad_mac++; /* a keyed host's datagram: this board has no key to check it */
             continue;
         }
         const uint64_t key = link_udp_key(&from);
         const uint32_t binds = u->bind.binds;
-        if (!link_bind_admit(&u->bind, key, buf, (size_t)n, now_us))
+        const bool lapsed = u->bind.bound && !u->bind.pending &&
+                            u->bind.state == HAL_SESSION_LAPSED;
+        if (!link_bind_admit(&u->bind, key, buf, len, now_us))
             continue; /* counted by the binding */
         if (u->bind.binds != binds) {
             u->peer = from;
             u->peer_changes++;
         }
+        /* A new session gets a new nonce, so no frame of an earlier one is accepted in it: at a
+         * new binding, and at a HELLO that restarts the bound host's lapsed session (the core
+         * restarts its sequence window there). */
+        if (u->keyed && (u->bind.binds != binds || (lapsed && nonce == 0u))) {
+            u->nonce = link_auth_new_nonce();
+            u->nonces++;
+        }
         u->rx_datagrams++;
-        return (size_t)n;
+        return len;
     }
     return 0;
 }
@@ -108,9 +141,18 @@ argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len)
         size_t size = link_frame_size(buf + at, len - at);
         if (size == 0 || size > len - at)
             size = len - at; /* not a frame boundary: send the rest as it is */
-        const ssize_t w = sendto(u->fd, buf + at, size, MSG_DONTWAIT,
-                                 (const struct sockaddr *)&u->peer, sizeof(u->peer));
-        if (w != (ssize_t)size) {
+        const uint8_t *dgram = buf + at;
+        size_t dlen = size;
+        uint8_t sealed[LINK_AUTH_DGRAM_MAX];
+        if (u->keyed) {
+            dlen = link_auth_seal(&u->key, LINK_AUTH_BOARD_TO_HOST, u->nonce, buf + at, size,
+                                  sealed, sizeof(sealed));
+            dgram = sealed;
+        }
+        const ssize_t w = dlen == 0 ? -1
+                                    : sendto(u->fd, dgram, dlen, MSG_DONTWAIT,
+                                             (const struct sockaddr *)&u->peer, sizeof(u->peer));
+        if (w != (ssize_t)dlen || dlen == 0) {
             u->tx_errors++;
             rc = ARGIL_ERR_IO;
         } else {

@@ -18,6 +18,7 @@
 
 #include "firmware/core/safety.h"
 #include "firmware/core/spsc_ring.h"
+#include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/app/host_tool.h"
@@ -62,6 +63,7 @@ typedef struct {
     _Atomic uint32_t resyncs;       /* reconnections seen (each asks for a HELLO) */
     _Atomic uint32_t frames_rx, frames_tx, errors_rx, errors_tx, reconnects;
     _Atomic uint32_t tx_dropped;    /* frames the transport could not take */
+    _Atomic uint32_t auth_refused;  /* keyed UDP: datagrams whose tag did not verify */
 } link_pub_t;
 
 typedef struct {
@@ -154,6 +156,7 @@ static void *link_thread(void *arg)
         atomic_store_explicit(&c->pub.errors_rx, s->errors_rx, memory_order_relaxed);
         atomic_store_explicit(&c->pub.errors_tx, s->errors_tx, memory_order_relaxed);
         atomic_store_explicit(&c->pub.reconnects, s->reconnects, memory_order_relaxed);
+        atomic_store_explicit(&c->pub.auth_refused, s->auth_refused, memory_order_relaxed);
     }
     /* Last frames out (the heartbeat that says we are going). */
     size_t len;
@@ -175,7 +178,8 @@ static bool ring_send(void *ctx, const uint8_t *frame, size_t len)
 static uint32_t board_refusals(const peer_t *p)
 {
     const proto_link_counts_t *l = &p->last_rt.link;
-    return l->wrong_source + l->no_session + l->duplicate + l->stale + l->decode_errors;
+    return l->wrong_source + l->no_session + l->duplicate + l->stale + l->decode_errors +
+           l->bad_mac + l->bad_nonce;
 }
 
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
@@ -254,6 +258,10 @@ static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t r
     }
 }
 
+/* The link's authentication says the session cannot go on (one line on stderr, true): a keyed
+ * host that hears only datagrams with no valid tag (the board has another key, or none) for
+ * 1 s, or an --arm session on a board that refuses to arm without a key. A keyless host that
+ * hears nothing from a UDP board for 2 s is told once what a keyed board needs. */
 /* ---- undo and redo: command lines on standard input ---- */
 
 /* Reads what standard input has (never waits), queues its undo and redo lines, then works on the
@@ -384,7 +392,8 @@ static void usage_connect(FILE *f)
     host_tool_names('s', 88, strengths, sizeof(strengths));
     host_tool_names('h', 0, shapes, sizeof(shapes));
     fprintf(f,
-            "usage: argil connect [--device DEV] [--seconds N] [--arm] [--telemetry FILE.csv]\n"
+            "usage: argil connect [--device DEV] [--key FILE] [--seconds N] [--arm]\n"
+            "                     [--telemetry FILE.csv]\n"
             "                     [--out DIR] [--quiet] [--global-solve bspline|springs]\n"
             "                     [--knot-ratio 1|2|4] [--action NAME [--strength S]]\n"
             "                     [--shape NAME] [--mirror AXES] [--autosave-s S]\n"
@@ -404,6 +413,9 @@ static void usage_connect(FILE *f)
             "                   usb            the first USB board 1209:0001 (default)\n"
             "                   usb:VID:PID    a USB board by vendor and product id (hex)\n"
             "                   usb:BUS-PORT[.PORT…]  a USB board by where it is plugged (lsusb -t)\n"
+            "  --key FILE       udp: the link key file the board has (argil keygen FILE; mode\n"
+            "                   0600): every datagram carries its tag (docs/link.md). A board\n"
+            "                   without a key refuses to arm unless started with --insecure\n"
             "  --seconds N      end after N seconds (default: run until Ctrl-C)\n"
             "  --arm            arm the board (forces on) once it has its window; when it\n"
             "                   faults because it lost the host (link loss, host stall), arm\n"
@@ -446,13 +458,15 @@ static void usage_connect(FILE *f)
             "\n"
             "exit status: 0 ran for --seconds; 130 ended by Ctrl-C or SIGTERM (files written);\n"
             "1 the link could not be opened (no such device, permission), the board never\n"
-            "answered, or a file could not be written; 2 a bad option or device string.\n"
+            "answered, its datagrams had no valid tag for --key, it refused to arm (--arm), or\n"
+            "a file could not be written; 2 a bad option, device string or key file.\n"
             "USB without root needs firmware/board/70-argil.rules (docs/link.md).\n",
             actions, strengths, shapes);
 }
 
 typedef struct {
     const char *device;
+    const char *key_file;           /* udp: the link key (NULL: none) */
     double seconds;                 /* 0: until Ctrl-C */
     bool arm;
     const char *telemetry;
@@ -590,7 +604,8 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             if (!host_opt)
                 host_opt = a;
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--seconds") == 0 ||
-                   strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0) {
+                   strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0 ||
+                   strcmp(a, "--key") == 0) {
             if (!v) {
                 fprintf(stderr, "argil connect: %s needs a value (see --help)\n", a);
                 return 2;
@@ -598,6 +613,8 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             i++;
             if (strcmp(a, "--device") == 0) {
                 o->device = v;
+            } else if (strcmp(a, "--key") == 0) {
+                o->key_file = v;
             } else if (strcmp(a, "--telemetry") == 0) {
                 o->telemetry = v;
             } else if (strcmp(a, "--out") == 0) {
@@ -626,6 +643,11 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
     if (pe != LINK_SPEC_OK) {
         fprintf(stderr, "argil connect: bad device '%s': %s\n", o->device,
                 link_spec_err_text(pe));
+        return 2;
+    }
+    if (o->key_file && spec.kind != LINK_KIND_UDP) {
+        fprintf(stderr, "argil connect: --key is for udp: devices (USB is a cable to one board "
+                        "and the sim board is in this process: neither needs a key)\n");
         return 2;
     }
     return -1;
@@ -658,6 +680,56 @@ static argil_err_t open_csv(conn_solver_t *s, const char *path, char *tmp, size_
     fprintf(s->csv, "time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state,tool,buttons,contact,"
                     "sculpting,tick,board_time_s,compute_us,deadline_misses,window_version\n");
     return ARGIL_OK;
+}
+
+/* Why a UDP board may stay silent to this host, for the "no answer" lines. */
+static const char *udp_key_hint(const connect_opts_t *o)
+{
+    if (strncmp(o->device, "udp:", 4) != 0)
+        return "";
+    return o->key_file ? "; a board answers a host with --key only when started with --key and "
+                         "the same key file (a board without a key refuses tagged datagrams)"
+                       : "; a board started with --key answers only a host given the same key "
+                         "file: --key FILE";
+}
+
+/* The summary's words on the link's authentication. */
+static const char *link_auth_summary(const connect_opts_t *o, conn_t *c)
+{
+    static char text[160];
+    if (strncmp(o->device, "udp:", 4) != 0)
+        return "no key needed (one host on the cable)";
+    if (!o->key_file)
+        return "no key (unauthenticated UDP)";
+    snprintf(text, sizeof(text), "key %s, datagrams with a bad tag %u", o->key_file,
+             atomic_load(&c->pub.auth_refused));
+    return text;
+}
+
+static bool link_refusal_ends(conn_solver_t *s, const connect_opts_t *o, double elapsed_s,
+                              bool *udp_hinted, bool tty)
+{
+    const char *nl = tty ? "\n" : "";
+    const uint32_t refused = atomic_load_explicit(&s->c->pub.auth_refused, memory_order_relaxed);
+    const uint32_t rx = atomic_load_explicit(&s->c->pub.frames_rx, memory_order_relaxed);
+    if (o->key_file && refused > 0 && rx == 0 && elapsed_s >= 1.0) {
+        fprintf(stderr, "%sargil connect: %s: %u datagrams from the board carried no valid tag "
+                "for the key in %s: start argil-board with --key and the same key file\n", nl,
+                o->device, refused, o->key_file);
+        return true;
+    }
+    if (o->arm && s->peer.last_rt.link.arm_refused > 0) {
+        fprintf(stderr, "%sargil connect: the board refuses to arm over UDP without a link key: "
+                "start argil-board with --key FILE (argil keygen FILE) and give connect the same "
+                "--key FILE, or start it with --insecure\n", nl);
+        return true;
+    }
+    if (!*udp_hinted && rx == 0 && elapsed_s >= 2.0 && strncmp(o->device, "udp:", 4) == 0) {
+        fprintf(stderr, "%sargil connect: no answer from %s yet (is argil-board running there?)%s\n",
+                nl, o->device, udp_key_hint(o));
+        *udp_hinted = true;
+    }
+    return false;
 }
 
 int cmd_connect(int argc, char **argv)
@@ -693,10 +765,23 @@ int cmd_connect(int argc, char **argv)
         exit_code = 1;
         goto free_conn;
     }
-    const argil_err_t lo = link_open(&c->link, o.device, err, sizeof(err));
+    link_key_t key;
+    if (o.key_file && !link_auth_init()) {
+        fprintf(stderr, "argil connect: libsodium cannot start (no random source?)\n");
+        exit_code = 1;
+        goto free_conn;
+    }
+    if (o.key_file && link_key_load(o.key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "argil connect: %s\n", err);
+        exit_code = 2;
+        goto free_conn;
+    }
+    const argil_err_t lo =
+        link_open_keyed(&c->link, o.device, o.key_file ? key.k : NULL, err, sizeof(err));
+    memset(&key, 0, sizeof(key));
     if (lo != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        exit_code = lo == ARGIL_ERR_PARSE ? 2 : 1;
+        exit_code = lo == ARGIL_ERR_PARSE || lo == ARGIL_ERR_ARG ? 2 : 1;
         goto free_conn;
     }
 
@@ -800,6 +885,7 @@ int cmd_connect(int argc, char **argv)
     /* What the host knew when the link was lost (for the re-arm rule below). */
     uint32_t faults_at_loss = 0, faults_seen = 0;
     bool loss_by_transport = false, bad_before_loss = false;
+    bool udp_hinted = false;
     for (;;) {
         s->now_us = mono_us();
         const double elapsed_s = (double)(s->now_us - s->t0_us) * 1e-6;
@@ -899,6 +985,10 @@ int cmd_connect(int argc, char **argv)
             s->rtt_t0_us = s->now_us;
             s->rtt_pending = true;
         }
+        if (link_refusal_ends(s, &o, elapsed_s, &udp_hinted, tty)) {
+            exit_code = 1;
+            break;
+        }
         if (s->now_us >= status_at_us) {
             const uint32_t rx = atomic_load(&c->pub.frames_rx), tx = atomic_load(&c->pub.frames_tx);
             if (!o.quiet)
@@ -963,11 +1053,11 @@ int cmd_connect(int argc, char **argv)
         printf("argil connect: %s for %.1f s%s\n", o.device, ran_s,
                interrupted ? " (interrupted)" : "");
         printf("  link                %s; frames in %u, out %u; receive errors %u, send errors "
-               "%u, reconnects %u, frames dropped %u\n",
+               "%u, reconnects %u, frames dropped %u; %s\n",
                link_state_name((link_state_t)atomic_load(&c->pub.state)), frames_rx,
                atomic_load(&c->pub.frames_tx), atomic_load(&c->pub.errors_rx),
                atomic_load(&c->pub.errors_tx), atomic_load(&c->pub.reconnects),
-               rx_drop + atomic_load(&c->pub.tx_dropped));
+               rx_drop + atomic_load(&c->pub.tx_dropped), link_auth_summary(&o, c));
         printf("  board               %s; ACTIVE entered %u times; board HELLOs %u; restarts "
                "seen %u; deadline misses %u; peak force %.3f N\n",
                s->have_tm ? safety_state_name((safety_state_t)s->last_state) : "never heard",
@@ -977,9 +1067,10 @@ int cmd_connect(int argc, char **argv)
             const proto_link_counts_t *l = &s->peer.last_rt.link;
             if (s->peer.stats.rt_stats_frames > 0)
                 printf("  board link          host sessions %u; host frames refused: wrong source "
-                       "%u, no session %u, duplicate %u, stale %u, decode errors %u\n",
+                       "%u, no session %u, duplicate %u, stale %u, decode errors %u, bad tag %u, "
+                       "bad nonce %u; ARM refused %u\n",
                        l->sessions, l->wrong_source, l->no_session, l->duplicate, l->stale,
-                       l->decode_errors);
+                       l->decode_errors, l->bad_mac, l->bad_nonce, l->arm_refused);
             else
                 printf("  board link          no RT_STATS report from the board\n");
         }
@@ -1043,8 +1134,9 @@ int cmd_connect(int argc, char **argv)
                    s->journaling ? "KEPT (the end was not clean): 'argil recover' restores"
                                  : "removed at this clean end");
     }
-    if (frames_rx == 0) {
-        fprintf(stderr, "argil connect: the board never answered on %s\n", o.device);
+    if (frames_rx == 0 && exit_code == 0) {
+        fprintf(stderr, "argil connect: the board never answered on %s%s\n", o.device,
+                udp_key_hint(&o));
         exit_code = 1;
     } else if (exit_code == 0 && interrupted) {
         exit_code = 130;

@@ -13,6 +13,7 @@ int cmd_view(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
 int cmd_connect(int argc, char **argv);
 int cmd_recover(int argc, char **argv);
+int cmd_keygen(int argc, char **argv);
 
 /* Before a session writes into dir: when dir holds an unfinished session's journal, says so in
  * one line and (interactive only) asks whether to recover, discard or quit; discard removes it.

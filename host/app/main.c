@@ -36,6 +36,7 @@ static const struct {
     {"view", cmd_view, "render a mesh to a PNG or show it in a window (see 'argil view --help')"},
     {"connect", cmd_connect, "a live session with a board over USB, UDP or sim (see 'argil connect --help')"},
     {"recover", cmd_recover, "restore an unfinished session from its journal (see 'argil recover --help')"},
+    {"keygen", cmd_keygen, "make a UDP link key file for board and host (see 'argil keygen --help')"},
 };
 
 static void usage_main(FILE *f)

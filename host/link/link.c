@@ -7,12 +7,27 @@
 
 argil_err_t link_open(link_t *l, const char *device, char *err, size_t err_len)
 {
+    return link_open_keyed(l, device, NULL, err, err_len);
+}
+
+argil_err_t link_open_keyed(link_t *l, const char *device, const uint8_t *key, char *err,
+                            size_t err_len)
+{
     memset(l, 0, sizeof(*l));
     const link_spec_err_t pe = link_spec_parse(device, &l->spec);
     if (pe != LINK_SPEC_OK) {
         snprintf(err, err_len, "bad device '%s': %s", device ? device : "",
                  link_spec_err_text(pe));
         return ARGIL_ERR_PARSE;
+    }
+    if (key && l->spec.kind != LINK_KIND_UDP) {
+        snprintf(err, err_len, "device '%s': a link key is for udp: devices (USB is a cable to "
+                 "one board and the sim board is in this process: neither needs one)", device);
+        return ARGIL_ERR_ARG;
+    }
+    if (key) {
+        l->keyed = true;
+        memcpy(l->key, key, LINK_KEY_SIZE);
     }
     switch (l->spec.kind) {
     case LINK_KIND_SIM: return link_sim_open(l, err, err_len);

@@ -20,7 +20,11 @@ typedef struct {
     uint32_t errors_rx;        /* datagrams or stream bytes that were not a frame; IN transfer errors */
     uint32_t errors_tx;        /* frames the transport refused or could not queue */
     uint32_t reconnects;       /* the board came back after the link was lost */
+    uint32_t auth_refused;     /* keyed UDP: datagrams whose tag did not verify (another key, or
+                                * a board without one) */
 } link_stats_t;
+
+#define LINK_KEY_SIZE 32u      /* the UDP link key (firmware/hal/link_auth.h, docs/link.md) */
 
 typedef struct link_s link_t;
 
@@ -41,12 +45,19 @@ struct link_s {
     link_fsm_t fsm;
     link_stats_t stats;
     uint64_t now_us;           /* of the last poll */
+    bool keyed;                /* udp: every datagram sealed and verified with key */
+    uint8_t key[LINK_KEY_SIZE];
 };
 
 /* Opens the link named by device. ARGIL_ERR_PARSE for a bad device string, ARGIL_ERR_IO when
  * the transport cannot be opened (no such device, permission, no USB library); one line
  * (without the program's name) in err. */
 argil_err_t link_open(link_t *l, const char *device, char *err, size_t err_len);
+/* As link_open; with a key (not NULL) a udp: device seals every datagram and drops those from the
+ * board whose tag does not verify (docs/protocol.md "Authenticated UDP"). ARGIL_ERR_ARG when a
+ * key is given for a device other than udp: (USB and sim need none). */
+argil_err_t link_open_keyed(link_t *l, const char *device, const uint8_t *key, char *err,
+                            size_t err_len);
 
 /* Wraps a transport the caller built (tests use a fake). */
 void link_attach(link_t *l, const link_ops_t *ops, void *impl, bool transport_up);

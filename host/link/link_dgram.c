@@ -1,6 +1,8 @@
 /* UDP transport of the host link: a connected, non-blocking socket to the board; every frame
- * is one datagram each way. A board that restarts on the same address is simply heard again
- * (the link state machine turns that into a reconnection). */
+ * is one datagram each way. With a key every datagram is sealed (the board's session nonce,
+ * learned from each verified datagram of the board; 0 on a HELLO) and every datagram from the
+ * board verified (firmware/hal/link_auth.h). A board that restarts on the same address is
+ * simply heard again (the link state machine turns that into a reconnection). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <netdb.h>
@@ -11,18 +13,31 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "firmware/hal/link_auth.h"
 #include "firmware/hal/link_io.h"
 #include "host/link/link.h"
+
+_Static_assert(LINK_KEY_SIZE == LINK_KEY_BYTES, "one key size");
 
 typedef struct {
     int fd;
     uint8_t dgram[65536];      /* the datagram being handed out frame by frame */
     size_t len, at;
+    bool keyed;
+    link_auth_host_t auth;     /* keyed: the key and the board's session nonce */
+    uint8_t sealed[LINK_AUTH_DGRAM_MAX];
 } dgram_t;
 
 static argil_err_t dgram_send(link_t *l, const uint8_t *frame, size_t len)
 {
     dgram_t *d = l->impl;
+    if (d->keyed) {
+        /* none before the board told its session's nonce: it would refuse them (bad nonce) */
+        len = link_auth_host_seal(&d->auth, frame, len, d->sealed, sizeof(d->sealed));
+        if (len == 0)
+            return ARGIL_ERR_STATE;
+        frame = d->sealed;
+    }
     ssize_t w = send(d->fd, frame, len, MSG_DONTWAIT | MSG_NOSIGNAL);
     /* ECONNREFUSED reports an earlier datagram that found the board's port closed (it was
      * restarting); this one may well pass: try it once more. */
@@ -60,6 +75,14 @@ static size_t dgram_recv(link_t *l, uint8_t *buf, size_t cap)
             return 0;
         d->len = (size_t)n;
         d->at = 0;
+        size_t flen = 0;
+        if (d->keyed && link_auth_host_open(&d->auth, d->dgram, d->len, &flen) != LINK_AUTH_OK) {
+            l->stats.auth_refused = d->auth.refused;
+            d->len = 0;
+            continue;
+        }
+        if (d->keyed)
+            d->len = flen; /* one frame, the trailer off */
     }
 }
 
@@ -115,6 +138,13 @@ argil_err_t link_dgram_open(link_t *l, char *err, size_t err_len)
         return ARGIL_ERR_IO;
     }
     freeaddrinfo(ai);
+    if (l->keyed) {
+        link_key_t k;
+        memcpy(k.k, l->key, sizeof(k.k));
+        link_auth_host_init(&d->auth, &k);
+        memset(&k, 0, sizeof(k));
+        d->keyed = true;
+    }
     /* Room for a burst of telemetry and impulses while the link thread is descheduled. */
     const int rcvbuf = 1 << 20;
     (void)setsockopt(d->fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof(rcvbuf));

@@ -112,7 +112,9 @@ static int msg_equal(const proto_msg_t *a, const proto_msg_t *b)
                x->link.decode_errors == y->link.decode_errors &&
                x->link.wrong_source == y->link.wrong_source &&
                x->link.no_session == y->link.no_session && x->link.duplicate == y->link.duplicate &&
-               x->link.stale == y->link.stale && x->link.sessions == y->link.sessions;
+               x->link.stale == y->link.stale && x->link.sessions == y->link.sessions &&
+               x->link.bad_mac == y->link.bad_mac && x->link.bad_nonce == y->link.bad_nonce &&
+               x->link.arm_refused == y->link.arm_refused;
     }
     default:
         return 0;

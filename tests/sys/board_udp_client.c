@@ -7,7 +7,9 @@
  *      a board that ticks slower than 1 kHz (the HIL VM) as on a real one;
  *   3. a new host (new socket) says HELLO → window re-sent, re-arm → ACTIVE again, no restart.
  * Usage: board_udp_client PORT [LINK_TICKS]. LINK_TICKS (default 1): board ticks the link may
- * take each way (heartbeat in, telemetry out). Prints one line per phase; exit 0 when all hold. */
+ * take each way (heartbeat in, telemetry out). With ARGIL_LINK_KEY=FILE in the environment every
+ * datagram is sealed with that link key and the board's verified (docs/link.md). Prints one line
+ * per phase; exit 0 when all hold. */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
 #include <math.h>
@@ -19,6 +21,7 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
+#include "firmware/hal/link_key.h"
 #include "host/app/peer.h"
 #include "host/model/grid.h"
 
@@ -32,10 +35,30 @@ typedef struct {
     uint32_t hello_from_board;
 } host_t;
 
+static bool g_keyed;              /* ARGIL_LINK_KEY given: every datagram sealed and verified */
+static link_auth_host_t g_auth;
+
 static bool udp_send(void *ctx, const uint8_t *f, size_t len)
 {
     host_t *h = ctx;
-    return sendto(h->fd, f, len, 0, (struct sockaddr *)&h->board, sizeof(h->board)) == (ssize_t)len;
+    uint8_t sealed[LINK_AUTH_DGRAM_MAX];
+    if (g_keyed && (len = link_auth_host_seal(&g_auth, f, len, sealed, sizeof(sealed))) == 0)
+        return false;
+    return sendto(h->fd, g_keyed ? sealed : f, len, 0, (struct sockaddr *)&h->board,
+                  sizeof(h->board)) == (ssize_t)len;
+}
+
+/* The next datagram's frames from the board (keyed: verified, the trailer off); <= 0: none. */
+static ssize_t udp_recv(host_t *h, uint8_t *buf, size_t cap)
+{
+    for (;;) {
+        const ssize_t n = recv(h->fd, buf, cap, 0);
+        size_t flen = 0;
+        if (n <= 0 || !g_keyed)
+            return n;
+        if (link_auth_host_open(&g_auth, buf, (size_t)n, &flen) == LINK_AUTH_OK)
+            return (ssize_t)flen;
+    }
 }
 
 static void on_tm(void *ctx, const msg_telemetry_t *t)
@@ -65,6 +88,7 @@ static void send_simple(host_t *h, uint8_t type, uint8_t command)
 static void host_open(host_t *h, int port)
 {
     memset(h, 0, sizeof(*h));
+    g_auth.nonce = 0; /* a new host: it learns its session's nonce from the board's answer */
     h->fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
     h->board.sin_family = AF_INET;
     h->board.sin_port = htons((uint16_t)port);
@@ -107,7 +131,7 @@ static void host_ms(host_t *h, bool talking, uint64_t *next)
 {
     static uint8_t buf[65536];
     ssize_t n;
-    while ((n = recv(h->fd, buf, sizeof(buf), 0)) > 0) {
+    while ((n = udp_recv(h, buf, sizeof(buf))) > 0) {
         if (n >= 6 && buf[5] == MSG_HELLO)
             h->hello_from_board++;
         peer_receive(&h->peer, buf, (size_t)n);
@@ -145,6 +169,14 @@ int main(int argc, char **argv)
     const int link_ticks = argc == 3 ? atoi(argv[2]) : 1;
     if (link_ticks < 0 || link_ticks > 50)
         return 2;
+    link_key_t key;
+    char err[400];
+    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "board_udp_client: ARGIL_LINK_KEY: %s\n", err);
+        return 2;
+    }
+    if (g_keyed)
+        link_auth_host_init(&g_auth, &key);
     static host_t h;
     host_open(&h, port);
     const int t1 = until_active(&h, 4000, false);
@@ -173,7 +205,7 @@ int main(int argc, char **argv)
      * the state is FAULT and the force zero. */
     static uint8_t drain[65536];
     ssize_t got;
-    while ((got = recv(h.fd, drain, sizeof(drain), 0)) > 0)
+    while ((got = udp_recv(&h, drain, sizeof(drain))) > 0)
         peer_receive(&h.peer, drain, (size_t)got);
     send_simple(&h, MSG_HEARTBEAT, PROTO_CMD_NONE);
     const int64_t tick0 = h.tm.tick;

@@ -33,7 +33,7 @@ seq = 0
 def frame(kind, payload):
     global seq
     seq += 1
-    h = struct.pack('<IBBHI', 0x4C475241, 2, kind, len(payload), seq) + payload
+    h = struct.pack("<IBBHI", 0x4C475241, 3, kind, len(payload), seq) + payload
     return h + struct.pack('<I', crc32c(h))
 
 

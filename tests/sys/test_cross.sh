@@ -58,11 +58,13 @@ ok "port 0 refused with status 2"
 
 # The aarch64 daemon's real loop (SCHED_FIFO 80, mlockall, absolute clock_nanosleep, the UDP link
 # thread) under qemu-user, with the native host peer over real UDP: HELLO, window, arm, ACTIVE;
-# host loss; reconnection. Emulated ticks overrun now and then, so no overrun-streak fault here.
+# host loss; reconnection, over a keyed link (the aarch64 libsodium's tags checked by the native
+# one's). Emulated ticks overrun now and then, so no overrun-streak fault here.
 step=a64-udp-session
 port=$((40000 + $$ % 20000))
+"$REL/argil" keygen "$tmp/link.key" >/dev/null || fail "argil keygen"
 $QEMU_A64 "$a64/argil-board" --bus sim --link "udp:127.0.0.1:$port" --duration-s 60 \
-    --stats-period-s 0 --overrun-streak 0 >"$tmp/a64d.out" 2>"$tmp/a64d.err" &
+    --stats-period-s 0 --overrun-streak 0 --key "$tmp/link.key" >"$tmp/a64d.out" 2>"$tmp/a64d.err" &
 dpid=$!
 trap 'kill "$dpid" 2>/dev/null; rm -rf "$tmp"' EXIT
 i=0
@@ -72,7 +74,7 @@ until grep -q "running at" "$tmp/a64d.err"; do
     sleep 0.1
 done
 st=0
-timeout -s KILL 60 "$REL/board_udp_client" "$port" 30 >"$tmp/a64c.out" 2>&1 || st=$?
+ARGIL_LINK_KEY="$tmp/link.key" timeout -s KILL 60 "$REL/board_udp_client" "$port" 30 >"$tmp/a64c.out" 2>&1 || st=$?
 sed 's/^/aarch64 daemon, native host: /' "$tmp/a64c.out"
 kill -TERM "$dpid" 2>/dev/null || true
 dst=0; wait "$dpid" || dst=$?

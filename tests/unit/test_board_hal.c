@@ -497,6 +497,124 @@ static void test_spsc_ring_wraps_and_refuses(void **st)
     assert_int_equal(r.dropped, 10);
 }
 
+/* Seals a frame with key (NULL: sends it bare) and nonce, sends it from fd to the link and
+ * returns what one receive call gives the core. */
+static size_t udp_deliver_sealed(link_udp_t *u, int fd, const struct sockaddr_in *to,
+                                 const link_key_t *key, uint64_t nonce, uint8_t type,
+                                 uint32_t seq, uint64_t now_us)
+{
+    uint8_t f[PROTO_FRAME_MAX], d[LINK_AUTH_DGRAM_MAX], buf[2 * PROTO_FRAME_MAX];
+    size_t len = frame_of(type, 0, seq, f);
+    const uint8_t *out = f;
+    if (key) {
+        len = link_auth_seal(key, LINK_AUTH_HOST_TO_BOARD, nonce, f, len, d, sizeof(d));
+        out = d;
+    }
+    assert_int_equal(sendto(fd, out, len, 0, (const struct sockaddr *)to, sizeof(*to)),
+                     (ssize_t)len);
+    usleep(5000);
+    return link_udp_receive(u, buf, sizeof(buf), now_us);
+}
+
+/* The board's next datagram to fd, verified with key: its nonce (fails if none or a bad tag). */
+static uint64_t udp_board_nonce(int fd, const link_key_t *key)
+{
+    uint8_t b[2 * PROTO_FRAME_MAX];
+    usleep(5000);
+    const ssize_t n = recv(fd, b, sizeof(b), MSG_DONTWAIT);
+    assert_true(n > 0);
+    size_t flen = 0;
+    uint64_t nonce = 0;
+    assert_int_equal(link_auth_open(key, LINK_AUTH_BOARD_TO_HOST, b, (size_t)n, &flen, &nonce),
+                     LINK_AUTH_OK);
+    (void)udp_got(fd); /* drain */
+    return nonce;
+}
+
+/* A keyed link over real sockets: only datagrams with the key's tag reach the core, every other
+ * one is counted; a session's frames carry its nonce, and a frame of an earlier session (a
+ * replay, whatever its sequence number) is refused once a new session has started, also when
+ * the same host restarts a lapsed one. */
+static void test_udp_link_with_a_key(void **st)
+{
+    (void)st;
+    assert_true(link_auth_init());
+    link_udp_t u;
+    char err[200];
+    assert_int_equal(link_udp_open(&u, "127.0.0.1:47317", err, sizeof(err)), ARGIL_OK);
+    link_key_t key, other;
+    for (unsigned i = 0; i < LINK_KEY_BYTES; i++) {
+        key.k[i] = (uint8_t)(3u * i + 1u);
+        other.k[i] = key.k[i];
+    }
+    other.k[31] ^= 1u;
+    link_udp_set_key(&u, &key);
+    struct sockaddr_in to, ha;
+    assert_int_equal(link_udp_parse("127.0.0.1:47317", &to), ARGIL_OK);
+    const int host = udp_peer(&ha);
+    uint8_t f[PROTO_FRAME_MAX], g[PROTO_FRAME_MAX];
+    const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
+    uint64_t t = 1000000u;
+
+    /* another key, no tag at all, a heartbeat with no session's nonce: refused, counted */
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &other, 0, MSG_HELLO, 1, t), 0);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, NULL, 0, MSG_HELLO, 2, t), 0);
+    assert_int_equal(u.bad_mac, 2);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, 0, MSG_HEARTBEAT, 3, t), 0);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, 99, MSG_HEARTBEAT, 4, t), 0);
+    assert_int_equal(u.bad_nonce, 2);
+    assert_false(u.bind.bound);
+
+    /* the HELLO with the key binds the host and draws the session's nonce; the core gets the
+     * frame without the trailer; the board's datagrams carry that nonce under a valid tag */
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, 0, MSG_HELLO, 5, t),
+                     frame_of(MSG_HELLO, 0, 5, g));
+    link_udp_session(&u, HAL_SESSION_LIVE, 1, t += 1000u);
+    const uint64_t n1 = u.nonce;
+    assert_true(n1 != 0);
+    assert_int_equal(link_udp_send(&u, f, flen), ARGIL_OK);
+    assert_true(udp_board_nonce(host, &key) == n1);
+    assert_true(udp_deliver_sealed(&u, host, &to, &key, n1, MSG_HEARTBEAT, 6, t) > 0);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, n1 + 1u, MSG_HEARTBEAT, 7, t), 0);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &other, n1, MSG_HEARTBEAT, 8, t), 0);
+    assert_int_equal(u.bad_nonce, 3);
+    assert_int_equal(u.bad_mac, 3);
+
+    /* END, then a new session (its numbers start lower): the earlier session's frame, numbered
+     * above them, is refused by its nonce */
+    link_udp_session(&u, HAL_SESSION_NONE, 1, t += 1000u);
+    assert_true(udp_deliver_sealed(&u, host, &to, &key, 0, MSG_HELLO, 1, t) > 0);
+    link_udp_session(&u, HAL_SESSION_LIVE, 2, t += 1000u);
+    const uint64_t n2 = u.nonce;
+    assert_true(n2 != 0 && n2 != n1);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, n1, MSG_HEARTBEAT, 9, t), 0);
+    assert_int_equal(u.bad_nonce, 4);
+    assert_true(udp_deliver_sealed(&u, host, &to, &key, n2, MSG_HEARTBEAT, 2, t) > 0);
+    /* the live host's HELLO again (a reconnection) keeps the session and its nonce */
+    assert_true(udp_deliver_sealed(&u, host, &to, &key, 0, MSG_HELLO, 3, t) > 0);
+    assert_true(u.nonce == n2);
+
+    /* lapsed, and the same host restarts it with a HELLO: a new nonce as well */
+    link_udp_session(&u, HAL_SESSION_LAPSED, 2, t += 60000u);
+    assert_true(udp_deliver_sealed(&u, host, &to, &key, 0, MSG_HELLO, 4, t) > 0);
+    const uint64_t n3 = u.nonce;
+    assert_true(n3 != n2 && n3 != 0);
+    assert_int_equal(udp_deliver_sealed(&u, host, &to, &key, n2, MSG_HEARTBEAT, 100, t), 0);
+    assert_int_equal(u.bad_nonce, 5);
+    assert_int_equal(u.nonces, 3);
+    close(host);
+    link_udp_close(&u);
+
+    /* a board without a key drops a keyed host's datagram (counted), not parts of it */
+    assert_int_equal(link_udp_open(&u, "127.0.0.1:47317", err, sizeof(err)), ARGIL_OK);
+    const int h2 = udp_peer(&ha);
+    assert_int_equal(udp_deliver_sealed(&u, h2, &to, &key, 0, MSG_HELLO, 1, t), 0);
+    assert_int_equal(u.bad_mac, 1);
+    assert_true(udp_deliver_sealed(&u, h2, &to, NULL, 0, MSG_HELLO, 2, t) > 0);
+    close(h2);
+    link_udp_close(&u);
+}
+
 static void test_config_ini_and_refusals(void **st)
 {
     (void)st;
@@ -526,6 +644,8 @@ static void test_config_ini_and_refusals(void **st)
         {"[transform]\noffset_m = 1,2\n", 2, "expected X,Y,Z"},
         {"[link]\nhost = tcp:1\n", 2, "udp:ADDR:PORT or ffs:DIR"},
         {"[gpio]\nestop = two words\n", 2, "gpio.estop"},
+        {"[link]\ninsecure = maybe\n", 2, "expected yes or no"},
+        {"[link]\nkey =\n", 2, "link.key"},
     };
     for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
         board_config_default(&c);
@@ -548,6 +668,7 @@ int main(void)
         cmocka_unit_test(test_gpio_errors_name_the_line),
         cmocka_unit_test(test_udp_link_loopback),
         cmocka_unit_test(test_udp_link_serves_its_session_host_only),
+        cmocka_unit_test(test_udp_link_with_a_key),
         cmocka_unit_test(test_framer_splits_a_stream),
         cmocka_unit_test(test_ffs_descriptors),
         cmocka_unit_test(test_spsc_ring_wraps_and_refuses),

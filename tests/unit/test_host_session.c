@@ -235,6 +235,8 @@ static void test_the_board_acts_on_its_host_only_and_counts_the_rest(void **st)
     in.gpio_in = GPIO_IN_ESTOP_N | GPIO_IN_DRIVE_FAULT_N;
     in.link_refused_source = 7;
     in.link_refused_no_session = 4;
+    in.link_refused_bad_mac = 9;
+    in.link_refused_bad_nonce = 5;
     board_tick(&g_board, &in, &g_out);
     proto_msg_t rt;
     board_rt_stats_msg(&g_board, &rt);
@@ -244,6 +246,44 @@ static void test_the_board_acts_on_its_host_only_and_counts_the_rest(void **st)
     assert_int_equal(rt.u.rt_stats.link.stale, 1);
     assert_int_equal(rt.u.rt_stats.link.sessions, 2);
     assert_int_equal(rt.u.rt_stats.link.decode_errors, 0);
+    assert_int_equal(rt.u.rt_stats.link.bad_mac, 9);
+    assert_int_equal(rt.u.rt_stats.link.bad_nonce, 5);
+    assert_int_equal(rt.u.rt_stats.link.arm_refused, 0);
+}
+
+/* A link that cannot tell who sent a frame (UDP without a key): the host's ARM is refused and
+ * counted, while its heartbeats keep the session alive; the same ARM acts when it may. */
+static void test_a_board_that_refuses_arm_counts_and_ignores_it(void **st)
+{
+    (void)st;
+    for (int refuse = 1; refuse >= 0; refuse--) {
+        board_cfg_t cfg;
+        board_cfg_default(&cfg);
+        cfg.refuse_arm = refuse != 0;
+        assert_int_equal(board_init(&g_board, &cfg), ARGIL_OK);
+        g_board.safety.state = SAFETY_IDLE; /* as after boot with the drives ready */
+        static uint8_t rx[4096];
+        proto_msg_t hello, beat;
+        memset(&hello, 0, sizeof(hello));
+        hello.type = MSG_HELLO;
+        hello.u.hello.role = PROTO_ROLE_HOST;
+        memset(&beat, 0, sizeof(beat));
+        beat.type = MSG_HEARTBEAT;
+        beat.u.heartbeat.command = PROTO_CMD_ARM;
+        size_t n = put(rx, 0, &hello, 1);
+        n = put(rx, n, &beat, 2);
+        tick(rx, n);
+        assert_int_equal(g_board.stats.refused_arm, refuse ? 1 : 0);
+        assert_int_equal(g_board.session.state, HOST_SESSION_LIVE);
+        /* an ARM that acts starts the drives' fault reset (for its bounded wait) */
+        if (refuse)
+            assert_int_equal(g_board.drives.fault_reset_left_us, 0);
+        else
+            assert_true(g_board.drives.fault_reset_left_us > 0);
+        proto_msg_t rt;
+        board_rt_stats_msg(&g_board, &rt);
+        assert_int_equal(rt.u.rt_stats.link.arm_refused, refuse ? 1 : 0);
+    }
 }
 
 int main(void)
@@ -256,6 +296,7 @@ int main(void)
         cmocka_unit_test(test_a_quiet_host_lapses_and_any_hello_takes_over),
         cmocka_unit_test(test_end_and_a_second_hello),
         cmocka_unit_test(test_the_board_acts_on_its_host_only_and_counts_the_rest),
+        cmocka_unit_test(test_a_board_that_refuses_arm_counts_and_ignores_it),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

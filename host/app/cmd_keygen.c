@@ -1,0 +1,47 @@
+/* argil keygen FILE: a new UDP link key file (firmware/hal/link_key.h, docs/link.md "Link key")
+ * for argil-board --key and argil connect --key. */
+#include <stdio.h>
+#include <string.h>
+
+#include "firmware/hal/link_key.h"
+#include "host/app/commands.h"
+
+static void usage_keygen(FILE *f)
+{
+    fprintf(f,
+            "usage: argil keygen FILE\n"
+            "\n"
+            "Makes a new pre-shared key for the UDP link between argil-board and argil connect:\n"
+            "32 random bytes (libsodium) as one line of 64 hex digits, in FILE created with mode\n"
+            "0600 (only its owner may read it). FILE must not exist: a key is never overwritten.\n"
+            "Give the same file to the board and to every host that may command it:\n"
+            "  argil keygen argil.key\n"
+            "  scp -p argil.key board:/etc/argil/argil.key   (keep it mode 0600 there)\n"
+            "  argil-board --key /etc/argil/argil.key ...    (or [link] key = ... in its INI)\n"
+            "  argil connect --device udp:board:7700 --key argil.key ...\n"
+            "Every datagram then carries a keyed BLAKE2b tag, and the board refuses any without\n"
+            "a valid one. A key file that group or others may read or write is refused: chmod\n"
+            "600 FILE. USB needs no key. See docs/link.md.\n"
+            "\n"
+            "exit status: 0 written; 1 FILE exists or cannot be written; 2 a usage error.\n");
+}
+
+int cmd_keygen(int argc, char **argv)
+{
+    if (argc == 1 && (strcmp(argv[0], "--help") == 0 || strcmp(argv[0], "-h") == 0)) {
+        usage_keygen(stdout);
+        return 0;
+    }
+    if (argc != 1 || argv[0][0] == '-') {
+        fprintf(stderr, "argil keygen: expected one FILE to create (see 'argil keygen --help')\n");
+        return 2;
+    }
+    char err[512];
+    if (link_key_create(argv[0], err, sizeof(err)) != LINK_KEY_OK) {
+        fprintf(stderr, "argil keygen: %s\n", err);
+        return 1;
+    }
+    printf("argil keygen: wrote a new link key to %s (mode 0600): give the same file to "
+           "argil-board --key and argil connect --key\n", argv[0]);
+    return 0;
+}
