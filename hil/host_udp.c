@@ -124,10 +124,21 @@ typedef struct {
     uint8_t b[PROTO_FRAME_MAX];
 } held_t;
 
+#define CAPTURED_MAX 64u
+#define STRANGER_ADDR "127.0.0.2"   /* another address on the host's network (loopback /8) */
+
 typedef struct {
     int fd;
     struct sockaddr_in board;
     uint64_t t0_us;
+    /* the stranger (`stranger KIND for D`): its own socket on STRANGER_ADDR, and what it has
+     * captured of the host's datagrams (as sent) */
+    int stranger_fd;
+    int stranger_kind;              /* scn_stranger_t while active, -1 */
+    uint64_t stranger_until_us, stranger_last_us;
+    held_t captured[CAPTURED_MAX];
+    uint32_t n_captured, replay_next;
+    uint32_t replayed_other, replayed_own, forged, flooded, stranger_errors;
     bool lost;
     int64_t delay_us;
     int32_t duplicate_n, reorder_n;
@@ -168,6 +179,121 @@ static void raw_send(shost_t *h, const uint8_t *f, size_t len)
 {
     udp_out(h->fd, &h->board, f, len);
     h->frames_sent++;
+    if (len <= PROTO_FRAME_MAX) { /* what a stranger on the network captures */
+        held_t *c = &h->captured[h->n_captured++ % CAPTURED_MAX];
+        c->len = len;
+        memcpy(c->b, f, len);
+    }
+}
+
+/* A datagram from the stranger's socket (another address), or from the host's own (a spoofed
+ * source: on a real network a stranger can forge the host's address). */
+static void stranger_sendto(shost_t *h, bool own, const uint8_t *f, size_t len)
+{
+    const int fd = own ? h->fd : h->stranger_fd;
+    if (fd < 0 || sendto(fd, f, len, 0, (const struct sockaddr *)&h->board, sizeof(h->board)) !=
+                      (ssize_t)len)
+        h->stranger_errors++;
+}
+
+/* The stranger's socket on STRANGER_ADDR; -1 (and a line) when the address cannot be bound. */
+static int stranger_open(void)
+{
+    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    inet_pton(AF_INET, STRANGER_ADDR, &a.sin_addr);
+    if (fd < 0 || bind(fd, (const struct sockaddr *)&a, sizeof(a)) != 0) {
+        fprintf(stderr, "hil-host: cannot bind the stranger's socket on %s (%s)\n",
+                STRANGER_ADDR, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* One CRC-valid command a stranger would send to take the arm, numbered far ahead of the
+ * host: a HELLO, DISARM and END heartbeats, a four times stiffer TOOL. */
+static size_t stranger_command(shost_t *h, uint8_t *buf, size_t cap)
+{
+    static proto_msg_t m;
+    memset(&m, 0, sizeof(m));
+    const uint32_t k = h->forged % 4u;
+    if (k == 0) {
+        m.type = MSG_HELLO;
+        m.u.hello.role = PROTO_ROLE_HOST;
+    } else if (k == 3) {
+        m.type = MSG_TOOL;
+        m.u.tool = *h->tool;
+        m.u.tool.contact_stiffness_n_per_m *= 4.0f;
+    } else {
+        m.type = MSG_HEARTBEAT;
+        m.u.heartbeat.command = k == 1 ? PROTO_CMD_DISARM : PROTO_CMD_END;
+    }
+    size_t len = 0;
+    if (proto_encode(&m, h->next_seq + 1000u + h->forged, buf, cap, &len) != PROTO_OK)
+        return 0;
+    return len;
+}
+
+/* One millisecond of the stranger (the caller holds h->mu): replay sends one captured
+ * datagram from its address and from the host's; forge one command every 5 ms from each;
+ * flood 10 junk datagrams from its address. */
+static void stranger_tick(shost_t *h)
+{
+    const uint64_t now = mono_us();
+    if (h->stranger_kind < 0)
+        return;
+    if (now >= h->stranger_until_us) {
+        h->stranger_kind = -1;
+        return;
+    }
+    if (now < h->stranger_last_us + 1000u)
+        return;
+    h->stranger_last_us = now;
+    switch (h->stranger_kind) {
+    case SCN_STRANGER_REPLAY: {
+        const uint32_t n = h->n_captured < CAPTURED_MAX ? h->n_captured : CAPTURED_MAX;
+        if (n == 0)
+            return;
+        const held_t *c = &h->captured[h->replay_next++ % n];
+        stranger_sendto(h, false, c->b, c->len);
+        h->replayed_other++;
+        stranger_sendto(h, true, c->b, c->len);
+        h->replayed_own++;
+        return;
+    }
+    case SCN_STRANGER_FORGE: {
+        if ((now / 1000u) % 5u != 0)
+            return;
+        uint8_t buf[PROTO_FRAME_MAX];
+        const size_t len = stranger_command(h, buf, sizeof(buf));
+        if (len == 0)
+            return;
+        stranger_sendto(h, false, buf, len);
+        stranger_sendto(h, true, buf, len);
+        h->forged++;
+        return;
+    }
+    case SCN_STRANGER_FLOOD: {
+        uint32_t v = 0x9E3779B9u ^ (uint32_t)now;
+        for (int k = 0; k < 10; k++) {
+            uint8_t junk[1024];
+            v ^= v << 13; v ^= v >> 17; v ^= v << 5;
+            const size_t n = 1u + v % sizeof(junk);
+            for (size_t i = 0; i < n; i++) {
+                v ^= v << 13; v ^= v >> 17; v ^= v << 5;
+                junk[i] = (uint8_t)v;
+            }
+            if (k % 2 == 0 && n >= 4)
+                memcpy(junk, "ARGL", 4); /* starts like a frame */
+            stranger_sendto(h, false, junk, n);
+            h->flooded++;
+        }
+        return;
+    }
+    default: return;
+    }
 }
 
 /* Gives a frame the next number of this host's one sequence (the board refuses a number it
@@ -355,6 +481,11 @@ static void *shost_rt(void *arg)
             if (h->synced && h->clk.now_us >= h->scn_end_us)
                 atomic_store(&h->done, true);
         }
+        if (h->stranger_kind >= 0) {
+            pthread_mutex_lock(&h->mu);
+            stranger_tick(h);
+            pthread_mutex_unlock(&h->mu);
+        }
         atomic_store(&h->synced_flag, h->synced);
         atomic_store(&h->now_us, (long long)h->clk.now_us);
         if (mono_us() < next_beat)
@@ -497,6 +628,13 @@ static bool shost_step(shost_t *h, const scn_step_t *st, const msg_tool_t *tool,
         return true;
     }
     case SCN_LINK_NAN: return shost_send_nan_tool(h, tool);
+    case SCN_STRANGER:
+        if (h->stranger_fd < 0)
+            return false;
+        h->stranger_kind = st->a;
+        h->stranger_until_us = mono_us() + (uint64_t)st->dur_us;
+        h->stranger_last_us = 0;
+        return true;
     default: return false;
     }
 }
@@ -543,6 +681,11 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     memset(&h, 0, sizeof(h));
     h.fd = fd;
     h.board = *board;
+    h.stranger_kind = -1;
+    h.stranger_fd = -1;
+    for (uint32_t i = 0; i < scn.n_steps; i++)
+        if (scn.step[i].action == SCN_STRANGER && h.stranger_fd < 0)
+            h.stranger_fd = stranger_open();
     h.last_state = 0xFFu;
     h.ready_file = ready_file;
     /* The SIL rig's clay and tool (tests/sil/rig.h): a 30 mm sphere at the model origin, the
@@ -679,6 +822,17 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
            realtime_s(), h.tm_n, h.frames_sent, h.frames_dropped, peer.stats.windows_sent,
            atomic_load(&h.beats), peer.stats.solves, sync_fd >= 0 ? "ticks" : "wall", h.clk.syncs,
            h.clk.wall_steps, (double)h.clk.now_us / 1e6);
+    if (h.stranger_fd >= 0) {
+        /* what the stranger sent, and the board's refusals as its last RT_STATS counts them */
+        const proto_link_counts_t *lc = &peer.last_rt.link;
+        printf("%.6f stranger replayed_other=%u replayed_own=%u forged=%u flooded=%u "
+               "send_errors=%u; board refused wrong_source=%u no_session=%u duplicate=%u "
+               "stale=%u decode_errors=%u sessions=%u (RT_STATS %u)\n",
+               realtime_s(), h.replayed_other, h.replayed_own, h.forged, h.flooded,
+               h.stranger_errors, lc->wrong_source, lc->no_session, lc->duplicate, lc->stale,
+               lc->decode_errors, lc->sessions, peer.stats.rt_stats_frames);
+        close(h.stranger_fd);
+    }
     peer_free(&peer);
     grid_free(&grid);
     if (h.follow_fd >= 0)

@@ -616,6 +616,19 @@ check_scenario() {
     # The board's states as it logged them, for a failure: "ACTIVE FAULT(drive heartbeat lost)".
     states=$(sed -n 's/^[0-9.]* argil-board: state \([A-Z]*\)\( — \(.*\)\)*$/\1(\3)/p' "$OUT/$CHECK.board.log" | sed 's/()//' | tr '\n' ' ')
     [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag; board: $states]"; return; }
+    # A stranger on the network (`stranger KIND for D`): the board refused its frames by reason,
+    # as its RT_STATS told hil-host, and served one host session throughout.
+    if grep -q '^at .* stranger ' "$scn"; then
+        sl=$(grep ' stranger replayed_other=' "$OUT/$CHECK.host.log" | tail -n 1)
+        [ -n "$sl" ] || { fail "$res, but hil-host reported no stranger line"; return; }
+        ws=$(echo "$sl" | sed -n 's/.* wrong_source=\([0-9]*\).*/\1/p')
+        dup=$(echo "$sl" | sed -n 's/.* duplicate=\([0-9]*\) stale=\([0-9]*\).*/\1 + \2/p')
+        ses=$(echo "$sl" | sed -n 's/.* sessions=\([0-9]*\).*/\1/p')
+        dup=$((${dup:-0}))
+        [ "${ws:-0}" -gt 0 ] && [ "$dup" -gt 0 ] && [ "${ses:-0}" = 1 ] ||
+            { fail "$res, but the board's refusals do not show the stranger: $(echo "$sl" | cut -d' ' -f2-)"; return; }
+        res="$res; stranger refused: wrong source $ws, replayed $dup, one session"
+    fi
     pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag)"
 }
 

@@ -18,7 +18,14 @@ static const char *const action_names[SCN_ACTION_COUNT] = {
     "hand", "hand release", "button", "estop", "drive_fault_line", "emcy", "heartbeat",
     "encoder_jump", "can_drop", "can_delay", "bus_off", "bus_restart", "link lost",
     "link restore", "link delay", "link duplicate", "link reorder", "link garbage",
-    "link nan_tool", "overrun", "rearm"};
+    "link nan_tool", "stranger", "overrun", "rearm"};
+
+static const char *const stranger_names[SCN_STRANGER_COUNT] = {"replay", "forge", "flood"};
+
+const char *scenario_stranger_name(scn_stranger_t k)
+{
+    return (unsigned)k < SCN_STRANGER_COUNT ? stranger_names[k] : "?";
+}
 
 static const char *const expect_names[SCN_EXP_COUNT] = {
     "torque_zero", "force_zero", "quick_stop", "fault", "enabled", "torque_nonzero",
@@ -312,6 +319,22 @@ static scn_err_t parse_action(const words_t *w, uint32_t at, uint32_t line, scn_
             return fail(err, SCN_ERR_ARG, line, "overrun needs a tick count 1-1000, got '%s'",
                         next);
         *used = at + 2;
+        return SCN_OK;
+    }
+    if (strcmp(a, "stranger") == 0) {
+        st->action = SCN_STRANGER;
+        st->a = -1;
+        for (int k = 0; k < (int)SCN_STRANGER_COUNT; k++)
+            if (strcmp(next, stranger_names[k]) == 0)
+                st->a = k;
+        if (st->a < 0)
+            return fail(err, SCN_ERR_ARG, line,
+                        "stranger needs replay, forge or flood, got '%s'", next);
+        if (at + 3 >= w->n || strcmp(w->w[at + 2], "for") != 0 ||
+            !parse_duration(w->w[at + 3], &st->dur_us) || st->dur_us > 10000000)
+            return fail(err, SCN_ERR_DURATION, line,
+                        "stranger %s needs 'for D' with D up to 10s, like 'for 500ms'", next);
+        *used = at + 4;
         return SCN_OK;
     }
     if (strcmp(a, "link") == 0) {

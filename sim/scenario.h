@@ -55,10 +55,23 @@ typedef enum {
     SCN_LINK_REORDER,   /* host side: the next a pairs of frames to the board swap places */
     SCN_LINK_GARBAGE,   /* host side: a bytes (1..1024, one frame at most) of noise */
     SCN_LINK_NAN,       /* host side: a TOOL frame with a NaN field (valid CRC) */
+    SCN_STRANGER,       /* host side: a hostile sender for dur_us, a = scn_stranger_t */
     SCN_OVERRUN,        /* host side: the next a board ticks overrun their 1 ms deadline */
     SCN_REARM,          /* host side: the host sends ARM */
     SCN_ACTION_COUNT
 } scn_action_t;
+
+/* What a hostile sender on the host's network does (`at T stranger KIND for D`). */
+typedef enum {
+    SCN_STRANGER_REPLAY = 0, /* resends the host's captured frames, from another address and
+                                from the host's own (spoofed) */
+    SCN_STRANGER_FORGE = 1,  /* CRC-valid commands (HELLO, DISARM, END, a stiffer TOOL) with no
+                                or a wrong authentication tag, from both addresses */
+    SCN_STRANGER_FLOOD = 2,  /* junk datagrams as fast as it can, from another address */
+    SCN_STRANGER_COUNT
+} scn_stranger_t;
+
+const char *scenario_stranger_name(scn_stranger_t k);
 
 /* True for the steps the host side of a rig performs (link, overrun, rearm); argil-sim does
  * only the others. */

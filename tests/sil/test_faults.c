@@ -65,10 +65,20 @@ typedef struct {
     uint32_t n_force;
     bool was_active, left_active;      /* ACTIVE once; left it afterwards */
     bool no_link_faults;               /* the twin run: the scenario's link faults not applied */
-    /* a stranger on the network (another sender) between these times, every 5 ms */
+    /* a stranger on the network between these times (`stranger KIND for D`, or set by a
+     * test): forge = CRC-valid commands from another sender every 5 ms; replay = the host's
+     * captured frames again, every 1 ms from another sender and from the host's own; flood =
+     * 20 junk datagrams a millisecond from another sender */
+    int stranger_kind;
     int64_t stranger_from_us, stranger_until_us;
-    uint32_t stranger_sent;
+    uint32_t stranger_sent;            /* forged commands */
+    uint32_t replayed_other, replayed_own, flooded;
+    held_frame_t *captured;            /* the host's last CAPTURED_MAX frames, as sent */
+    uint32_t n_captured, replay_next;
 } fx_t;
+
+#define CAPTURED_MAX 64u
+#define HAL_SIM_STRANGER 2u            /* another sender on the host's network */
 
 #define FORCE_TICKS_MAX 10000u
 
@@ -116,6 +126,11 @@ static void hold(fx_t *x, const uint8_t *f, size_t len, int64_t due_us)
 static bool link_hook(void *ctx, const uint8_t *f, size_t len)
 {
     fx_t *x = ctx;
+    if (len <= PROTO_FRAME_MAX) { /* what a stranger on the network captures */
+        held_frame_t *c = &x->captured[x->n_captured++ % CAPTURED_MAX];
+        c->len = len;
+        memcpy(c->bytes, f, len);
+    }
     if (x->lost)
         return true; /* sent, and lost on the way */
     if (x->delay_us > 0) {
@@ -226,6 +241,13 @@ static void host_step(fx_t *x, const scn_step_t *st)
     case SCN_LINK_NAN: send_nan_tool(x); break;
     case SCN_OVERRUN: x->overrun_left = (uint32_t)st->a; break;
     case SCN_REARM: send_rearm(x); break;
+    case SCN_STRANGER:
+        if (!x->no_link_faults) {
+            x->stranger_kind = st->a;
+            x->stranger_from_us = x->run.now_us;
+            x->stranger_until_us = x->run.now_us + st->dur_us;
+        }
+        break;
     default: return;
     }
     char text[SCN_TEXT_LEN + 24];
@@ -256,8 +278,50 @@ static void stranger_send(fx_t *x)
     size_t len = 0;
     assert_int_equal(proto_encode(&m, x->r->peer.tx_seq + 1000u + x->stranger_sent, buf,
                                   sizeof(buf), &len), PROTO_OK);
-    assert_int_equal(hal_sim_host_send_from(&x->r->hal, 2u, buf, len), ARGIL_OK);
+    assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, buf, len), ARGIL_OK);
     x->stranger_sent++;
+}
+
+/* One millisecond of the stranger's kind. */
+static void stranger_tick(fx_t *x, int64_t now)
+{
+    switch (x->stranger_kind) {
+    case SCN_STRANGER_FORGE:
+        if (now % 5000 == 0)
+            stranger_send(x);
+        break;
+    case SCN_STRANGER_REPLAY: {
+        const uint32_t n = x->n_captured < CAPTURED_MAX ? x->n_captured : CAPTURED_MAX;
+        if (n == 0)
+            break;
+        const held_frame_t *c = &x->captured[x->replay_next++ % n];
+        assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, c->bytes, c->len),
+                         ARGIL_OK);
+        x->replayed_other++;
+        (void)hal_sim_host_send(&x->r->hal, c->bytes, c->len); /* the host's own address */
+        x->replayed_own++;
+        break;
+    }
+    case SCN_STRANGER_FLOOD: {
+        uint32_t v = 0x9E3779B9u ^ (uint32_t)now;
+        for (int k = 0; k < 20; k++) {
+            uint8_t junk[1024];
+            v = v * 1103515245u + 12345u;
+            const size_t n = 1u + (v >> 8) % sizeof(junk);
+            for (size_t i = 0; i < n; i++) {
+                v = v * 1103515245u + 12345u;
+                junk[i] = (uint8_t)(v >> 16);
+            }
+            if (k % 2 == 0 && n >= 4)
+                memcpy(junk, "ARGL", 4); /* starts like a frame */
+            assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, junk, n),
+                             ARGIL_OK);
+            x->flooded++;
+        }
+        break;
+    }
+    default: break;
+    }
 }
 
 /* One millisecond: device side (scenario + faults), board tick, host side. */
@@ -271,8 +335,8 @@ static void fx_tick(fx_t *x)
             host_step(x, st);
     }
     release_held(x);
-    if (now >= x->stranger_from_us && now < x->stranger_until_us && now % 5000 == 0)
-        stranger_send(x);
+    if (now >= x->stranger_from_us && now < x->stranger_until_us)
+        stranger_tick(x, now);
     can_batch_t from_board, to_b;
     hal_sim_take_from_board(&r->hal, &from_board);
     sim_runner_tick(&x->run, &from_board, hal_sim_gpio_out(&r->hal), &to_b, 1000);
@@ -327,6 +391,9 @@ static fx_t *fx_new(const char *path)
     x->force = calloc(FORCE_TICKS_MAX, sizeof(*x->force));
     assert_non_null(x->force);
     x->stranger_from_us = x->stranger_until_us = -1;
+    x->stranger_kind = SCN_STRANGER_FORGE;
+    x->captured = calloc(CAPTURED_MAX, sizeof(*x->captured));
+    assert_non_null(x->captured);
     x->can_log = open_memstream(&x->can_text, &x->can_len);
     x->ev_log = open_memstream(&x->ev_text, &x->ev_len);
     assert_non_null(x->can_log);
@@ -376,6 +443,7 @@ static void fx_free(fx_t *x)
     free(x->can_text);
     free(x->ev_text);
     free(x->held);
+    free(x->captured);
     free(x->force);
     rig_free(x->r);
     free(x);
@@ -434,6 +502,7 @@ static const matrix_row_t matrix[] = {
     {"link_garbage.scn", -1, 5, FAULT_NONE, 0},
     {"link_nan.scn", FAULT_NONFINITE, 1, FAULT_NONE, 0},
     {"overrun.scn", FAULT_DEADLINE, 0, FAULT_NONE, 0},
+    {"hostile_network.scn", -1, 0, FAULT_NONE, 0},
 };
 
 /* Runs a row and checks it; returns the run for more checks (fx_free it). */
@@ -584,6 +653,40 @@ static void test_stranger_cannot_command_the_arm(void **st)
     fx_free(x);
 }
 
+/* hostile_network.scn: while the hand presses and strokes the clay a stranger replays the
+ * host's captured frames (from another sender and from the host's own), sends CRC-valid
+ * commands from another sender, and floods junk. Each frame is refused and counted by its
+ * reason, the board stays ACTIVE with its one session, and the hand feels exactly what it
+ * feels with no stranger. (The forged authentication tag over UDP, where a stranger can spoof
+ * the host's own address, is the HIL's and test_link_auth's: this link carries no tag.) */
+static void test_hostile_network(void **st)
+{
+    (void)st;
+    fx_t *t;
+    float diff, peak;
+    fx_t *x = run_with_twin(&matrix[17], &t, &diff, &peak);
+    const board_stats_t *bs = &x->r->board.stats;
+    printf("  hostile_network: replayed %u from another sender + %u from the host's, forged %u, "
+           "flooded %u; refused: sender %u, duplicate %u, stale %u; board %s, left ACTIVE %s, "
+           "sessions %u; force differs from the run without the stranger by %.6f N (peak "
+           "%.3f N)\n", x->replayed_other, x->replayed_own, x->stranger_sent, x->flooded,
+           bs->transport_refused_source, bs->refused_duplicate, bs->refused_stale,
+           safety_state_name(x->r->board.safety.state), x->left_active ? "yes" : "no",
+           x->r->board.session.epoch, (double)diff, (double)peak);
+    assert_true(x->replayed_own >= 500u && x->stranger_sent >= 100u && x->flooded >= 10000u);
+    assert_int_equal(bs->transport_refused_source,
+                     x->replayed_other + x->stranger_sent + x->flooded);
+    assert_int_equal(bs->refused_duplicate + bs->refused_stale, x->replayed_own);
+    assert_int_equal(x->r->board.session.epoch, 1);
+    assert_true(x->first_bad_us < 0);
+    assert_true(x->was_active);
+    assert_false(x->left_active);
+    assert_true(peak > 0.5f);
+    assert_true(diff == 0.0f);
+    fx_free(t);
+    fx_free(x);
+}
+
 #define ROW_TEST(name, i)                  \
     static void name(void **st)            \
     {                                      \
@@ -705,6 +808,7 @@ int main(void)
         cmocka_unit_test(test_link_duplicate),
         cmocka_unit_test(test_link_reorder),
         cmocka_unit_test(test_stranger_cannot_command_the_arm),
+        cmocka_unit_test(test_hostile_network),
         cmocka_unit_test(test_link_garbage),
         cmocka_unit_test(test_link_nan),
         cmocka_unit_test(test_overrun),

@@ -109,6 +109,42 @@ static void test_a_full_scenario(void **st)
     assert_int_equal(s.expect[6].within_us, 250);
 }
 
+/* A hostile sender: three kinds, each for a stated time; anything else names its line. */
+static void test_stranger_steps(void **st)
+{
+    (void)st;
+    scn_error_t err;
+    assert_int_equal(parse("duration 15s\n"
+                           "at 1.0 stranger replay for 800ms\n"
+                           "at 2.0 stranger forge for 1s\n"
+                           "at 3.0 stranger flood for 10s\n", &err), SCN_OK);
+    assert_int_equal(s.n_steps, 3);
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(s.step[k].action, SCN_STRANGER);
+        assert_int_equal(s.step[k].a, k);
+    }
+    assert_int_equal(s.step[0].dur_us, 800000);
+    assert_int_equal(s.step[2].dur_us, 10000000);
+    assert_true(scenario_action_is_host_side(SCN_STRANGER));
+    assert_string_equal(scenario_stranger_name(SCN_STRANGER_FLOOD), "flood");
+    static const struct {
+        const char *line;
+        scn_err_t e;
+    } bad[] = {
+        {"at 1 stranger dance for 1s\n", SCN_ERR_ARG},
+        {"at 1 stranger replay\n", SCN_ERR_DURATION},
+        {"at 1 stranger replay 1s\n", SCN_ERR_DURATION},
+        {"at 1 stranger replay for 11s\n", SCN_ERR_DURATION},
+        {"at 1 stranger flood for 1s now\n", SCN_ERR_TRAILING},
+    };
+    for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+        char text[128];
+        snprintf(text, sizeof(text), "duration 20s\n%s", bad[k].line);
+        assert_int_equal(parse(text, &err), bad[k].e);
+        assert_int_equal(err.line, 2);
+    }
+}
+
 static void test_every_shipped_scenario_parses(void **st)
 {
     (void)st;
@@ -296,6 +332,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_full_scenario),
+        cmocka_unit_test(test_stranger_steps),
         cmocka_unit_test(test_every_shipped_scenario_parses),
         cmocka_unit_test(test_every_refusal_names_its_line),
         cmocka_unit_test(test_too_many_steps_and_expectations),
