@@ -74,17 +74,27 @@ static bool g_keyed;
 static link_auth_host_t g_auth;
 static pthread_mutex_t g_auth_mu = PTHREAD_MUTEX_INITIALIZER;
 
+/* The datagram a frame goes out as (keyed: sealed) in out; its length, 0 when not sent. */
+static size_t udp_wire(const uint8_t *f, size_t len, uint8_t *out, size_t cap)
+{
+    if (!g_keyed) {
+        if (len > cap)
+            return 0;
+        memcpy(out, f, len);
+        return len;
+    }
+    pthread_mutex_lock(&g_auth_mu);
+    len = link_auth_host_seal(&g_auth, f, len, out, cap);
+    pthread_mutex_unlock(&g_auth_mu);
+    return len;
+}
+
 static void udp_out(int fd, const struct sockaddr_in *to, const uint8_t *f, size_t len)
 {
-    uint8_t sealed[LINK_AUTH_DGRAM_MAX];
-    if (g_keyed) {
-        pthread_mutex_lock(&g_auth_mu);
-        len = link_auth_host_seal(&g_auth, f, len, sealed, sizeof(sealed));
-        pthread_mutex_unlock(&g_auth_mu);
-        f = sealed;
-    }
+    uint8_t wire[LINK_AUTH_DGRAM_MAX];
+    len = udp_wire(f, len, wire, sizeof(wire));
     if (len > 0)
-        (void)sendto(fd, f, len, 0, (const struct sockaddr *)to, sizeof(*to));
+        (void)sendto(fd, wire, len, 0, (const struct sockaddr *)to, sizeof(*to));
 }
 
 /* The next datagram's frames from the board (keyed: verified, the trailer off); <= 0: none. */
@@ -125,6 +135,11 @@ typedef struct {
 } held_t;
 
 #define CAPTURED_MAX 64u
+
+typedef struct {
+    size_t len;
+    uint8_t b[LINK_AUTH_DGRAM_MAX];
+} wire_t;
 #define STRANGER_ADDR "127.0.0.2"   /* another address on the host's network (loopback /8) */
 
 typedef struct {
@@ -136,7 +151,7 @@ typedef struct {
     int stranger_fd;
     int stranger_kind;              /* scn_stranger_t while active, -1 */
     uint64_t stranger_until_us, stranger_last_us;
-    held_t captured[CAPTURED_MAX];
+    wire_t captured[CAPTURED_MAX];   /* datagrams as they went on the wire */
     uint32_t n_captured, replay_next;
     uint32_t replayed_other, replayed_own, forged, flooded, stranger_errors;
     bool lost;
@@ -177,13 +192,15 @@ typedef struct {
 
 static void raw_send(shost_t *h, const uint8_t *f, size_t len)
 {
-    udp_out(h->fd, &h->board, f, len);
-    h->frames_sent++;
-    if (len <= PROTO_FRAME_MAX) { /* what a stranger on the network captures */
-        held_t *c = &h->captured[h->n_captured++ % CAPTURED_MAX];
-        c->len = len;
-        memcpy(c->b, f, len);
+    /* sealed as it goes, and kept as a stranger on the network captures it */
+    wire_t *c = &h->captured[h->n_captured % CAPTURED_MAX];
+    c->len = udp_wire(f, len, c->b, sizeof(c->b));
+    if (c->len > 0) {
+        (void)sendto(h->fd, c->b, c->len, 0, (const struct sockaddr *)&h->board,
+                     sizeof(h->board));
+        h->n_captured++;
     }
+    h->frames_sent++;
 }
 
 /* A datagram from the stranger's socket (another address), or from the host's own (a spoofed
@@ -256,7 +273,7 @@ static void stranger_tick(shost_t *h)
         const uint32_t n = h->n_captured < CAPTURED_MAX ? h->n_captured : CAPTURED_MAX;
         if (n == 0)
             return;
-        const held_t *c = &h->captured[h->replay_next++ % n];
+        const wire_t *c = &h->captured[h->replay_next++ % n];
         stranger_sendto(h, false, c->b, c->len);
         h->replayed_other++;
         stranger_sendto(h, true, c->b, c->len);
@@ -266,12 +283,26 @@ static void stranger_tick(shost_t *h)
     case SCN_STRANGER_FORGE: {
         if ((now / 1000u) % 5u != 0)
             return;
-        uint8_t buf[PROTO_FRAME_MAX];
+        uint8_t buf[PROTO_FRAME_MAX], sealed[LINK_AUTH_DGRAM_MAX];
         const size_t len = stranger_command(h, buf, sizeof(buf));
         if (len == 0)
             return;
+        /* with no tag, and (on a keyed link) with a wrong key's tag over the session's own
+         * nonce, from both addresses */
         stranger_sendto(h, false, buf, len);
         stranger_sendto(h, true, buf, len);
+        if (g_keyed) {
+            static const link_key_t wrong = {{0x5A}};
+            pthread_mutex_lock(&g_auth_mu);
+            const uint64_t nonce = g_auth.nonce;
+            pthread_mutex_unlock(&g_auth_mu);
+            const size_t n = link_auth_seal(&wrong, LINK_AUTH_HOST_TO_BOARD, nonce, buf, len,
+                                            sealed, sizeof(sealed));
+            if (n > 0) {
+                stranger_sendto(h, false, sealed, n);
+                stranger_sendto(h, true, sealed, n);
+            }
+        }
         h->forged++;
         return;
     }
@@ -826,11 +857,13 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
         /* what the stranger sent, and the board's refusals as its last RT_STATS counts them */
         const proto_link_counts_t *lc = &peer.last_rt.link;
         printf("%.6f stranger replayed_other=%u replayed_own=%u forged=%u flooded=%u "
-               "send_errors=%u; board refused wrong_source=%u no_session=%u duplicate=%u "
-               "stale=%u decode_errors=%u sessions=%u (RT_STATS %u)\n",
+               "send_errors=%u keyed=%d; board refused wrong_source=%u no_session=%u "
+               "duplicate=%u stale=%u decode_errors=%u bad_mac=%u bad_nonce=%u sessions=%u "
+               "(RT_STATS %u)\n",
                realtime_s(), h.replayed_other, h.replayed_own, h.forged, h.flooded,
-               h.stranger_errors, lc->wrong_source, lc->no_session, lc->duplicate, lc->stale,
-               lc->decode_errors, lc->sessions, peer.stats.rt_stats_frames);
+               h.stranger_errors, g_keyed ? 1 : 0, lc->wrong_source, lc->no_session,
+               lc->duplicate, lc->stale, lc->decode_errors, lc->bad_mac, lc->bad_nonce,
+               lc->sessions, peer.stats.rt_stats_frames);
         close(h.stranger_fd);
     }
     peer_free(&peer);

@@ -624,10 +624,16 @@ check_scenario() {
         ws=$(echo "$sl" | sed -n 's/.* wrong_source=\([0-9]*\).*/\1/p')
         dup=$(echo "$sl" | sed -n 's/.* duplicate=\([0-9]*\) stale=\([0-9]*\).*/\1 + \2/p')
         ses=$(echo "$sl" | sed -n 's/.* sessions=\([0-9]*\).*/\1/p')
+        mac=$(echo "$sl" | sed -n 's/.* bad_mac=\([0-9]*\).*/\1/p')
+        keyed=$(echo "$sl" | sed -n 's/.* keyed=\([01]\).*/\1/p')
         dup=$((${dup:-0}))
-        [ "${ws:-0}" -gt 0 ] && [ "$dup" -gt 0 ] && [ "${ses:-0}" = 1 ] ||
+        # Keyed, a tag is checked first: forged and junk datagrams are bad tags; the captured
+        # ones verify and are refused for their sender (another address) or as replays (the
+        # host's own). Unkeyed, only the sender and the sequence window stand in the way.
+        [ "${ws:-0}" -gt 0 ] && [ "$dup" -gt 0 ] && [ "${ses:-0}" = 1 ] &&
+            { [ "${keyed:-0}" = 0 ] || [ "${mac:-0}" -gt 0 ]; } ||
             { fail "$res, but the board's refusals do not show the stranger: $(echo "$sl" | cut -d' ' -f2-)"; return; }
-        res="$res; stranger refused: wrong source $ws, replayed $dup, one session"
+        res="$res; stranger refused: wrong source $ws, replayed $dup, bad tag ${mac:-0}, one session"
     fi
     pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag)"
 }
