@@ -72,7 +72,8 @@ static uint64_t mono_us(void)
  * thread: the heartbeats' and the peer's). */
 static bool g_keyed;
 static link_auth_host_t g_auth;
-static pthread_mutex_t g_auth_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_mutex_t g_auth_mu; /* priority inheritance (main): the heartbeat thread must
+                                     not wait behind the peer's loop sealing a window */
 
 /* The datagram a frame goes out as (keyed: sealed) in out; its length, 0 when not sent. */
 static size_t udp_wire(const uint8_t *f, size_t len, uint8_t *out, size_t cap)
@@ -918,6 +919,11 @@ int main(int argc, char **argv)
     }
     if (g_keyed)
         link_auth_host_init(&g_auth, &key);
+    pthread_mutexattr_t auth_attr;
+    pthread_mutexattr_init(&auth_attr);
+    pthread_mutexattr_setprotocol(&auth_attr, PTHREAD_PRIO_INHERIT);
+    pthread_mutex_init(&g_auth_mu, &auth_attr);
+    pthread_mutexattr_destroy(&auth_attr);
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
     if (fd < 0) {
         perror("hil-host: socket");

@@ -31,6 +31,9 @@ const board_setting_t board_settings[] = {
     {"link", "heartbeat_timeout_ms", "host-timeout-ms", "MS",
      "host heartbeat silence that stops sculpting and fades the force (50)"},
     {"link", "fade_ms", "host-fade-ms", "MS", "force fade to zero after the host is lost (20)"},
+    {"link", "rt_priority", "link-rt-priority", "PRIO",
+     "SCHED_FIFO priority of the link thread(s), 1-99, used when the loop is real-time; 0 = 10 "
+     "under the loop's (0)"},
     {"link", "key", "key", "FILE",
      "UDP link key file (argil keygen FILE; mode 0600): every datagram carries its tag. With no "
      "key the board refuses to arm over UDP (none)"},
@@ -224,6 +227,12 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
         if (parse_long(v, 0, 99, &x) != ARGIL_OK)
             return BAD("loop.rt_priority '%s': expected 0-99", v);
         c->rt_priority = (int32_t)x;
+        return ARGIL_OK;
+    }
+    if (IS("link", "rt_priority")) {
+        if (parse_long(v, 0, 99, &x) != ARGIL_OK)
+            return BAD("link.rt_priority '%s': expected 0-99", v);
+        c->link_rt_priority = (int32_t)x;
         return ARGIL_OK;
     }
     if (IS("loop", "cpu")) {

@@ -30,6 +30,7 @@ typedef struct {
     uint32_t host_fade_ms;
     uint32_t rate_hz;                /* 1000, 2000 or 4000 (100 … 10000 accepted) */
     int32_t rt_priority;             /* SCHED_FIFO 1..99; 0 = stay SCHED_OTHER */
+    int32_t link_rt_priority;        /* the link thread(s): 1..99; 0 = rt_priority − 10 */
     int32_t cpu;                     /* CPU to pin the fast loop to; -1 = any */
     uint32_t overrun_streak;         /* consecutive overruns that are a fault; 0 = never */
     float max_force_n;

@@ -634,7 +634,10 @@ int main(int argc, char **argv)
     }
 
     pthread_t loop_t, link_t, extra_t[2];
-    const int link_prio = c->rt_priority > 10 ? c->rt_priority - 10 : 0;
+    const int link_prio = c->rt_priority <= 0        ? 0
+                          : c->link_rt_priority > 0 ? c->link_rt_priority
+                          : c->rt_priority > 10     ? c->rt_priority - 10
+                                                    : 0;
     if (c->link == BOARD_LINK_UDP) {
         if (start_thread(&link_t, udp_thread, &d, link_prio, -1, why, sizeof(why)) != 0)
             return fail(3, "cannot start the link thread (%s)%s", why, "");

@@ -623,7 +623,8 @@ static void test_config_ini_and_refusals(void **st)
     char why[200];
     uint32_t line = 0;
     const char *ok = "; comment\n[can]\ninterface = can1\n[gpio]\nestop = EMERG ; inline\n"
-                     "[link]\nhost = ffs:/dev/ffs-argil\n[loop]\nrate_hz=4000\ncpu = 1\n"
+                     "[link]\nhost = ffs:/dev/ffs-argil\nrt_priority = 79\n[loop]\nrate_hz=4000\n"
+                     "cpu = 1\n"
                      "[transform]\noffset_m = 0.01,-0.02,0.5\n";
     assert_int_equal(board_config_parse_ini(&c, ok, strlen(ok), &line, why, sizeof(why)), ARGIL_OK);
     assert_string_equal(c.can_if, "can1");
@@ -631,6 +632,7 @@ static void test_config_ini_and_refusals(void **st)
     assert_int_equal(c.link, BOARD_LINK_FFS);
     assert_string_equal(c.link_target, "/dev/ffs-argil");
     assert_int_equal(c.rate_hz, 4000);
+    assert_int_equal(c.link_rt_priority, 79);
     assert_float_equal(c.model_offset_m[1], -0.02f, 1e-7f);
     static const struct { const char *text; uint32_t line; const char *says; } bad[] = {
         {"x = 1\n", 1, "outside any [section]"},
@@ -638,6 +640,7 @@ static void test_config_ini_and_refusals(void **st)
         {"[loop]\nrate_hz\n", 2, "expected key = value"},
         {"[loop]\nrate_hz = 3000\n", 2, "rate_hz '3000'"},
         {"[loop]\nrt_priority = 100\n", 2, "expected 0-99"},
+        {"[link]\nrt_priority = -1\n", 2, "link.rt_priority '-1'"},
         {"[loop]\nbogus = 1\n", 2, "unknown setting 'loop.bogus'"},
         {"[can]\nbus = vcan\n", 2, "expected socketcan or sim"},
         {"[limits]\nmax_force_n = nan\n", 2, "max_force_n"},
