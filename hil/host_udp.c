@@ -488,6 +488,8 @@ static void shost_steps(shost_t *h)
  * so a SYNC is counted as it comes and a step lands in the tick it names, however busy the
  * peer is) and the host-side steps; and a heartbeat carrying the peer's window version and
  * impulse ack every 5 ms of CLOCK_MONOTONIC until h->stop, whatever the main loop is doing. */
+static void shost_release_held(shost_t *h, bool all);
+
 static void *shost_rt(void *arg)
 {
     shost_t *h = arg;
@@ -518,6 +520,13 @@ static void *shost_rt(void *arg)
             stranger_tick(h);
             pthread_mutex_unlock(&h->mu);
         }
+        /* `link delay`: the held frames go when due from here, not from the peer's loop, which
+         * a global solve under TCG holds for 100s of ms (the board then lost its host: the
+         * heartbeats waited behind the solve, not behind the 30 ms delay) */
+        pthread_mutex_lock(&h->mu);
+        if (h->n_held > 0)
+            shost_release_held(h, false);
+        pthread_mutex_unlock(&h->mu);
         atomic_store(&h->synced_flag, h->synced);
         atomic_store(&h->now_us, (long long)h->clk.now_us);
         if (mono_us() < next_beat)

@@ -123,15 +123,28 @@ can_log_start() {
     CANDUMP_PID=$!; sleep 0.2
 }
 # candump runs under the rig's real-time work and may be far behind (0.7 s of frames were still
-# in its socket when a scenario's log was cut, 2026-12-02): before it is stopped it must have
-# written a frame stamped after now (the board still ticks, so one comes), at most 10 s.
+# in its socket when a scenario's log was cut, 2026-12-02): before it is stopped it writes out
+# what it holds: while the board ticks, until a frame stamped after now is in the log; once the
+# board is gone, until the log stops growing for 0.3 s; at most 10 s. (Its own variable names:
+# the checks' are global.)
 can_log_stop() {
     [ -n "$CANDUMP_PID" ] || return 0
-    t_stop=$(hil-probe now)
-    i=0
-    while [ "$i" -lt 100 ] && kill -0 "$CANDUMP_PID" 2>/dev/null; do
-        last=$(tail -n 1 "$OUT/$CHECK.candump.log" 2>/dev/null | sed -n 's/^(\([0-9.]*\)).*/\1/p')
-        [ -n "$last" ] && awk -v a="$last" -v b="$t_stop" 'BEGIN { exit !(a >= b) }' && break
+    cls_t=$(hil-probe now) cls_i=0 cls_size=-1 cls_still=0
+    while [ "$cls_i" -lt 100 ] && kill -0 "$CANDUMP_PID" 2>/dev/null; do
+        if board_alive; then
+            cls_last=$(tail -n 1 "$OUT/$CHECK.candump.log" 2>/dev/null | sed -n 's/^(\([0-9.]*\)).*/\1/p')
+            [ -n "$cls_last" ] && awk -v a="$cls_last" -v b="$cls_t" 'BEGIN { exit !(a >= b) }' && break
+        else
+            cls_now=$(wc -c <"$OUT/$CHECK.candump.log" 2>/dev/null || echo 0)
+            if [ "$cls_now" = "$cls_size" ]; then cls_still=$((cls_still + 1)); else cls_still=0; fi
+            [ "$cls_still" -ge 3 ] && break
+            cls_size=$cls_now
+        fi
+        sleep 0.1; cls_i=$((cls_i + 1))
+    done
+    kill "$CANDUMP_PID" 2>/dev/null; wait "$CANDUMP_PID" 2>/dev/null; CANDUMP_PID=
+}
+ && break
         sleep 0.1; i=$((i + 1))
     done
     kill "$CANDUMP_PID" 2>/dev/null; wait "$CANDUMP_PID" 2>/dev/null; CANDUMP_PID=
