@@ -144,11 +144,6 @@ can_log_stop() {
     done
     kill "$CANDUMP_PID" 2>/dev/null; wait "$CANDUMP_PID" 2>/dev/null; CANDUMP_PID=
 }
- && break
-        sleep 0.1; i=$((i + 1))
-    done
-    kill "$CANDUMP_PID" 2>/dev/null; wait "$CANDUMP_PID" 2>/dev/null; CANDUMP_PID=
-}
 # Frames with this id#data prefix (e.g. "080#", "000#0101") in the check's CAN log.
 can_count() { grep -c " $CAN_IF $1" "$OUT/$CHECK.candump.log"; }
 can_first() { grep -m 1 " $CAN_IF $1" "$OUT/$CHECK.candump.log" | sed 's/^(\([0-9.]*\)).*/\1/'; }
