@@ -404,6 +404,20 @@ static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
     return o->start_us + t_us;
 }
 
+/* The instant the rig's clock reached the scenario's end: its (duration / 1 ms)-th SYNC after
+ * the start line; INT64_MAX without SYNCs or when the log ends first. */
+static int64_t rig_end(const scenario_t *s, const hil_obs_t *o)
+{
+    if (o->n_syncs == 0 || !o->have_start)
+        return INT64_MAX;
+    const int64_t want = s->duration_us / HIL_TICK_US;
+    int64_t n = 0;
+    for (size_t k = 0; k < o->n_frames; k++)
+        if (o->frame[k].t_us > o->start_us && is_sync(&o->frame[k]) && ++n == want)
+            return o->frame[k].t_us;
+    return INT64_MAX;
+}
+
 /* True when scenario time t_us is anchored on a host-side step the log holds: the board sees
  * it only once the host link has delivered it. */
 static bool host_anchored(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
@@ -621,7 +635,15 @@ void hil_check_expect(const scenario_t *s, const hil_obs_t *o, uint32_t i, hil_r
     const int64_t t0 = abs_time(s, o, e->t_us);
     /* A host-side step reaches the board through the link: its bound starts link_ticks later. */
     const int64_t link = o->n_syncs > 0 && host_anchored(s, o, e->t_us) ? o->link_ticks : 0;
-    const int64_t t_end = abs_time(s, o, scenario_until_us(s, e));
+    /* A window ends no later than the rig's own end: the SYNC at which its clock (one tick per
+     * SYNC since the start line) reached the duration. A time counted from a step's logged
+     * injection carries the arm stand-in's lag at that step, and counted past the end it ran
+     * into the rig's shutdown: the arm stops answering, the host leaves (can_drop_1pct, CI
+     * 2026-12-02: "heartbeat 253 ticks old" and a host-lost fault, both after the end). */
+    int64_t t_end = abs_time(s, o, scenario_until_us(s, e));
+    const int64_t t_rig_end = rig_end(s, o);
+    if (t_end > t_rig_end)
+        t_end = t_rig_end;
     const int64_t t_bound = bound_end(o, t0, e->within_us, link);
     const bool gpio = o->n_gpio > 0;
     char la[48], bo[48];

@@ -352,6 +352,49 @@ static void test_enabled_counts_the_boards_ticks_not_the_drives(void **st)
     hil_obs_free(&o);
 }
 
+/* A run whose step at 1.0 was logged 100 ticks late (the arm stand-in lagging) and whose
+ * drives go off at off_ms after the start, at 1 kHz with a SYNC each tick. */
+static void synth_lagged_end(hil_obs_t *o, const scenario_t *sc, int64_t off_ms)
+{
+    hil_obs_init(o);
+    const char ev[] = "(10.000000) start scenario e\n(11.100000) inject line=3 at 1.0 can_drop\n";
+    uint32_t line;
+    assert_int_equal(hil_obs_add_events(o, sc, ev, strlen(ev), &line), HIL_OK);
+    for (int64_t ms = 0; ms < 3300; ms++) {
+        const int64_t t = 10000000 + ms * 1000 + 500;
+        can_frame_t f;
+        for (uint8_t n = 1; n <= 3; n++) {
+            canopen_rpdo_encode(&f, n, ms < off_ms ? CIA402_CW_ENABLE_OP : CIA402_CW_QUICK_STOP, 0);
+            assert_int_equal(hil_obs_push_frame(o, t, &f), HIL_OK);
+        }
+        f = (can_frame_t){.id = CANOPEN_COB_SYNC, .len = 0};
+        assert_int_equal(hil_obs_push_frame(o, t + 200, &f), HIL_OK);
+    }
+}
+
+/* A window "until end" stops at the rig's end (its clock's last SYNC), not 100 ticks later
+ * where a time counted from a lagged injection puts it: there the rig was shutting down. */
+static void test_until_end_stops_at_the_rigs_end(void **st)
+{
+    (void)st;
+    static const char text[] = "name e\nduration 3s\nat 1.0 can_drop 1% seed 1\n"
+                               "expect at 1.0 running until end\n";
+    static scenario_t sc;
+    scn_error_t err;
+    assert_int_equal(scenario_parse(&sc, text, sizeof(text) - 1, &err), SCN_OK);
+    hil_obs_t o;
+    hil_result_t r;
+    synth_lagged_end(&o, &sc, 3050);   /* off 50 ticks after the end: not the board's doing */
+    hil_check_expect(&sc, &o, 0, &r);
+    if (!r.pass)
+        fail_msg("%s", r.msg);
+    hil_obs_free(&o);
+    synth_lagged_end(&o, &sc, 2950);   /* off 50 ticks before it: a failure */
+    hil_check_expect(&sc, &o, 0, &r);
+    assert_false(r.pass);
+    hil_obs_free(&o);
+}
+
 /* With SYNCs in the log, bounds count board ticks: a board at 333 ticks/s that reacts one tick
  * after the one in flight meets "within 1ms" though 3 ms of wall time passed; one more fails. */
 static void test_bounds_in_ticks(void **st)
@@ -684,6 +727,7 @@ int main(void)
         cmocka_unit_test(test_heartbeat_supervised),
         cmocka_unit_test(test_times_after_a_step_count_from_its_injection),
         cmocka_unit_test(test_enabled_counts_the_boards_ticks_not_the_drives),
+        cmocka_unit_test(test_until_end_stops_at_the_rigs_end),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
