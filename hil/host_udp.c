@@ -846,9 +846,6 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
         atomic_store(&h.window_version, peer.have_current ? peer.current.version : 0u);
         atomic_store(&h.impulse_seq, peer.impulse_seq_applied);
         atomic_store(&h.board_seen, peer.board_seen);
-        pthread_mutex_lock(&h.mu);
-        shost_release_held(&h, false);
-        pthread_mutex_unlock(&h.mu);
         next += 1000;
         const uint64_t now = mono_us();
         if (next < now)
