@@ -650,7 +650,9 @@ check_scenario() {
     lag=$(sed -n 's/.* end .*max_syncs_per_read=\([0-9]*\).*/, arm stand-in >= \1 ticks behind at worst (8: a full read)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     # The board's states as it logged them, for a failure: "ACTIVE FAULT(drive heartbeat lost)".
     states=$(sed -n 's/^[0-9.]* argil-board: state \([A-Z]*\)\( — \(.*\)\)*$/\1(\3)/p' "$OUT/$CHECK.board.log" | sed 's/()//' | tr '\n' ' ')
-    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag; board: $states]"; return; }
+    # and its last word (a daemon that gave up says why: "CAN bus-off not recovered ...").
+    last=$(tail -n 1 "$OUT/$CHECK.board.log" | cut -d' ' -f2-)
+    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag; board: $states; last: $last]"; return; }
     # A stranger on the network (`stranger KIND for D`): the board refused its frames by reason,
     # as its RT_STATS told hil-host, and served one host session throughout.
     if grep -q '^at .* stranger ' "$scn"; then

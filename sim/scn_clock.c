@@ -8,13 +8,14 @@ void scn_clock_init(scn_clock_t *c, bool ticks, int64_t wall_us)
     c->now_us = 0;
     c->last_wall_us = wall_us;
     c->silent = false;
+    c->bus_off = false;
     c->syncs = 0;
     c->wall_steps = 0;
 }
 
 uint32_t scn_clock_sync(scn_clock_t *c, int64_t wall_us)
 {
-    if (!c->ticks)
+    if (!c->ticks || c->bus_off)
         return 0;
     c->silent = false;
     c->syncs++;
@@ -26,7 +27,7 @@ uint32_t scn_clock_sync(scn_clock_t *c, int64_t wall_us)
 uint32_t scn_clock_idle(scn_clock_t *c, int64_t wall_us)
 {
     const int64_t since = wall_us - c->last_wall_us;
-    if (c->ticks && !c->silent) {
+    if (c->ticks && !c->silent && !c->bus_off) {
         if (since <= SCN_CLOCK_SILENCE_US)
             return 0;
         c->silent = true;
@@ -40,4 +41,9 @@ uint32_t scn_clock_idle(scn_clock_t *c, int64_t wall_us)
     c->last_wall_us += step;
     c->wall_steps++;
     return step;
+}
+
+void scn_clock_wall_while_bus_off(scn_clock_t *c, bool bus_off)
+{
+    c->bus_off = bus_off;
 }

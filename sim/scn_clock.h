@@ -20,6 +20,7 @@ typedef struct {
     int64_t now_us;          /* scenario time */
     int64_t last_wall_us;    /* wall time of the last step (or of the start) */
     bool silent;             /* following the wall clock until the next SYNC */
+    bool bus_off;            /* the scenario holds the bus off: the wall clock only */
     uint32_t syncs;          /* SYNCs counted */
     uint32_t wall_steps;     /* steps taken on the wall clock */
 } scn_clock_t;
@@ -36,5 +37,13 @@ uint32_t scn_clock_sync(scn_clock_t *c, int64_t wall_us);
  * counted whole, from the last SYNC), or 0 while it waits for the next SYNC (SYNC-driven and
  * silent for at most SCN_CLOCK_SILENCE_US) or is up to date. */
 uint32_t scn_clock_idle(scn_clock_t *c, int64_t wall_us);
+
+/* While the scenario itself holds the bus off (bus_off until bus_restart: the board's
+ * controller sends no SYNC), scenario time is the wall time, from the last SYNC on: SYNCs the
+ * board still sends before it sees the bus-off step nothing, idle calls step the wall time. A
+ * SYNC-driven clock waited SCN_CLOCK_SILENCE_US for the silence and then caught up, and each
+ * late SYNC started the wait again: under TCG a restart timed 300 ms after the bus-off came
+ * 530-560 ms after it, past the board's 500 ms recovery bound. Off again, SYNCs drive it. */
+void scn_clock_wall_while_bus_off(scn_clock_t *c, bool bus_off);
 
 #endif

@@ -317,25 +317,60 @@ static void gpio_close(sim_gpio_t *g)
 
 /* ---- CAN ---- */
 
-/* Sends the tick's frames: data frames through can_socket_send, SocketCAN error frames (the
- * bus-off fault) written with their CAN_ERR_FLAG id, which vcan delivers to the board's socket
- * as an error frame. */
+/* SocketCAN error frames (the bus-off fault and the restart) still to be written: each is a
+ * state change of the board's bus that nothing repeats, so one the socket had no room for
+ * (ENOBUFS under load) is written again at the next step instead of being lost. */
+#define ERR_FRAMES_PENDING_MAX 4
+static struct can_frame err_pending[ERR_FRAMES_PENDING_MAX];
+static unsigned err_pending_n, err_frames_retried;
+
+/* Writes the pending error frames in order; false on a hard error (not ENOBUFS/EAGAIN). */
+static bool err_frames_flush(int fd, can_socket_stats_t *st)
+{
+    unsigned done = 0;
+    for (; done < err_pending_n; done++) {
+        if (send(fd, &err_pending[done], sizeof(err_pending[done]), MSG_DONTWAIT) ==
+            (ssize_t)sizeof(err_pending[done])) {
+            st->tx_frames++;
+            continue;
+        }
+        if (errno == ENOBUFS || errno == EAGAIN || errno == EWOULDBLOCK) {
+            st->tx_busy++;
+            err_frames_retried++;
+            break;
+        }
+        st->last_errno = errno;
+        st->tx_errors++;
+        return false;
+    }
+    memmove(err_pending, err_pending + done, (err_pending_n - done) * sizeof(err_pending[0]));
+    err_pending_n -= done;
+    return true;
+}
+
+/* Sends the tick's frames: SocketCAN error frames (the bus-off fault) first, written with
+ * their CAN_ERR_FLAG id, which vcan delivers to the board's socket as an error frame; then the
+ * data frames through can_socket_send. */
 static argil_err_t can_send_all(int fd, const can_batch_t *tx, can_socket_stats_t *st)
 {
     can_batch_t data = {0};
     for (uint8_t i = 0; i < tx->n; i++) {
         if (tx->f[i].id & CAN_ERR_FLAG) {
-            struct can_frame cf;
-            memset(&cf, 0, sizeof(cf));
-            cf.can_id = tx->f[i].id & (CAN_ERR_FLAG | CAN_ERR_MASK);
-            cf.can_dlc = 8;
-            memcpy(cf.data, tx->f[i].data, 8);
-            if (send(fd, &cf, sizeof(cf), MSG_DONTWAIT) != (ssize_t)sizeof(cf))
-                st->tx_errors++;
+            if (err_pending_n == ERR_FRAMES_PENDING_MAX) {
+                st->tx_errors++; /* four state changes unwritten: the bus is gone */
+                continue;
+            }
+            struct can_frame *cf = &err_pending[err_pending_n++];
+            memset(cf, 0, sizeof(*cf));
+            cf->can_id = tx->f[i].id & (CAN_ERR_FLAG | CAN_ERR_MASK);
+            cf->can_dlc = 8;
+            memcpy(cf->data, tx->f[i].data, 8);
         } else {
             (void)can_batch_push(&data, &tx->f[i]);
         }
     }
+    if (!err_frames_flush(fd, st))
+        return ARGIL_ERR_IO;
     return data.n ? can_socket_send(fd, &data, st) : ARGIL_OK;
 }
 
@@ -666,6 +701,7 @@ int main(int argc, char **argv)
             can_batch_t tx;
             run.outputs_reused = steps_this_read++ > 0;
             sim_runner_tick(&run, &held, out, &tx, dt_us);
+            scn_clock_wall_while_bus_off(&clk, run.faults.bus_off); /* no SYNC until restart */
             held.n = 0;
             const argil_err_t se = can_send_all(fd, &tx, &st);
             if (se == ARGIL_ERR_IO) {
@@ -700,9 +736,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "argil-sim: %u events not logged (more than %u in one tick)\n",
                 lost_ev, EVENTS_MAX);
     snprintf(line, sizeof(line),
-             "end frames_rx=%u frames_tx=%u tx_busy=%u late_ticks=%u dropped=%u/%u silenced=%u "
+             "end frames_rx=%u frames_tx=%u tx_busy=%u tx_errors=%u error_frames_retried=%u "
+             "error_frames_unsent=%u late_ticks=%u dropped=%u/%u silenced=%u "
              "clock %s syncs=%u wall_steps=%u max_syncs_per_read=%u cpu_ms=%.0f",
-             st.rx_frames, st.tx_frames, st.tx_busy, late_ticks, run.faults.dropped_to_board,
+             st.rx_frames, st.tx_frames, st.tx_busy, st.tx_errors, err_frames_retried,
+             err_pending_n, late_ticks, run.faults.dropped_to_board,
              run.faults.dropped_from_board, run.faults.silenced, clock_ticks ? "ticks" : "wall",
              clk.syncs, clk.wall_steps, max_syncs_per_read, cpu_ms());
     log_event(NULL, run.now_us, line);

@@ -60,6 +60,29 @@ static void test_silence_falls_back_to_wall_clock(void **st)
     assert_int_equal(c.wall_steps, 21 + 1 + 398);
 }
 
+/* A bus-off the scenario makes: scenario time is wall time from the last SYNC at once, and the
+ * SYNCs the board still sends before it sees the bus-off do not restart a wait; so a restart
+ * 300 ms later comes 300 ms later. After it, SYNCs drive the clock again. */
+static void test_bus_off_follows_the_wall_clock_at_once(void **st)
+{
+    (void)st;
+    scn_clock_t c;
+    scn_clock_init(&c, true, 0);
+    assert_int_equal(scn_clock_sync(&c, 1000), 1000u);
+    scn_clock_wall_while_bus_off(&c, true);
+    assert_int_equal(scn_clock_sync(&c, 3000), 0u);               /* a late SYNC: no step */
+    uint32_t caught = 0;
+    for (uint32_t d; (d = scn_clock_idle(&c, 301000)) > 0;)
+        caught += d;
+    assert_int_equal(caught, 300000);                             /* the whole 300 ms */
+    assert_int_equal(c.now_us, 301000);
+    scn_clock_wall_while_bus_off(&c, false);
+    assert_int_equal(scn_clock_sync(&c, 302000), 1000u);          /* the bus is back */
+    assert_false(c.silent);
+    assert_int_equal(scn_clock_idle(&c, 650000), 0);              /* waits for SYNCs again */
+    assert_int_equal(c.now_us, 302000);
+}
+
 /* A wall-clock-only clock ignores SYNCs and steps by the time passed (at most 20 ms a step). */
 static void test_wall_clock_only(void **st)
 {
@@ -80,6 +103,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ticks_follow_syncs),
         cmocka_unit_test(test_silence_falls_back_to_wall_clock),
+        cmocka_unit_test(test_bus_off_follows_the_wall_clock_at_once),
         cmocka_unit_test(test_wall_clock_only),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
