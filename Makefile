@@ -64,10 +64,17 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all check-compile-deps run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil $(REL)/argil-board check-freestanding
+
+# A fresh machine gets one clear line instead of a compiler's "sodium.h: No such file".
+check-compile-deps:
+	@sh toolchain/install-deps.sh --check compile >/dev/null || { \
+	  echo "argil: missing Debian packages:$$(sh toolchain/install-deps.sh --check compile | sed 's/^toolchain: missing://')"; \
+	  echo "argil: install them with 'make deps-build' (as root), or use 'make run' / 'make test', which install what is missing"; \
+	  exit 1; }
 
 deps:
 	@sh toolchain/install-deps.sh
@@ -91,11 +98,11 @@ deps-hil:
 	@sh toolchain/install-deps.sh hil
 
 # Pattern rules: release and sanitizer objects.
-$(REL)/%.o: %.c
+$(REL)/%.o: %.c | check-compile-deps
 	@mkdir -p $(dir $@)
 	$(CC) $(REL_CFLAGS) $(if $(filter $<,$(RT_SRC)),$(RT_FLAGS)) -MMD -MP -c $< -o $@
 
-$(SAN)/%.o: %.c
+$(SAN)/%.o: %.c | check-compile-deps
 	@mkdir -p $(dir $@)
 	$(CC) $(TEST_CFLAGS) $(if $(filter $<,$(RT_SRC)),$(RT_FLAGS)) -MMD -MP -c $< -o $@
 

@@ -1,8 +1,8 @@
 #!/bin/sh
 # Installs the Debian 12 packages argil needs to build and test, and only the
 # missing ones. Idempotent: a second run installs nothing and says so.
-# Usage: toolchain/install-deps.sh [--check] [build|test|fuzz|cross|render|bench|hil ...]
-#   build: what `make` and `make run` need (includes render); test: + the test tools;
+# Usage: toolchain/install-deps.sh [--check] [compile|build|test|fuzz|cross|render|bench|hil ...]
+#   compile: what compiling `make all` needs (headers and libraries only); build: what `make` and `make run` need (includes render); test: + the test tools;
 #   fuzz: + clang/libFuzzer; render: argil view/plot (GLFW, EGL, Mesa, stb, Xvfb);
 #   bench: + valgrind and the third-party meshers make bench compares against.
 #   hil: qemu and the tools put into the HIL VM (the kernel debs are fetched, not installed).
@@ -17,6 +17,8 @@ FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
 # argil view / argil plot (docs/render.md): headers at build time (GL, EGL, GLFW, stb's PNG
 # writer); at run time libglfw/libEGL/Mesa are opened with dlopen, so no link flags are needed.
 # Mesa's llvmpipe renders with no GPU (EGL surfaceless); Xvfb gives GLFW a display in tests.
+# the headers of the render packages below, all that compiling needs of them
+RENDER_HDR_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libstb-dev"
 RENDER_PKGS="libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libstb-dev xvfb xauth"
 # make cross (and the cross tier of make test): aarch64 board daemon + its tests under
 # qemu-user, the Cortex-M image under qemu-system-arm. The :arm64 libraries need Debian's
@@ -34,14 +36,15 @@ groups=""
 for a in "$@"; do
     case "$a" in
         --check) check_only=1 ;;
-        build|test|fuzz|cross|render|bench|hil) groups="$groups $a" ;;
-        *) echo "toolchain: unknown argument '$a' (use --check, build, test, fuzz, cross, render, bench, hil)" >&2; exit 2 ;;
+        compile|build|test|fuzz|cross|render|bench|hil) groups="$groups $a" ;;
+        *) echo "toolchain: unknown argument '$a' (use --check, compile, build, test, fuzz, cross, render, bench, hil)" >&2; exit 2 ;;
     esac
 done
 [ -n "$groups" ] || groups="build test fuzz cross render"
 PACKAGES=""
 for g in $groups; do
     case "$g" in
+        compile) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_HDR_PKGS" ;;
         build|render) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS" ;;
         test) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $TEST_PKGS" ;;
         fuzz) PACKAGES="$PACKAGES $BUILD_PKGS $RENDER_PKGS $FUZZ_PKGS" ;;
