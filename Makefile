@@ -64,10 +64,10 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all check-compile-deps run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all check-compile-deps check-layers run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
-all: $(REL)/argil $(REL)/argil-board check-freestanding
+all: $(REL)/argil $(REL)/argil-board check-freestanding check-layers
 
 # A fresh machine gets one clear line instead of a compiler's "sodium.h: No such file".
 check-compile-deps:
@@ -177,6 +177,11 @@ $(SAN)/sil/%: tests/sil/%.c $(SAN)/libargil.a
 # relocatable object and list what they still need from outside.
 check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 	@sh toolchain/check-freestanding.sh $^
+
+# Includes keep DESIGN.md's layers: shared/ depends on nothing, host/ and firmware/ meet only
+# in shared/, and only sim/rig/ puts firmware/, sim/ and the host link together.
+check-layers:
+	@sh toolchain/check-layers.sh
 
 tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil \
              $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/hil-host
