@@ -16,7 +16,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/core/spsc_ring.h"
 #include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
@@ -33,6 +32,7 @@
 #include "host/model/grid.h"
 #include "shared/arm_kin.h"
 #include "shared/safety_codes.h"
+#include "shared/spsc_ring.h"
 #include "sim/sim_device.h"
 
 #define CONNECT_RX_RING_BYTES (1u << 20)  /* ~1 s of board traffic if the solver stalls */

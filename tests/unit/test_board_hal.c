@@ -17,11 +17,11 @@
 
 #include "firmware/board/board_config.h"
 #include "firmware/core/drives.h"
-#include "firmware/core/spsc_ring.h"
 #include "firmware/hal/can_socket.h"
 #include "firmware/hal/gpio_port.h"
 #include "firmware/hal/link_io.h"
 #include "shared/gpio_lines.h"
+#include "shared/spsc_ring.h"
 
 static void test_can_socket_frames_and_error_frames(void **st)
 {
