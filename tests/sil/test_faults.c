@@ -96,7 +96,7 @@ static void log_frames(fx_t *x, int64_t t_us, const can_batch_t *b)
     for (uint8_t i = 0; i < b->n; i++) {
         const can_frame_t *f = &b->f[i];
         fprintf(x->can_log, "(%" PRId64 ".%06" PRId64 ") vcan0 ", t / 1000000, t % 1000000);
-        if (f->id & DRIVES_CAN_ERR_FLAG)
+        if (f->id & ARGIL_CAN_ERR_FLAG)
             fprintf(x->can_log, "%08X#", (unsigned)f->id);
         else
             fprintf(x->can_log, "%03X#", (unsigned)f->id);
