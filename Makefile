@@ -39,16 +39,14 @@ CORE_SRC := $(wildcard firmware/core/*.c)
 HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
-# The host's USB link cuts its byte stream with the board's own framer (host/link/link_usb.c).
-HOST_FRAMER_SRC := firmware/hal/link_framer.c
 # The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
-LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(HOST_FRAMER_SRC) $(LINK_AUTH_SRC) $(SIM_SRC) $(HOST_SRC)
+LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
 BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
-                 firmware/hal/gpio_gpiod.c firmware/hal/link_framer.c firmware/hal/link_udp.c \
+                 firmware/hal/gpio_gpiod.c firmware/hal/link_udp.c \
                  firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)

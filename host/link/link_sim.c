@@ -10,8 +10,8 @@
 
 #include "firmware/core/board_hal.h"
 #include "firmware/hal/hal_sim.h"
-#include "firmware/hal/link_io.h"
 #include "host/link/link.h"
+#include "shared/link_framer.h"
 #include "sim/sim_device.h"
 
 #define SIM_CATCH_UP_TICKS 50u   /* at most this many ticks per poll; later ones are skipped */

@@ -18,10 +18,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "firmware/hal/link_io.h"
 #include "host/link/link.h"
 #include "host/link/link_usb_api.h"
 #include "host/link/link_usb_desc.h"
+#include "shared/link_framer.h"
 
 #define USB_IN_TRANSFERS 8u          /* bulk IN transfers kept in flight */
 #define USB_IN_BYTES 4096u           /* each */
