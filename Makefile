@@ -38,10 +38,12 @@ SHARED_SRC := $(wildcard shared/*.c)
 CORE_SRC := $(wildcard firmware/core/*.c)
 HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
+# The lockstep rig (sim/rig/rig.h): the simulated arm, the sim HAL and the board core together.
+RIG_SRC := $(wildcard sim/rig/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 # The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
-LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(HOST_SRC)
+LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(RIG_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
