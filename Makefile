@@ -38,17 +38,17 @@ SHARED_SRC := $(wildcard shared/*.c)
 CORE_SRC := $(wildcard firmware/core/*.c)
 HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
+# The lockstep rig (sim/rig/rig.h): the simulated arm, the sim HAL and the board core together.
+RIG_SRC := $(wildcard sim/rig/*.c)
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
-# The host's USB link cuts its byte stream with the board's own framer (host/link/link_usb.c).
-HOST_FRAMER_SRC := firmware/hal/link_framer.c
 # The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
-LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(HOST_FRAMER_SRC) $(LINK_AUTH_SRC) $(SIM_SRC) $(HOST_SRC)
+LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(RIG_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
 BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
-                 firmware/hal/gpio_gpiod.c firmware/hal/link_framer.c firmware/hal/link_udp.c \
+                 firmware/hal/gpio_gpiod.c firmware/hal/link_udp.c \
                  firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
@@ -64,10 +64,10 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all check-compile-deps run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all check-compile-deps check-layers run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
-all: $(REL)/argil $(REL)/argil-board check-freestanding
+all: $(REL)/argil $(REL)/argil-board check-freestanding check-layers
 
 # A fresh machine gets one clear line instead of a compiler's "sodium.h: No such file".
 check-compile-deps:
@@ -177,6 +177,11 @@ $(SAN)/sil/%: tests/sil/%.c $(SAN)/libargil.a
 # relocatable object and list what they still need from outside.
 check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 	@sh toolchain/check-freestanding.sh $^
+
+# Includes keep DESIGN.md's layers: shared/ depends on nothing, host/ and firmware/ meet only
+# in shared/, and only sim/rig/ puts firmware/, sim/ and the host link together.
+check-layers:
+	@sh toolchain/check-layers.sh
 
 tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil \
              $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/hil-host

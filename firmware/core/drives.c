@@ -55,7 +55,7 @@ static void bus_enter(drives_t *dr, can_bus_state_t s)
 static void bus_error_frame(drives_t *dr, const can_frame_t *f)
 {
     dr->error_frames++;
-    if (f->id & DRIVES_CAN_ERR_RESTARTED) {
+    if (f->id & ARGIL_CAN_ERR_RESTARTED) {
         /* The controller is back on the bus: the drives may have missed frames, so
          * restart NMT supervision from scratch (a fresh heartbeat window, NMT start again). */
         bus_enter(dr, CAN_BUS_ACTIVE);
@@ -66,15 +66,15 @@ static void bus_error_frame(drives_t *dr, const can_frame_t *f)
         }
         return;
     }
-    if (f->id & DRIVES_CAN_ERR_BUSOFF) {
+    if (f->id & ARGIL_CAN_ERR_BUSOFF) {
         bus_enter(dr, CAN_BUS_OFF);
         return;
     }
-    if ((f->id & DRIVES_CAN_ERR_CRTL) && f->len >= 2 && dr->bus != CAN_BUS_OFF) {
+    if ((f->id & ARGIL_CAN_ERR_CRTL) && f->len >= 2 && dr->bus != CAN_BUS_OFF) {
         const uint8_t st = f->data[1];
-        if (st & (DRIVES_CAN_CRTL_RX_PASSIVE | DRIVES_CAN_CRTL_TX_PASSIVE))
+        if (st & (ARGIL_CAN_CRTL_RX_PASSIVE | ARGIL_CAN_CRTL_TX_PASSIVE))
             bus_enter(dr, CAN_BUS_PASSIVE);
-        else if (st & DRIVES_CAN_CRTL_ACTIVE)
+        else if (st & ARGIL_CAN_CRTL_ACTIVE)
             bus_enter(dr, CAN_BUS_ACTIVE);
     }
 }
@@ -97,7 +97,7 @@ void drives_receive(drives_t *dr, const can_batch_t *rx)
         uint8_t reg;
         drive_link_t *d;
         dr->frames_rx++;
-        if (f->id & DRIVES_CAN_ERR_FLAG) {
+        if (f->id & ARGIL_CAN_ERR_FLAG) {
             bus_error_frame(dr, f);
             continue;
         }

@@ -8,18 +8,8 @@
 #include <stdint.h>
 
 #include "shared/argil_limits.h"
+#include "shared/can_err.h"
 #include "shared/canopen.h"
-
-/* SocketCAN error frames pass through can_batch_t unchanged: id carries the error flag and
- * class bits, data[1] the controller status. Values are Linux's <linux/can/error.h> ones
- * (checked against the kernel header in firmware/hal/can_socket.c). */
-#define DRIVES_CAN_ERR_FLAG 0x20000000u      /* CAN_ERR_FLAG: this is an error frame */
-#define DRIVES_CAN_ERR_CRTL 0x00000004u      /* CAN_ERR_CRTL: controller problem, see data[1] */
-#define DRIVES_CAN_ERR_BUSOFF 0x00000040u    /* CAN_ERR_BUSOFF */
-#define DRIVES_CAN_ERR_RESTARTED 0x00000100u /* CAN_ERR_RESTARTED: controller restarted */
-#define DRIVES_CAN_CRTL_RX_PASSIVE 0x10u     /* CAN_ERR_CRTL_RX_PASSIVE */
-#define DRIVES_CAN_CRTL_TX_PASSIVE 0x20u     /* CAN_ERR_CRTL_TX_PASSIVE */
-#define DRIVES_CAN_CRTL_ACTIVE 0x40u         /* CAN_ERR_CRTL_ACTIVE: back to error-active */
 
 typedef enum {
     CAN_BUS_ACTIVE = 0,     /* error-active: normal */

@@ -12,16 +12,16 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "firmware/core/drives.h"
+#include "shared/can_err.h"
 
 /* The core decodes error frames with its own copies of the kernel's constants. */
-_Static_assert(DRIVES_CAN_ERR_FLAG == CAN_ERR_FLAG, "CAN_ERR_FLAG");
-_Static_assert(DRIVES_CAN_ERR_CRTL == CAN_ERR_CRTL, "CAN_ERR_CRTL");
-_Static_assert(DRIVES_CAN_ERR_BUSOFF == CAN_ERR_BUSOFF, "CAN_ERR_BUSOFF");
-_Static_assert(DRIVES_CAN_ERR_RESTARTED == CAN_ERR_RESTARTED, "CAN_ERR_RESTARTED");
-_Static_assert(DRIVES_CAN_CRTL_RX_PASSIVE == CAN_ERR_CRTL_RX_PASSIVE, "RX_PASSIVE");
-_Static_assert(DRIVES_CAN_CRTL_TX_PASSIVE == CAN_ERR_CRTL_TX_PASSIVE, "TX_PASSIVE");
-_Static_assert(DRIVES_CAN_CRTL_ACTIVE == CAN_ERR_CRTL_ACTIVE, "CRTL_ACTIVE");
+_Static_assert(ARGIL_CAN_ERR_FLAG == CAN_ERR_FLAG, "CAN_ERR_FLAG");
+_Static_assert(ARGIL_CAN_ERR_CRTL == CAN_ERR_CRTL, "CAN_ERR_CRTL");
+_Static_assert(ARGIL_CAN_ERR_BUSOFF == CAN_ERR_BUSOFF, "CAN_ERR_BUSOFF");
+_Static_assert(ARGIL_CAN_ERR_RESTARTED == CAN_ERR_RESTARTED, "CAN_ERR_RESTARTED");
+_Static_assert(ARGIL_CAN_CRTL_RX_PASSIVE == CAN_ERR_CRTL_RX_PASSIVE, "RX_PASSIVE");
+_Static_assert(ARGIL_CAN_CRTL_TX_PASSIVE == CAN_ERR_CRTL_TX_PASSIVE, "TX_PASSIVE");
+_Static_assert(ARGIL_CAN_CRTL_ACTIVE == CAN_ERR_CRTL_ACTIVE, "CRTL_ACTIVE");
 
 argil_err_t can_socket_open(const char *ifname, int *fd, char *err, size_t err_len)
 {

@@ -10,9 +10,9 @@
 #include <stdint.h>
 
 #include "can_socket.h"
-#include "firmware/core/spsc_ring.h"
 #include "gpio_port.h"
 #include "hal.h"
+#include "shared/spsc_ring.h"
 #include "sim/sim_device.h"
 
 #define HAL_LINUX_RX_RING_BYTES (1u << 17)   /* host → board frames waiting for the tick */

@@ -1,7 +1,7 @@
 /* The host link's transports for the board daemon's link thread: UDP (one frame per datagram;
  * with a key each sealed and verified here, link_auth.h; only the host whose HELLO started the
  * core's session gets through, and gets the replies: link_bind.h) and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
- * the same frames back to back). A framer cuts a byte stream into whole protocol frames.
+ * the same frames back to back).
  * Linux only (hosted); nothing here runs in the fast loop. */
 #ifndef ARGIL_LINK_IO_H
 #define ARGIL_LINK_IO_H
@@ -14,29 +14,11 @@
 #include "link_auth.h"
 #include "link_bind.h"
 #include "shared/argil_err.h"
+#include "shared/link_framer.h"
 #include "shared/proto.h"
 
 #define LINK_USB_VID 0x1209u   /* pid.codes test VID */
 #define LINK_USB_PID 0x0001u   /* pid.codes test PID */
-
-/* ---- framing ---- */
-
-/* Size of the frame whose header starts buf (header length field + header + CRC), or 0 when
- * fewer than PROTO_HEADER_SIZE bytes are given, the magic is wrong or it would exceed
- * PROTO_FRAME_MAX. */
-size_t link_frame_size(const uint8_t *buf, size_t len);
-
-typedef struct {
-    uint8_t buf[2u * PROTO_FRAME_MAX];
-    size_t len;
-    uint32_t skipped_bytes;     /* bytes dropped while looking for a frame start */
-} link_framer_t;
-
-void link_framer_init(link_framer_t *fr);
-/* Appends bytes (at most sizeof(buf) - len are taken; returns how many). */
-size_t link_framer_feed(link_framer_t *fr, const uint8_t *data, size_t len);
-/* Moves the next whole frame to out (cap ≥ PROTO_FRAME_MAX); returns its size or 0. */
-size_t link_framer_next(link_framer_t *fr, uint8_t *out, size_t cap);
 
 /* ---- UDP ---- */
 

@@ -16,8 +16,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/core/safety.h"
-#include "firmware/core/spsc_ring.h"
 #include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
@@ -33,7 +31,8 @@
 #include "host/mesh/mesh_check.h"
 #include "host/model/grid.h"
 #include "shared/arm_kin.h"
-#include "sim/sim_device.h"
+#include "shared/safety_codes.h"
+#include "shared/spsc_ring.h"
 
 #define CONNECT_RX_RING_BYTES (1u << 20)  /* ~1 s of board traffic if the solver stalls */
 #define CONNECT_TX_RING_BYTES (1u << 18)
@@ -786,9 +785,9 @@ int cmd_connect(int argc, char **argv)
     }
 
     /* The host's clay: a sphere just below the arm's workspace centre (device = model). */
-    sim_params_t sp;
-    sim_params_default(&sp);
-    const vec3_t centre = arm_workspace_centre(&sp.arm.desc);
+    arm_desc_t arm_desc;
+    arm_desc_default(&arm_desc);
+    const vec3_t centre = arm_workspace_centre(&arm_desc);
     const int32_t dims[3] = {CONNECT_GRID_EDGE, CONNECT_GRID_EDGE, CONNECT_GRID_EDGE};
     const float half = 0.5f * (float)(CONNECT_GRID_EDGE - 1) * CONNECT_SPACING_M;
     peer_cfg_t pc;

@@ -6,12 +6,12 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "firmware/core/safety.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/app/sculpt_window.h"
 #include "host/app/session.h"
 #include "host/render/colour_map.h"
+#include "shared/safety_codes.h"
 
 static volatile sig_atomic_t g_stop;
 

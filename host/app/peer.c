@@ -6,8 +6,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "firmware/core/safety.h"
 #include "host/app/histogram.h"
+#include "shared/safety_codes.h"
 
 void peer_cfg_default(peer_cfg_t *cfg)
 {

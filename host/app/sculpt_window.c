@@ -16,7 +16,6 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "firmware/core/safety.h"
 #include "host/app/live_hand.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc_blocks.h"
@@ -30,6 +29,7 @@
 #include "host/render/triple_buffer.h"
 #include "host/render/ui_input.h"
 #include "host/render/ui_queue.h"
+#include "shared/safety_codes.h"
 
 #define FRAME_PERIOD_S (1.0 / 60.0)   /* simulated time between snapshots */
 #define EARLY_PUBLISH_S 0.008        /* least simulated time between snapshots of other changes */

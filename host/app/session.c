@@ -11,9 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/core/board_hal.h"
 #include "host/app/histogram.h"
-#include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
 #include "host/app/script.h"
@@ -24,7 +22,7 @@
 #include "host/mesh/mesh_check.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/model/grid.h"
-#include "sim/sim_device.h"
+#include "sim/rig/rig.h"
 
 #define SESSION_CLAY_RADIUS_M 0.030f
 #define SESSION_GRID_EDGE 88
@@ -58,18 +56,14 @@ void session_opts_default(session_opts_t *o)
 
 /* Everything a session owns; large, so it lives on the heap. */
 typedef struct {
-    hal_t hal;
-    board_t board;
-    board_io_t io;
-    sim_device_t dev;
-    sim_params_t sim_params;
+    sim_rig_t rig;                     /* the simulated arm and the board, in lockstep */
     grid_t grid;
     peer_t peer;
     script_t script;
     script_player_t player;
     FILE *csv;
     uint32_t csv_rows;
-    uint8_t rx[HAL_SIM_LINK_BYTES];
+    uint8_t rx[SIM_RIG_LINK_BYTES];
     vec3_t model_offset_m;             /* model = device + offset (scale 1) */
     uint32_t compute_hist_us[COMPUTE_HIST_BINS]; /* tick compute times, 1 µs bins */
     session_undo_t undo;               /* undo / redo of strokes (B-spline model) */
@@ -88,7 +82,7 @@ typedef struct {
 static bool link_send(void *ctx, const uint8_t *frame, size_t len)
 {
     session_t *s = ctx;
-    return hal_sim_host_send(&s->hal, frame, len) == ARGIL_OK;
+    return sim_rig_host_send(&s->rig, frame, len) == ARGIL_OK;
 }
 
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
@@ -339,20 +333,15 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     }
 
     /* The device and the board. */
-    sim_params_default(&s->sim_params);
-    sim_device_init(&s->dev, &s->sim_params);
-    hal_sim_init(&s->hal);
-    board_cfg_t bcfg;
-    board_cfg_default(&bcfg);
-    bcfg.arm = s->sim_params.arm.desc;
+    sim_rig_cfg_t rcfg;
+    sim_rig_cfg_default(&rcfg);
     if (!opts->deadline_faults)
-        bcfg.safety.overrun_streak = 0;
-    if (board_init(&s->board, &bcfg) != ARGIL_OK) {
+        rcfg.board.safety.overrun_streak = 0;
+    if (sim_rig_init(&s->rig, &rcfg) != ARGIL_OK) {
         snprintf(err, err_len, "board configuration refused");
         rc = ARGIL_ERR_ARG;
         goto done;
     }
-    board_io_init(&s->io);
 
     /* The host's clay: a sphere at the model origin. */
     const int32_t dims[3] = {SESSION_GRID_EDGE, SESSION_GRID_EDGE, SESSION_GRID_EDGE};
@@ -399,7 +388,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     (void)session_undo_init(&s->undo, s->peer.gs ? &s->peer.gs->field : NULL,
                             (size_t)opts->undo_mb << 20);
 
-    const vec3_t centre = sim_device_tip_m(&s->dev);
+    const vec3_t centre = sim_rig_tip_m(&s->rig);
     s->model_offset_m = vec3_sub(vec3(0, 0, SESSION_START_Z_M), centre);
     script_player_init(&s->player, &s->script, vec3(0, 0, SESSION_START_Z_M));
 
@@ -433,7 +422,7 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     }
 
     /* The lockstep loop. */
-    const uint32_t dt_us = bcfg.tick_us;
+    const uint32_t dt_us = rcfg.board.tick_us;
     const float dt_s = (float)dt_us * 1e-6f;
     const double script_s = script_duration_s(&s->script);
     const double total_s = opts->settle_s + script_s + SESSION_TAIL_S;
@@ -529,19 +518,13 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
 
         /* The hand, the arm and its drives. */
         const vec3_t target_dev = vec3_sub(s->player.pos_m, s->model_offset_m);
-        sim_device_set_hand(&s->dev, target_dev, s->player.vel_m_s, (s->player.buttons & 1) != 0,
-                            (s->player.buttons & 2) != 0);
-        can_batch_t from_board, to_board;
-        to_board.n = 0;
-        hal_sim_take_from_board(&s->hal, &from_board);
-        sim_device_step(&s->dev, &from_board, hal_sim_gpio_out(&s->hal), &to_board, dt_us);
-        hal_sim_put_to_board(&s->hal, &to_board);
-        hal_sim_set_gpio_in(&s->hal, sim_device_gpio_in(&s->dev));
+        sim_rig_set_hand(&s->rig, target_dev, s->player.vel_m_s, (s->player.buttons & 1) != 0,
+                         (s->player.buttons & 2) != 0);
 
-        /* The board's tick, then the host's. */
-        const uint32_t compute_us = board_run_tick(&s->board, &s->io, &s->hal) / 1000u;
+        /* The arm's and the board's tick, then the host's. */
+        const uint32_t compute_us = sim_rig_step_ns(&s->rig, dt_us) / 1000u;
         s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
-        const size_t n = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
+        const size_t n = sim_rig_host_receive(&s->rig, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
         session_undo_observe(&s->undo, &s->peer, dt_us); /* a new stroke; its diff a slice a tick */
         peer_tick(&s->peer, dt_us);
@@ -573,22 +556,24 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         fputc('\n', stderr);
     (void)started_at_s;
 
+    sim_rig_board_stats_t board;
+    sim_rig_board_stats(&s->rig, &board);
     sum->sim_seconds = (double)tick * dt_s;
-    sum->board_ticks = s->board.stats.ticks;
+    sum->board_ticks = board.ticks;
     sum->tick_hz = 1000000u / dt_us;
-    sum->worst_compute_ns = s->board.stats.worst_compute_ns;
-    sum->deadline_misses = s->board.stats.deadline_misses;
+    sum->worst_compute_ns = board.worst_compute_ns;
+    sum->deadline_misses = board.deadline_misses;
     sum->rt_stats_frames = s->peer.stats.rt_stats_frames;
     sum->rt = s->peer.last_rt;
     sum->median_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.5) * 1000u;
     sum->p99_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.99) * 1000u;
-    sum->peak_force_n = s->board.stats.peak_force_n;
-    sum->force_limit_n = s->board.cfg.max_force_n;
-    sum->final_state = s->board.safety.state;
-    sum->fault_code = s->board.safety.fault;
+    sum->peak_force_n = board.peak_force_n;
+    sum->force_limit_n = board.max_force_n;
+    sum->final_state = board.state;
+    sum->fault_code = board.fault;
     sum->windows_sent = s->peer.stats.windows_sent;
     sum->impulse_frames = s->peer.stats.impulse_frames;
-    sum->link_errors = s->peer.stats.decode_errors + s->board.stats.link_errors;
+    sum->link_errors = s->peer.stats.decode_errors + board.link_errors;
     sum->telemetry_rows = s->csv_rows;
     sum->solves = s->peer.stats.solves;
     sum->solve_errors = s->peer.stats.solve_errors;

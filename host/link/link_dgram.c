@@ -14,8 +14,8 @@
 #include <unistd.h>
 
 #include "firmware/hal/link_auth.h"
-#include "firmware/hal/link_io.h"
 #include "host/link/link.h"
+#include "shared/link_framer.h"
 
 _Static_assert(LINK_KEY_SIZE == LINK_KEY_BYTES, "one key size");
 

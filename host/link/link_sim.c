@@ -8,40 +8,34 @@
 #include <string.h>
 #include <time.h>
 
-#include "firmware/core/board_hal.h"
-#include "firmware/hal/hal_sim.h"
-#include "firmware/hal/link_io.h"
 #include "host/link/link.h"
-#include "sim/sim_device.h"
+#include "shared/link_framer.h"
+#include "sim/rig/rig.h"
 
 #define SIM_CATCH_UP_TICKS 50u   /* at most this many ticks per poll; later ones are skipped */
 
 typedef struct {
-    hal_t hal;
-    board_t board;
-    board_io_t io;
-    sim_device_t dev;
-    sim_params_t params;
+    sim_rig_t rig;
     vec3_t hold_m;                 /* where the hand holds the stylus */
     uint32_t tick_us;
     uint64_t start_us;
     uint64_t ticks;
     uint64_t skipped_ticks;
-    uint8_t rx[HAL_SIM_LINK_BYTES];
+    uint8_t rx[SIM_RIG_LINK_BYTES];
     size_t rx_len, rx_at;
 } sim_link_t;
 
 static argil_err_t sim_send(link_t *l, const uint8_t *frame, size_t len)
 {
     sim_link_t *s = l->impl;
-    return hal_sim_host_send(&s->hal, frame, len);
+    return sim_rig_host_send(&s->rig, frame, len);
 }
 
 static size_t sim_recv(link_t *l, uint8_t *buf, size_t cap)
 {
     sim_link_t *s = l->impl;
     if (s->rx_at >= s->rx_len) {
-        s->rx_len = hal_sim_host_receive(&s->hal, s->rx, sizeof(s->rx));
+        s->rx_len = sim_rig_host_receive(&s->rig, s->rx, sizeof(s->rx));
         s->rx_at = 0;
         if (s->rx_len == 0)
             return 0;
@@ -59,14 +53,8 @@ static size_t sim_recv(link_t *l, uint8_t *buf, size_t cap)
 
 static void sim_tick(sim_link_t *s)
 {
-    sim_device_set_hand(&s->dev, s->hold_m, vec3(0, 0, 0), false, false);
-    can_batch_t from_board, to_board;
-    to_board.n = 0;
-    hal_sim_take_from_board(&s->hal, &from_board);
-    sim_device_step(&s->dev, &from_board, hal_sim_gpio_out(&s->hal), &to_board, s->tick_us);
-    hal_sim_put_to_board(&s->hal, &to_board);
-    hal_sim_set_gpio_in(&s->hal, sim_device_gpio_in(&s->dev));
-    (void)board_run_tick(&s->board, &s->io, &s->hal);
+    sim_rig_set_hand(&s->rig, s->hold_m, vec3(0, 0, 0), false, false);
+    (void)sim_rig_step_ns(&s->rig, s->tick_us);
     s->ticks++;
 }
 
@@ -105,20 +93,15 @@ argil_err_t link_sim_open(link_t *l, char *err, size_t err_len)
         snprintf(err, err_len, "out of memory for the simulated board");
         return ARGIL_ERR_NOMEM;
     }
-    sim_params_default(&s->params);
-    sim_device_init(&s->dev, &s->params);
-    hal_sim_init(&s->hal);
-    board_cfg_t cfg;
-    board_cfg_default(&cfg);
-    cfg.arm = s->params.arm.desc;
-    if (board_init(&s->board, &cfg) != ARGIL_OK) {
+    sim_rig_cfg_t cfg;
+    sim_rig_cfg_default(&cfg);
+    if (sim_rig_init(&s->rig, &cfg) != ARGIL_OK) {
         free(s);
         snprintf(err, err_len, "sim: the simulated board refused its configuration");
         return ARGIL_ERR_ARG;
     }
-    board_io_init(&s->io);
-    s->tick_us = cfg.tick_us;
-    s->hold_m = sim_device_tip_m(&s->dev);
+    s->tick_us = cfg.board.tick_us;
+    s->hold_m = sim_rig_tip_m(&s->rig);
     link_attach(l, &SIM_OPS, s, true);
     return ARGIL_OK;
 }

@@ -3,7 +3,7 @@
  * bus/port path, claims its vendor interface, reads the endpoint addresses from the interface
  * descriptor, keeps several asynchronous bulk IN transfers in flight (the board's 1 kHz
  * telemetry never waits on the host) and one bulk OUT. The byte stream is cut into frames by
- * the board's own framer (firmware/hal/link_framer.c). Unplug → transport down (link LOST,
+ * the framer the board uses too (shared/link_framer.c). Unplug → transport down (link LOST,
  * everything else kept); the device is looked for again (hot-plug events where libusb has
  * them, and a fresh scan every USB_RESCAN_US), reopened, and the link state machine asks the
  * host to resynchronise once frames flow.
@@ -18,10 +18,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "firmware/hal/link_io.h"
 #include "host/link/link.h"
 #include "host/link/link_usb_api.h"
 #include "host/link/link_usb_desc.h"
+#include "shared/link_framer.h"
 
 #define USB_IN_TRANSFERS 8u          /* bulk IN transfers kept in flight */
 #define USB_IN_BYTES 4096u           /* each */

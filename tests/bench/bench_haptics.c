@@ -35,9 +35,9 @@ static void send_wall(rig_t *r, float wall_z, vec3_t centre, int edge)
 static bool wall_stable(float k_n_per_mm, bool passivity, float *pp_mm)
 {
     rig_t *r = rig_new_mode(k_n_per_mm, true);
-    r->board.cfg.passivity = passivity;
-    r->dev.p.hand.stiffness_n_per_m = 100.0f;
-    r->dev.p.hand.damping_n_s_per_m = 0.2f;
+    r->rig.board.cfg.passivity = passivity;
+    r->rig.dev.p.hand.stiffness_n_per_m = 100.0f;
+    r->rig.dev.p.hand.damping_n_s_per_m = 0.2f;
     const vec3_t tip = rig_tip_model(r);
     const float wall = tip.z - r->tool.radius_m - 0.002f;
     send_wall(r, wall, tip, 16);
@@ -57,7 +57,7 @@ static bool wall_stable(float k_n_per_mm, bool passivity, float *pp_mm)
         }
     }
     *pp_mm = (hi - lo) * 1e3f;
-    const bool ok = r->board.safety.state == SAFETY_ACTIVE && *pp_mm < 0.05f;
+    const bool ok = r->rig.board.safety.state == SAFETY_ACTIVE && *pp_mm < 0.05f;
     rig_free(r);
     return ok;
 }
@@ -87,7 +87,7 @@ static void zwidth(void)
 static void tick_workload(const char *shape, int edge)
 {
     rig_t *r = rig_new_mode(1.0f, true);
-    r->board.cfg.safety.overrun_streak = 0; /* under valgrind every tick overruns */
+    r->rig.board.cfg.safety.overrun_streak = 0; /* under valgrind every tick overruns */
     const vec3_t tip = rig_tip_model(r);
     send_wall(r, tip.z - r->tool.radius_m - 0.001f, tip, edge);
     msg_tool_t t = rig_tool(r, TOOL_PUSH, 1.0f);
@@ -106,7 +106,7 @@ static void tick_workload(const char *shape, int edge)
     rig_move(r, vec3_add(tip, vec3(0.003f, 0, -0.004f)), 1000);
     rig_move(r, vec3_add(tip, vec3(-0.003f, 0, -0.004f)), 1000);
     printf("%s %d: peak %.3f N, %u swaps, %u ticks\n", shape, edge,
-           (double)r->board.stats.peak_force_n, r->board.stats.windows_swapped, r->board.stats.ticks);
+           (double)r->rig.board.stats.peak_force_n, r->rig.board.stats.windows_swapped, r->rig.board.stats.ticks);
     rig_free(r);
 }
 

@@ -24,12 +24,10 @@
 #define RUNNING_ON_VALGRIND 0
 #endif
 
-#include "firmware/core/board_hal.h"
-#include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
-#include "sim/sim_device.h"
+#include "sim/rig/rig.h"
 
 /* The same scene as host/app/session.c: an 88³ grid of 1.25 mm, a 30 mm clay sphere at the
  * origin, the stylus starting 60 mm in front of it, 2 s to become ACTIVE, 0.3 s tail. */
@@ -41,23 +39,19 @@
 #define TAIL_S 0.3
 
 typedef struct {
-    hal_t hal;
-    board_t board;
-    board_io_t io;
-    sim_device_t dev;
-    sim_params_t sp;
+    sim_rig_t rig;
     grid_t grid;
     peer_t peer;
     script_t script;
     script_player_t player;
     vec3_t offset_m;
-    uint8_t rx[HAL_SIM_LINK_BYTES];
+    uint8_t rx[SIM_RIG_LINK_BYTES];
 } bench_t;
 
 static bool bench_send(void *ctx, const uint8_t *frame, size_t len)
 {
     bench_t *b = ctx;
-    return hal_sim_host_send(&b->hal, frame, len) == ARGIL_OK;
+    return sim_rig_host_send(&b->rig, frame, len) == ARGIL_OK;
 }
 
 static void tool_from_player(const bench_t *b, msg_tool_t *t)
@@ -132,20 +126,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_ticks: %s\n", err);
         return 1;
     }
-    sim_params_default(&b->sp);
-    sim_device_init(&b->dev, &b->sp);
-    hal_sim_init(&b->hal);
-    board_cfg_t bc;
-    board_cfg_default(&bc);
-    bc.arm = b->sp.arm.desc;
+    sim_rig_cfg_t rc;
+    sim_rig_cfg_default(&rc);
     /* Under valgrind a tick takes ~50x longer; the overrun-streak fault would end the session. */
     if (RUNNING_ON_VALGRIND)
-        bc.safety.overrun_streak = 0;
-    if (board_init(&b->board, &bc) != ARGIL_OK) {
+        rc.board.safety.overrun_streak = 0;
+    if (sim_rig_init(&b->rig, &rc) != ARGIL_OK) {
         fprintf(stderr, "bench_ticks: board configuration refused\n");
         return 1;
     }
-    board_io_init(&b->io);
     const int32_t dims[3] = {GRID_EDGE, GRID_EDGE, GRID_EDGE};
     const float half = 0.5f * (float)(GRID_EDGE - 1) * SPACING_M;
     if (grid_init(&b->grid, dims, SPACING_M, vec3(-half, -half, -half)) != ARGIL_OK) {
@@ -168,10 +157,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_ticks: paint scale %g refused\n", (double)paint_scale);
         return 2;
     }
-    b->offset_m = vec3_sub(vec3(0, 0, START_Z_M), sim_device_tip_m(&b->dev));
+    b->offset_m = vec3_sub(vec3(0, 0, START_Z_M), sim_rig_tip_m(&b->rig));
     script_player_init(&b->player, &b->script, vec3(0, 0, START_Z_M));
 
-    const uint32_t dt_us = bc.tick_us;
+    const uint32_t dt_us = rc.board.tick_us;
     const float dt_s = (float)dt_us * 1e-6f;
     const double total_s = SETTLE_S + script_duration_s(&b->script) + TAIL_S;
     uint64_t max_ticks = (uint64_t)(total_s / dt_s) + 1u;
@@ -211,27 +200,22 @@ int main(int argc, char **argv)
             b->player.params_changed = 0;
         }
         const vec3_t target = vec3_sub(b->player.pos_m, b->offset_m);
-        sim_device_set_hand(&b->dev, target, b->player.vel_m_s, (b->player.buttons & 1) != 0,
-                            (b->player.buttons & 2) != 0);
-        can_batch_t from_board, to_board;
-        to_board.n = 0;
-        hal_sim_take_from_board(&b->hal, &from_board);
-        sim_device_step(&b->dev, &from_board, hal_sim_gpio_out(&b->hal), &to_board, dt_us);
-        hal_sim_put_to_board(&b->hal, &to_board);
-        hal_sim_set_gpio_in(&b->hal, sim_device_gpio_in(&b->dev));
+        sim_rig_set_hand(&b->rig, target, b->player.vel_m_s, (b->player.buttons & 1) != 0,
+                         (b->player.buttons & 2) != 0);
+        sim_rig_step_device(&b->rig, dt_us);
 
         /* The measured part: one board tick, nothing else. */
         const double t0 = now_ns();
         CALLGRIND_TOGGLE_COLLECT;
-        (void)board_run_tick(&b->board, &b->io, &b->hal);
+        (void)sim_rig_step_board(&b->rig);
         CALLGRIND_TOGGLE_COLLECT;
         const double t1 = now_ns();
         CALLGRIND_DUMP_STATS;
         wall[tick] = (uint64_t)(t1 - t0);
-        if (b->board.safety.state == SAFETY_ACTIVE)
+        if (b->rig.board.safety.state == SAFETY_ACTIVE)
             active_ticks++;
 
-        const size_t n = hal_sim_host_receive(&b->hal, b->rx, sizeof(b->rx));
+        const size_t n = sim_rig_host_receive(&b->rig, b->rx, sizeof(b->rx));
         peer_receive(&b->peer, b->rx, n);
         peer_tick(&b->peer, dt_us);
     }
@@ -239,7 +223,7 @@ int main(int argc, char **argv)
     qsort(wall, ticks, sizeof(*wall), cmp_u64);
     printf("window %d^3: %llu ticks (%.2f s simulated, %llu ACTIVE), final state %s\n", edge,
            (unsigned long long)ticks, (double)ticks * dt_s, (unsigned long long)active_ticks,
-           safety_state_name(b->board.safety.state));
+           safety_state_name(b->rig.board.safety.state));
     if (paint_scale > 0.0f)
         printf("painted %gx: %u windows, %u chunks sent\n", (double)paint_scale,
                b->peer.stats.windows_sent, b->peer.stats.chunks_sent);

@@ -9,19 +9,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "firmware/core/board_hal.h"
-#include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/model/grid.h"
 #include "shared/gpio_lines.h"
-#include "sim/sim_device.h"
+#include "sim/rig/rig.h"
 
 typedef struct {
-    hal_t hal;
-    board_t board;
-    board_io_t io;
-    sim_device_t dev;
-    sim_params_t sp;
+    sim_rig_t rig;            /* the simulated arm, the sim HAL and the board */
     grid_t grid;
     peer_t peer;
     bool manual_host;         /* the test plays the host (rig_send_window, heartbeats here) */
@@ -34,8 +28,7 @@ typedef struct {
     uint32_t host_seq;
     uint32_t window_version;
     bool armed_sent;
-    can_batch_t last_from_board;
-    uint8_t rx[HAL_SIM_LINK_BYTES];
+    uint8_t rx[SIM_RIG_LINK_BYTES];
     uint32_t ms;
     /* Optional: every frame the host's peer sends goes here instead of straight to the link
      * (tests/sil/test_faults.c loses, delays, duplicates and reorders them). NULL: direct. */
@@ -48,7 +41,7 @@ static inline bool rig_send(void *ctx, const uint8_t *f, size_t len)
     rig_t *r = ctx;
     if (r->link_hook)
         return r->link_hook(r->link_hook_ctx, f, len);
-    return hal_sim_host_send(&r->hal, f, len) == ARGIL_OK;
+    return sim_rig_host_send(&r->rig, f, len) == ARGIL_OK;
 }
 
 /* A sensible tool of the given kind, as the host would send it. */
@@ -88,7 +81,7 @@ static inline void rig_send_msg(rig_t *r, proto_msg_t *m)
     size_t len = 0;
     assert_int_equal(proto_encode(m, r->host_seq++, buf, sizeof(buf), &len), PROTO_OK);
     int tries = 0;
-    while (hal_sim_host_send(&r->hal, buf, len) == ARGIL_ERR_FULL && tries++ < 1000)
+    while (sim_rig_host_send(&r->rig, buf, len) == ARGIL_ERR_FULL && tries++ < 1000)
         rig_tick(r);
     assert_int_equal(tries <= 1000, 1);
 }
@@ -99,20 +92,15 @@ static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
 {
     rig_t *r = calloc(1, sizeof(*r));
     assert_non_null(r);
-    sim_params_default(&r->sp);
-    sim_device_init(&r->dev, &r->sp);
-    hal_sim_init(&r->hal);
-    board_cfg_t bc;
-    board_cfg_default(&bc);
-    bc.arm = r->sp.arm.desc;
+    sim_rig_cfg_t rc;
+    sim_rig_cfg_default(&rc);
     /* Scenarios run on a virtual clock and test behaviour, not this machine's speed: a
      * sanitizer build on a busy machine must not trip the overrun streak (tested on its own in
      * test_safety and test_safety_table). */
-    bc.safety.overrun_streak = 0;
-    assert_int_equal(board_init(&r->board, &bc), ARGIL_OK);
-    board_io_init(&r->io);
+    rc.board.safety.overrun_streak = 0;
+    assert_int_equal(sim_rig_init(&r->rig, &rc), ARGIL_OK);
     r->manual_host = manual_host;
-    r->offset_m = vec3_sub(vec3(0, 0, 0.060f), sim_device_tip_m(&r->dev));
+    r->offset_m = vec3_sub(vec3(0, 0, 0.060f), sim_rig_tip_m(&r->rig));
     r->hand_model_m = vec3(0, 0, 0.060f);
     r->host_alive = true;
     r->tool = rig_tool(r, TOOL_TOUCH, stiffness_n_per_mm);
@@ -210,17 +198,12 @@ static inline void rig_send_window(rig_t *r, const float *density, const float *
 static inline void rig_tick(rig_t *r)
 {
     if (r->hand_released)
-        sim_device_release_hand(&r->dev);
+        sim_rig_release_hand(&r->rig);
     else
-        sim_device_set_hand(&r->dev, vec3_sub(r->hand_model_m, r->offset_m), vec3(0, 0, 0),
-                            r->btn1, false);
-    can_batch_t to_board = {0};
-    hal_sim_take_from_board(&r->hal, &r->last_from_board);
-    sim_device_step(&r->dev, &r->last_from_board, hal_sim_gpio_out(&r->hal), &to_board, 1000);
-    hal_sim_put_to_board(&r->hal, &to_board);
-    hal_sim_set_gpio_in(&r->hal, sim_device_gpio_in(&r->dev));
-    (void)board_run_tick(&r->board, &r->io, &r->hal);
-    const size_t n = hal_sim_host_receive(&r->hal, r->rx, sizeof(r->rx));
+        sim_rig_set_hand(&r->rig, vec3_sub(r->hand_model_m, r->offset_m), vec3(0, 0, 0),
+                         r->btn1, false);
+    (void)sim_rig_step_ns(&r->rig, 1000);
+    const size_t n = sim_rig_host_receive(&r->rig, r->rx, sizeof(r->rx));
     if (r->host_alive && !r->manual_host) {
         peer_receive(&r->peer, r->rx, n);
         peer_tick(&r->peer, 1000);
@@ -230,8 +213,8 @@ static inline void rig_tick(rig_t *r)
         m.type = MSG_HEARTBEAT;
         m.u.heartbeat.time_us = (uint64_t)r->ms * 1000u;
         m.u.heartbeat.window_version = r->window_version;
-        m.u.heartbeat.impulse_seq = r->board.impulse_seq;
-        if (!r->armed_sent && r->board.safety.state == SAFETY_IDLE && r->window_version > 0) {
+        m.u.heartbeat.impulse_seq = r->rig.board.impulse_seq;
+        if (!r->armed_sent && r->rig.board.safety.state == SAFETY_IDLE && r->window_version > 0) {
             m.u.heartbeat.command = PROTO_CMD_ARM;
             r->armed_sent = true;
         }
@@ -245,7 +228,7 @@ static inline int rig_until_active(rig_t *r, int max_ms)
 {
     for (int i = 0; i < max_ms; i++) {
         rig_tick(r);
-        if (r->board.safety.state == SAFETY_ACTIVE)
+        if (r->rig.board.safety.state == SAFETY_ACTIVE)
             return i + 1;
     }
     return -1;
@@ -264,7 +247,7 @@ static inline void rig_move(rig_t *r, vec3_t to_m, int ms)
 /* The stylus tip in model space (the truth, from the simulator). */
 static inline vec3_t rig_tip_model(const rig_t *r)
 {
-    return vec3_add(sim_device_tip_m(&r->dev), r->offset_m);
+    return vec3_add(sim_rig_tip_m(&r->rig), r->offset_m);
 }
 
 /* Where the host's clay surface crosses the +z axis through (x, y), in metres (-1 if none). */

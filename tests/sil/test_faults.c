@@ -96,7 +96,7 @@ static void log_frames(fx_t *x, int64_t t_us, const can_batch_t *b)
     for (uint8_t i = 0; i < b->n; i++) {
         const can_frame_t *f = &b->f[i];
         fprintf(x->can_log, "(%" PRId64 ".%06" PRId64 ") vcan0 ", t / 1000000, t % 1000000);
-        if (f->id & DRIVES_CAN_ERR_FLAG)
+        if (f->id & ARGIL_CAN_ERR_FLAG)
             fprintf(x->can_log, "%08X#", (unsigned)f->id);
         else
             fprintf(x->can_log, "%03X#", (unsigned)f->id);
@@ -109,7 +109,7 @@ static void log_frames(fx_t *x, int64_t t_us, const can_batch_t *b)
 /* Straight to the board's link queue. */
 static void to_board(fx_t *x, const uint8_t *f, size_t len)
 {
-    (void)hal_sim_host_send(&x->r->hal, f, len);
+    (void)hal_sim_host_send(&x->r->rig.hal, f, len);
 }
 
 static void hold(fx_t *x, const uint8_t *f, size_t len, int64_t due_us)
@@ -203,7 +203,7 @@ static void send_rearm(fx_t *x)
     m.type = MSG_HEARTBEAT;
     m.u.heartbeat.time_us = (uint64_t)x->run.now_us;
     m.u.heartbeat.window_version = x->r->peer.have_current ? x->r->peer.current.version : 0u;
-    m.u.heartbeat.impulse_seq = x->r->board.impulse_seq;
+    m.u.heartbeat.impulse_seq = x->r->rig.board.impulse_seq;
     m.u.heartbeat.command = PROTO_CMD_ARM;
     uint8_t buf[PROTO_FRAME_MAX];
     size_t len = 0;
@@ -278,7 +278,7 @@ static void stranger_send(fx_t *x)
     size_t len = 0;
     assert_int_equal(proto_encode(&m, x->r->peer.tx_seq + 1000u + x->stranger_sent, buf,
                                   sizeof(buf), &len), PROTO_OK);
-    assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, buf, len), ARGIL_OK);
+    assert_int_equal(hal_sim_host_send_from(&x->r->rig.hal, HAL_SIM_STRANGER, buf, len), ARGIL_OK);
     x->stranger_sent++;
 }
 
@@ -295,10 +295,10 @@ static void stranger_tick(fx_t *x, int64_t now)
         if (n == 0)
             break;
         const held_frame_t *c = &x->captured[x->replay_next++ % n];
-        assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, c->bytes, c->len),
+        assert_int_equal(hal_sim_host_send_from(&x->r->rig.hal, HAL_SIM_STRANGER, c->bytes, c->len),
                          ARGIL_OK);
         x->replayed_other++;
-        (void)hal_sim_host_send(&x->r->hal, c->bytes, c->len); /* the host's own address */
+        (void)hal_sim_host_send(&x->r->rig.hal, c->bytes, c->len); /* the host's own address */
         x->replayed_own++;
         break;
     }
@@ -314,7 +314,7 @@ static void stranger_tick(fx_t *x, int64_t now)
             }
             if (k % 2 == 0 && n >= 4)
                 memcpy(junk, "ARGL", 4); /* starts like a frame */
-            assert_int_equal(hal_sim_host_send_from(&x->r->hal, HAL_SIM_STRANGER, junk, n),
+            assert_int_equal(hal_sim_host_send_from(&x->r->rig.hal, HAL_SIM_STRANGER, junk, n),
                              ARGIL_OK);
             x->flooded++;
         }
@@ -338,35 +338,35 @@ static void fx_tick(fx_t *x)
     if (now >= x->stranger_from_us && now < x->stranger_until_us)
         stranger_tick(x, now);
     can_batch_t from_board, to_b;
-    hal_sim_take_from_board(&r->hal, &from_board);
-    sim_runner_tick(&x->run, &from_board, hal_sim_gpio_out(&r->hal), &to_b, 1000);
+    hal_sim_take_from_board(&r->rig.hal, &from_board);
+    sim_runner_tick(&x->run, &from_board, hal_sim_gpio_out(&r->rig.hal), &to_b, 1000);
     log_frames(x, now, &to_b);
-    hal_sim_put_to_board(&r->hal, &to_b);
-    hal_sim_set_gpio_in(&r->hal, sim_runner_gpio_in(&x->run));
-    (void)board_run_tick(&r->board, &r->io, &r->hal);
+    hal_sim_put_to_board(&r->rig.hal, &to_b);
+    hal_sim_set_gpio_in(&r->rig.hal, sim_runner_gpio_in(&x->run));
+    (void)board_run_tick(&r->rig.board, &r->rig.io, &r->rig.hal);
     /* The tick's compute as the board's next tick sees it: the scenario's, not this machine's.
      * This VM charges stolen time to the running thread (/proc/stat steal stays 0; a fixed
      * 150 us loop read up to 1.6 ms of thread CPU time), and with the daemon's streak of 3 the
      * measured time of this sanitizer build was the one thing in the run not on the virtual
      * clock: a loaded run of basic.scn once sent 0 RPDOs with torque where it sends 3,510. */
-    r->io.prev_compute_ns = x->overrun_left > 0 ? OVERRUN_NS : 0u; /* the injected load */
+    r->rig.io.prev_compute_ns = x->overrun_left > 0 ? OVERRUN_NS : 0u; /* the injected load */
     if (x->overrun_left > 0)
         x->overrun_left--;
-    log_frames(x, now + 500, &r->io.out.can_tx); /* the board's frames, half a tick later */
-    const size_t n = hal_sim_host_receive(&r->hal, r->rx, sizeof(r->rx));
+    log_frames(x, now + 500, &r->rig.io.out.can_tx); /* the board's frames, half a tick later */
+    const size_t n = hal_sim_host_receive(&r->rig.hal, r->rx, sizeof(r->rx));
     if (!x->lost)
         peer_receive(&r->peer, r->rx, n);
     peer_tick(&r->peer, 1000);
-    const safety_state_t s = r->board.safety.state;
+    const safety_state_t s = r->rig.board.safety.state;
     if (x->n_force < FORCE_TICKS_MAX)
-        x->force[x->n_force++] = r->board.force_n;
+        x->force[x->n_force++] = r->rig.board.force_n;
     if (s == SAFETY_ACTIVE)
         x->was_active = true;
     else if (x->was_active)
         x->left_active = true;
     if ((s == SAFETY_FAULT || s == SAFETY_ESTOP) && x->first_bad_us < 0) {
         x->first_bad_us = now;
-        x->fault = r->board.safety.fault;
+        x->fault = r->rig.board.safety.fault;
     }
     r->ms++;
 }
@@ -382,8 +382,8 @@ static fx_t *fx_new(const char *path)
     x->r = rig_new(0.8f);
     /* The daemon's limits (firmware/board/board_config.c): 3 overruns in a row are a fault,
      * and a tool faster than 1.5 m/s is one (how an encoder jump shows). */
-    x->r->board.cfg.safety.overrun_streak = 3u;
-    x->r->board.cfg.max_velocity_m_s = 1.5f;
+    x->r->rig.board.cfg.safety.overrun_streak = 3u;
+    x->r->rig.board.cfg.max_velocity_m_s = 1.5f;
     x->r->link_hook = link_hook;
     x->r->link_hook_ctx = x;
     x->held = calloc(LINK_HELD_MAX, sizeof(*x->held));
@@ -399,7 +399,7 @@ static fx_t *fx_new(const char *path)
     assert_non_null(x->can_log);
     assert_non_null(x->ev_log);
     x->first_bad_us = -1;
-    sim_runner_init(&x->run, &x->r->sp, &x->scn, true, log_event, x);
+    sim_runner_init(&x->run, &x->r->rig.sim_params, &x->scn, true, log_event, x);
     char text[64];
     snprintf(text, sizeof(text), "start scenario %s", x->scn.name);
     log_event(x, 0, text);
@@ -518,7 +518,7 @@ static fx_t *run_row_keep(const matrix_row_t *row)
     printf("  %s: first FAULT/ESTOP at %.3f s (%s), link errors %u, CAN dropped %u/%u\n",
            x->scn.name, x->first_bad_us < 0 ? -1.0 : (double)x->first_bad_us * 1e-6,
            x->first_bad_us < 0 ? "none" : safety_fault_name(x->fault),
-           x->r->board.stats.link_errors, x->run.faults.dropped_to_board,
+           x->r->rig.board.stats.link_errors, x->run.faults.dropped_to_board,
            x->run.faults.dropped_from_board);
     assert_int_equal(failed, 0);
     if (row->fault == -1) {
@@ -530,7 +530,7 @@ static fx_t *run_row_keep(const matrix_row_t *row)
         assert_true(x->fault == (fault_code_t)row->fault ||
                     (row->alt_fault != FAULT_NONE && x->fault == row->alt_fault));
     }
-    assert_true(x->r->board.stats.link_errors >= row->min_link_errors);
+    assert_true(x->r->rig.board.stats.link_errors >= row->min_link_errors);
     assert_true(ridden >= row->min_hb_ridden);
     return x;
 }
@@ -584,7 +584,7 @@ static void test_link_duplicate(void **st)
     fx_t *t;
     float diff, peak;
     fx_t *x = run_with_twin(&matrix[12], &t, &diff, &peak);
-    const board_stats_t *bs = &x->r->board.stats;
+    const board_stats_t *bs = &x->r->rig.board.stats;
     printf("  link_duplicate: %u copies, refused duplicate %u, stale %u, no session %u; force "
            "differs from the run without duplicates by %.6f N (peak %.3f N)\n", x->dup_sent,
            bs->refused_duplicate, bs->refused_stale, bs->refused_no_session, (double)diff,
@@ -593,7 +593,7 @@ static void test_link_duplicate(void **st)
     /* all but the copies of the run's last host tick, which no board tick takes in */
     assert_true(bs->refused_duplicate <= x->dup_sent && bs->refused_duplicate + 2u >= x->dup_sent);
     assert_int_equal(bs->refused_stale, 0);
-    assert_int_equal(t->r->board.stats.refused_duplicate, 0);
+    assert_int_equal(t->r->rig.board.stats.refused_duplicate, 0);
     assert_true(peak > 0.5f); /* the hand presses into the clay meanwhile */
     assert_true(diff == 0.0f);
     fx_free(t);
@@ -608,7 +608,7 @@ static void test_link_reorder(void **st)
     fx_t *t;
     float diff, peak;
     fx_t *x = run_with_twin(&matrix[13], &t, &diff, &peak);
-    const board_stats_t *bs = &x->r->board.stats;
+    const board_stats_t *bs = &x->r->rig.board.stats;
     printf("  link_reorder: refused duplicate %u, stale %u; force differs from the run in "
            "order by %.6f N (peak %.3f N)\n", bs->refused_duplicate, bs->refused_stale,
            (double)diff, (double)peak);
@@ -635,15 +635,15 @@ static void test_stranger_cannot_command_the_arm(void **st)
     fx_t *t = twin_run("basic.scn");
     float peak = 0.0f;
     const float diff = force_diff_n(x, t, &peak);
-    const board_stats_t *bs = &x->r->board.stats;
+    const board_stats_t *bs = &x->r->rig.board.stats;
     printf("  stranger: %u frames sent, refused for their sender %u; board %s, left ACTIVE %s; "
            "force differs from the run without the stranger by %.6f N (peak %.3f N)\n",
            x->stranger_sent, bs->transport_refused_source,
-           safety_state_name(x->r->board.safety.state), x->left_active ? "yes" : "no",
+           safety_state_name(x->r->rig.board.safety.state), x->left_active ? "yes" : "no",
            (double)diff, (double)peak);
     assert_int_equal(x->stranger_sent, 200);
     assert_int_equal(bs->transport_refused_source, x->stranger_sent);
-    assert_int_equal(x->r->board.session.epoch, 1); /* no HELLO but the host's acted */
+    assert_int_equal(x->r->rig.board.session.epoch, 1); /* no HELLO but the host's acted */
     assert_true(x->first_bad_us < 0);
     assert_true(x->was_active);
     assert_false(x->left_active);
@@ -665,19 +665,19 @@ static void test_hostile_network(void **st)
     fx_t *t;
     float diff, peak;
     fx_t *x = run_with_twin(&matrix[17], &t, &diff, &peak);
-    const board_stats_t *bs = &x->r->board.stats;
+    const board_stats_t *bs = &x->r->rig.board.stats;
     printf("  hostile_network: replayed %u from another sender + %u from the host's, forged %u, "
            "flooded %u; refused: sender %u, duplicate %u, stale %u; board %s, left ACTIVE %s, "
            "sessions %u; force differs from the run without the stranger by %.6f N (peak "
            "%.3f N)\n", x->replayed_other, x->replayed_own, x->stranger_sent, x->flooded,
            bs->transport_refused_source, bs->refused_duplicate, bs->refused_stale,
-           safety_state_name(x->r->board.safety.state), x->left_active ? "yes" : "no",
-           x->r->board.session.epoch, (double)diff, (double)peak);
+           safety_state_name(x->r->rig.board.safety.state), x->left_active ? "yes" : "no",
+           x->r->rig.board.session.epoch, (double)diff, (double)peak);
     assert_true(x->replayed_own >= 500u && x->stranger_sent >= 100u && x->flooded >= 10000u);
     assert_int_equal(bs->transport_refused_source,
                      x->replayed_other + x->stranger_sent + x->flooded);
     assert_int_equal(bs->refused_duplicate + bs->refused_stale, x->replayed_own);
-    assert_int_equal(x->r->board.session.epoch, 1);
+    assert_int_equal(x->r->rig.board.session.epoch, 1);
     assert_true(x->first_bad_us < 0);
     assert_true(x->was_active);
     assert_false(x->left_active);

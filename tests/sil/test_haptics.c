@@ -42,12 +42,12 @@ static void push_scenario(rig_t *r, float depth_m, float *z_before, float *z_aft
     for (int i = 1; i <= ms; i++) {
         r->hand_model_m = vec3(0, 0, z0 + (z1 - z0) * (float)i / (float)ms);
         rig_tick(r);
-        const float f = r->board.force_n.z;
+        const float f = r->rig.board.force_n.z;
         if (!yielded && f > 0.05f) {
             /* Before the clay yields, the resistance only grows with depth. */
             if (f < last - 0.02f)
                 *monotonic = false;
-            if (r->board.sculpting) {
+            if (r->rig.board.sculpting) {
                 yielded = true;
                 *yield_force = f;
             }
@@ -99,7 +99,7 @@ static void test_windows_put_off_on_impulse_ticks_still_arrive(void **st)
     float zb, za, fy, drop;
     bool mono;
     push_scenario(r, 0.005f, &zb, &za, &fy, &mono, &drop);
-    const board_stats_t *s = &r->board.stats;
+    const board_stats_t *s = &r->rig.board.stats;
     printf("# %u WINDOW frames put off a tick, %u windows swapped in, %u link errors\n",
            s->window_frames_deferred, s->windows_swapped, s->link_errors);
     assert_true(s->window_frames_deferred > 0);
@@ -159,15 +159,15 @@ static void test_stiff_wall_settles_and_stays_passive(void **st)
         const float pen = (tip.z + 0.005f) - rig_tip_model(r).z; /* > 0 inside */
         if (pen > pen_max[ms / 50])
             pen_max[ms / 50] = pen;
-        assert_int_equal(r->board.safety.state, SAFETY_ACTIVE);
+        assert_int_equal(r->rig.board.safety.state, SAFETY_ACTIVE);
     }
     /* No sustained oscillation: the deepest penetration halves (or better) every 50 ms. */
     for (int w = 1; w < 8; w++)
         assert_true(pen_max[w] <= 0.5f * pen_max[w - 1] + 1e-5f);
     printf("# wall: penetration peaks per 50 ms %.2f %.2f %.2f %.2f mm; PO max %.3f mJ\n",
            pen_max[0] * 1e3, pen_max[1] * 1e3, pen_max[2] * 1e3, pen_max[3] * 1e3,
-           r->board.passivity.max_energy_j * 1e3);
-    assert_true(r->board.passivity.max_energy_j <= 1e-3f); /* ≤ 1 mJ generated */
+           r->rig.board.passivity.max_energy_j * 1e3);
+    assert_true(r->rig.board.passivity.max_energy_j <= 1e-3f); /* ≤ 1 mJ generated */
     rig_free(r);
 }
 
@@ -181,27 +181,27 @@ static void test_window_swap_under_3N_is_not_felt(void **st)
     assert_true(rig_until_active(r, 1000) > 0);
     /* Press until the wall pushes back with about 3 N. */
     int ms = 0;
-    while (r->board.force_n.z < 3.0f && ms < 3000) {
+    while (r->rig.board.force_n.z < 3.0f && ms < 3000) {
         r->hand_model_m = vec3(tip.x, tip.y, r->hand_model_m.z - 0.00001f);
         rig_tick(r);
         ms++;
     }
-    assert_true(r->board.force_n.z >= 3.0f);
+    assert_true(r->rig.board.force_n.z >= 3.0f);
     for (int i = 0; i < 300; i++)
         rig_tick(r);
     /* The host recentres the window and its field has moved 0.4 mm (as the clay settled). */
-    const uint32_t swaps = r->board.stats.windows_swapped;
+    const uint32_t swaps = r->rig.board.stats.windows_swapped;
     send_wall(r, wall - 0.0004f, vec3_add(rig_tip_model(r), vec3(0.002f, 0.0f, 0.001f)), 0.0f,
               0.0f);
-    float prev = r->board.force_n.z, worst = 0.0f;
+    float prev = r->rig.board.force_n.z, worst = 0.0f;
     for (int i = 0; i < 200; i++) {
         rig_tick(r);
-        const float dz = fabsf(r->board.force_n.z - prev);
+        const float dz = fabsf(r->rig.board.force_n.z - prev);
         if (dz > worst)
             worst = dz;
-        prev = r->board.force_n.z;
+        prev = r->rig.board.force_n.z;
     }
-    assert_int_equal(r->board.stats.windows_swapped, swaps + 1);
+    assert_int_equal(r->rig.board.stats.windows_swapped, swaps + 1);
     printf("# swap at %.2f N: largest tick-to-tick change %.4f N\n", prev, worst);
     assert_true(worst < 0.1f);
     rig_free(r);
@@ -230,8 +230,8 @@ static void test_probe_feels_four_times_the_stiffness(void **st)
         r->hand_model_m = vec3_add(a, vec3_scale(vec3_sub(b, a), (float)i / 700.0f));
         rig_tick(r);
         const float x = rig_tip_model(r).x - tip.x;
-        if (x < -0.0045f && x > -0.0065f) { f_soft += fabsf(r->board.force_n.x); n_soft++; }
-        if (x > 0.0045f && x < 0.0065f) { f_hard += fabsf(r->board.force_n.x); n_hard++; }
+        if (x < -0.0045f && x > -0.0065f) { f_soft += fabsf(r->rig.board.force_n.x); n_soft++; }
+        if (x > 0.0045f && x < 0.0065f) { f_hard += fabsf(r->rig.board.force_n.x); n_hard++; }
     }
     assert_true(n_soft > 20 && n_hard > 20);
     const double ratio = (f_hard / n_hard) / (f_soft / n_soft);
@@ -249,7 +249,7 @@ static rig_t *pressing_rig(void)
     assert_true(rig_until_active(r, 1000) > 0);
     for (int i = 0; i < 100; i++)
         rig_tick(r);
-    assert_true(vec3_norm(r->board.force_n) > 0.3f);
+    assert_true(vec3_norm(r->rig.board.force_n) > 0.3f);
     return r;
 }
 
@@ -282,11 +282,11 @@ static void test_nan_window_faults_with_zero_force_in_the_tick(void **st)
     const uint32_t crc = crc32c(0, buf, len - 4u);
     for (int k = 0; k < 4; k++)
         buf[len - 4u + (size_t)k] = (uint8_t)(crc >> (8 * k));
-    assert_int_equal(hal_sim_host_send(&r->hal, buf, len), ARGIL_OK);
+    assert_int_equal(hal_sim_host_send(&r->rig.hal, buf, len), ARGIL_OK);
     rig_tick(r);
-    assert_int_equal(r->board.safety.state, SAFETY_FAULT);
-    assert_int_equal(r->board.safety.fault, FAULT_NONFINITE);
-    assert_float_equal(vec3_norm(r->board.force_n), 0.0f, 0.0f);
+    assert_int_equal(r->rig.board.safety.state, SAFETY_FAULT);
+    assert_int_equal(r->rig.board.safety.fault, FAULT_NONFINITE);
+    assert_float_equal(vec3_norm(r->rig.board.force_n), 0.0f, 0.0f);
     rig_free(r);
 }
 
@@ -297,13 +297,13 @@ static void test_nan_gain_or_position_faults_in_the_tick(void **st)
         rig_t *r = pressing_rig();
         /* A corrupted gain or transform in the board's memory (the decoder refuses them on
          * the wire, so poke them): the very next tick must be safe. */
-        if (c == 0) r->board.tool.contact_stiffness_n_per_m = NAN;
-        if (c == 1) r->board.tool.model_scale = INFINITY;
-        if (c == 2) r->board.tool.model_offset_m[1] = NAN;
+        if (c == 0) r->rig.board.tool.contact_stiffness_n_per_m = NAN;
+        if (c == 1) r->rig.board.tool.model_scale = INFINITY;
+        if (c == 2) r->rig.board.tool.model_offset_m[1] = NAN;
         rig_tick(r);
-        assert_int_equal(r->board.safety.state, SAFETY_FAULT);
-        assert_int_equal(r->board.safety.fault, FAULT_NONFINITE);
-        assert_float_equal(vec3_norm(r->board.force_n), 0.0f, 0.0f);
+        assert_int_equal(r->rig.board.safety.state, SAFETY_FAULT);
+        assert_int_equal(r->rig.board.safety.fault, FAULT_NONFINITE);
+        assert_float_equal(vec3_norm(r->rig.board.force_n), 0.0f, 0.0f);
         rig_free(r);
     }
 }
@@ -323,11 +323,11 @@ static void test_stiff_clay_halves_the_step_and_stays_stable(void **st)
     rig_move(r, vec3_add(tip, vec3(0, 0, -0.004f)), 300);
     for (int i = 0; i < 200; i++)
         rig_tick(r);
-    assert_true(r->board.stats.max_substeps >= 4); /* halved at least twice */
-    const window_buf_t *w = window_active(&r->board.window);
+    assert_true(r->rig.board.stats.max_substeps >= 4); /* halved at least twice */
+    const window_buf_t *w = window_active(&r->rig.board.window);
     for (int32_t i = 0; i < window_nodes(w); i++)
         assert_true(w->density[i] >= 0.0f && w->density[i] <= 1.0f && isfinite(w->velocity[i]));
-    assert_int_equal(r->board.safety.state, SAFETY_ACTIVE);
+    assert_int_equal(r->rig.board.safety.state, SAFETY_ACTIVE);
     rig_free(r);
 }
 
@@ -339,22 +339,22 @@ static void test_soft_limit_pushes_back_before_the_joint_stop(void **st)
     send_wall(r, tip.z - 0.05f, tip, 0.0f, 0.0f); /* clay far away: no contact force */
     assert_true(rig_until_active(r, 1000) > 0);
     /* Drag the stylus sideways until the yaw joint is inside its 0.1 rad margin. */
-    const float q_max = r->board.cfg.arm.q_max_rad[0];
+    const float q_max = r->rig.board.cfg.arm.q_max_rad[0];
     float q[3];
     int ms = 0;
     do {
         r->hand_model_m = vec3_add(r->hand_model_m, vec3(0.0002f, 0, 0));
         rig_tick(r);
-        sim_device_q_rad(&r->dev, q);
+        sim_device_q_rad(&r->rig.dev, q);
     } while (fabsf(q[0]) < q_max - 0.05f && ++ms < 3000);
     assert_true(fabsf(q[0]) >= q_max - 0.05f);
     for (int i = 0; i < 5; i++)
         rig_tick(r);
     /* The board now commands a yaw torque back towards the middle of the range. */
     float tq[3];
-    sim_device_motor_torque_nm(&r->dev, tq);
+    sim_device_motor_torque_nm(&r->rig.dev, tq);
     assert_true(tq[0] * q[0] < 0.0f);
-    assert_true(fabsf(tq[0]) * r->board.cfg.arm.gear_ratio[0] > 0.5f * 0.04f * 0.5f);
+    assert_true(fabsf(tq[0]) * r->rig.board.cfg.arm.gear_ratio[0] > 0.5f * 0.04f * 0.5f);
     rig_free(r);
 }
 

@@ -43,7 +43,7 @@ typedef struct {
 /* Where the board's window surface crosses the z axis (x = y = 0), metres; -1 when it does not. */
 static float board_surface_z(const rig_t *r)
 {
-    const window_buf_t *b = window_active(&r->board.window);
+    const window_buf_t *b = window_active(&r->rig.board.window);
     assert_non_null(b);
     float prev = -1.0f;
     for (int k = 0; k <= 3000; k++) {
@@ -121,13 +121,13 @@ static void press(float paint_scale, uint32_t window_period_us, press_t *out)
             n++;
         }
     }
-    assert_int_equal(r->board.safety.state, SAFETY_ACTIVE);
+    assert_int_equal(r->rig.board.safety.state, SAFETY_ACTIVE);
     out->host_dent_mm = host_sum / n * 1e3;
     out->board_dent_mm = board_sum / n * 1e3;
     out->host_end_dent_mm = (SURFACE_Z_M - rig_surface_z(r, 0, 0)) * 1e3;
     if (out->force_2_3mm_ticks > 0)
         out->force_2_3mm_n /= out->force_2_3mm_ticks;
-    const window_buf_t *b = window_active(&r->board.window);
+    const window_buf_t *b = window_active(&r->rig.board.window);
     out->channels = b->node_stiffness ? 2 : 1;
     const float u[3] = {-b->origin_m.x / b->spacing_m, -b->origin_m.y / b->spacing_m,
                         (SURFACE_Z_M - b->origin_m.z) / b->spacing_m};

@@ -17,11 +17,11 @@
 
 #include "firmware/board/board_config.h"
 #include "firmware/core/drives.h"
-#include "firmware/core/spsc_ring.h"
 #include "firmware/hal/can_socket.h"
 #include "firmware/hal/gpio_port.h"
 #include "firmware/hal/link_io.h"
 #include "shared/gpio_lines.h"
+#include "shared/spsc_ring.h"
 
 static void test_can_socket_frames_and_error_frames(void **st)
 {
@@ -47,7 +47,7 @@ static void test_can_socket_frames_and_error_frames(void **st)
     assert_int_equal(rx.n, 2);
     assert_int_equal(rx.f[0].id, 0x182);
     assert_int_equal(rx.f[0].data[0], 0x37);
-    assert_int_equal(rx.f[1].id, DRIVES_CAN_ERR_FLAG | DRIVES_CAN_ERR_BUSOFF);
+    assert_int_equal(rx.f[1].id, ARGIL_CAN_ERR_FLAG | ARGIL_CAN_ERR_BUSOFF);
     assert_int_equal(stats.rx_error_frames, 1);
     assert_int_equal(stats.rx_dropped, 1);
     /* The core sees bus-off from it in the same tick. */

@@ -193,7 +193,7 @@ static can_frame_t error_frame(uint32_t cls, uint8_t ctrl)
 {
     can_frame_t f;
     memset(&f, 0, sizeof(f));
-    f.id = DRIVES_CAN_ERR_FLAG | cls;
+    f.id = ARGIL_CAN_ERR_FLAG | cls;
     f.len = 8;
     f.data[1] = ctrl;
     return f;
@@ -207,7 +207,7 @@ static void test_bus_passive_off_and_recovery(void **st)
     drives_init(&dr);
     heartbeat_all(&dr, NMT_STATE_OPERATIONAL);
     can_batch_t tx = {0};
-    can_frame_t f = error_frame(DRIVES_CAN_ERR_CRTL, DRIVES_CAN_CRTL_TX_PASSIVE);
+    can_frame_t f = error_frame(ARGIL_CAN_ERR_CRTL, ARGIL_CAN_CRTL_TX_PASSIVE);
     rx_frame(&dr, &f);
     assert_int_equal(dr.bus, CAN_BUS_PASSIVE);
     for (int ms = 0; ms < 99; ms++)
@@ -215,11 +215,11 @@ static void test_bus_passive_off_and_recovery(void **st)
     assert_false(drives_bus_error(&dr, &cfg)); /* 99 ms error-passive: tolerated */
     drives_process(&dr, &cfg, false, torque, 1000, (tx.n = 0, &tx));
     assert_true(drives_bus_error(&dr, &cfg));  /* 100 ms: a fault */
-    f = error_frame(DRIVES_CAN_ERR_CRTL, DRIVES_CAN_CRTL_ACTIVE);
+    f = error_frame(ARGIL_CAN_ERR_CRTL, ARGIL_CAN_CRTL_ACTIVE);
     rx_frame(&dr, &f);
     assert_false(drives_bus_error(&dr, &cfg));
 
-    f = error_frame(DRIVES_CAN_ERR_BUSOFF, 0);
+    f = error_frame(ARGIL_CAN_ERR_BUSOFF, 0);
     rx_frame(&dr, &f);
     assert_true(drives_bus_error(&dr, &cfg)); /* bus-off: a fault in the same tick */
     tx.n = 0;
@@ -228,7 +228,7 @@ static void test_bus_passive_off_and_recovery(void **st)
     for (int ms = 1; ms < 500; ms++)
         drives_process(&dr, &cfg, true, torque, 1000, (tx.n = 0, &tx));
     assert_true(drives_bus_unrecoverable(&dr, &cfg)); /* 500 ms without a restart */
-    f = error_frame(DRIVES_CAN_ERR_RESTARTED, 0);
+    f = error_frame(ARGIL_CAN_ERR_RESTARTED, 0);
     rx_frame(&dr, &f);
     assert_int_equal(dr.bus, CAN_BUS_ACTIVE);
     assert_false(drives_bus_unrecoverable(&dr, &cfg));

@@ -1,7 +1,7 @@
 /* Cuts a byte stream from the host link into whole protocol frames. */
 #include <string.h>
 
-#include "link_io.h"
+#include "link_framer.h"
 
 size_t link_frame_size(const uint8_t *buf, size_t len)
 {
