@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "host/mesh/mc.h"
+#include "host/model/floor_div.h"
 
 #define MCB_NONE UINT32_MAX
 #define MCB_L (MC_BLOCK_CELLS + 3) /* scratch samples per axis: cells + 1 corners + 2 halo */
@@ -45,12 +46,6 @@ void mc_blocks_free(mc_blocks_t *b)
     free(b->col);
     free(b->cache);
     memset(b, 0, sizeof(*b));
-}
-
-/* Block key of padded cell c: floor(c / MC_BLOCK_CELLS) for any sign. */
-static int32_t mcb_block_of(int64_t c)
-{
-    return (int32_t)(c >= 0 ? c / MC_BLOCK_CELLS : -((-c + MC_BLOCK_CELLS - 1) / MC_BLOCK_CELLS));
 }
 
 /* Home slot of block key k in a table of cap (a power of two) slots. */
@@ -227,8 +222,8 @@ argil_err_t mc_blocks_grow(mc_blocks_t *b, const int32_t lo[3], const int32_t hi
 static void mcb_box_keys(const mc_blocks_t *b, int32_t klo[3], int32_t khi[3])
 {
     for (int a = 0; a < 3; a++) {
-        klo[a] = mcb_block_of(b->lo[a]);
-        khi[a] = mcb_block_of(b->hi[a]) + 1;
+        klo[a] = floor_div_i32(b->lo[a], MC_BLOCK_CELLS);
+        khi[a] = floor_div_i32(b->hi[a], MC_BLOCK_CELLS) + 1;
     }
 }
 
@@ -278,8 +273,8 @@ void mc_blocks_mark(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
             h = (int64_t)b->hi[a] + 1;
         if (l >= h)
             return;
-        blo[a] = mcb_block_of(l);
-        bhi[a] = mcb_block_of(h - 1) + 1;
+        blo[a] = floor_div_i32((int32_t)l, MC_BLOCK_CELLS); /* l, h within [lo, hi + 1] */
+        bhi[a] = floor_div_i32((int32_t)(h - 1), MC_BLOCK_CELLS) + 1;
     }
     for (int32_t z = blo[2]; z < bhi[2]; z++)
         for (int32_t y = blo[1]; y < bhi[1]; y++)

@@ -2,6 +2,7 @@
  * tensor-product separability of A), evaluation with gradient, quasi-interpolating fill. */
 #include "host/model/field.h"
 
+#include "host/model/floor_div.h"
 #include "host/model/model_hot.h"
 
 #include <math.h>
@@ -86,14 +87,9 @@ vec3_t field_sample_pos(const field_t *f, const int32_t s[3])
                 f->origin_m.z + h * (float)s[2]);
 }
 
-static int32_t field_floordiv(int32_t a, int32_t b)
-{
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
-
 int32_t field_sample_taps(const field_t *f, int32_t s, float w[4])
 {
-    const int32_t q = field_floordiv(s, f->ratio);
+    const int32_t q = floor_div_i32(s, f->ratio);
     memcpy(w, f->wtab[s - q * f->ratio], sizeof(float) * 4);
     return q - 1;
 }
@@ -102,8 +98,8 @@ void field_coefs_of_samples(const field_t *f, const int32_t slo[3], const int32_
                             int32_t clo[3], int32_t chi[3])
 {
     for (int a = 0; a < 3; a++) {
-        clo[a] = field_floordiv(slo[a], f->ratio) - 1;
-        chi[a] = field_floordiv(shi[a] - 1, f->ratio) + 3;
+        clo[a] = floor_div_i32(slo[a], f->ratio) - 1;
+        chi[a] = floor_div_i32(shi[a] - 1, f->ratio) + 3;
     }
 }
 

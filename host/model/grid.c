@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/model/floor_div.h"
+
 /* Largest |sample index| computed from a position; keeps int32 arithmetic far from overflow. */
 #define GRID_INDEX_LIMIT 1.0e9
 #define GRID_CAP0 64 /* hash slots of a new grid */
@@ -14,11 +16,6 @@
 static bool same_bits(float a, float b)
 {
     return memcmp(&a, &b, sizeof(float)) == 0;
-}
-
-static int32_t block_of(int32_t i)
-{
-    return i >= 0 ? i / GRID_B : -((-i + GRID_B - 1) / GRID_B);
 }
 
 static size_t hash_key(const int32_t k[3], size_t cap)
@@ -148,9 +145,9 @@ static bool block_mat(grid_t *g, grid_block_t *b)
 
 static void split(int32_t x, int32_t y, int32_t z, int32_t k[3], int *li)
 {
-    k[0] = block_of(x);
-    k[1] = block_of(y);
-    k[2] = block_of(z);
+    k[0] = floor_div_i32(x, GRID_B);
+    k[1] = floor_div_i32(y, GRID_B);
+    k[2] = floor_div_i32(z, GRID_B);
     *li = (x - k[0] * GRID_B) + GRID_B * ((y - k[1] * GRID_B) + GRID_B * (z - k[2] * GRID_B));
 }
 
@@ -331,8 +328,8 @@ static bool for_blocks(const grid_t *g, const int32_t lo[3], const int32_t n[3],
         return true;
     int32_t k0[3], k1[3];
     for (int a = 0; a < 3; a++) {
-        k0[a] = block_of(c0[a]);
-        k1[a] = block_of(c1[a] - 1);
+        k0[a] = floor_div_i32(c0[a], GRID_B);
+        k1[a] = floor_div_i32(c1[a] - 1, GRID_B);
     }
     int32_t k[3];
     for (k[2] = k0[2]; k[2] <= k1[2]; k[2]++)
@@ -1162,7 +1159,7 @@ static void block_view_fill(const grid_block_t *b, const int32_t k[3], grid_bloc
 
 int32_t grid_block_index(int32_t i)
 {
-    return block_of(i);
+    return floor_div_i32(i, GRID_B);
 }
 
 bool grid_block_view(const grid_t *g, const int32_t k[3], grid_block_view_t *v)
@@ -1195,8 +1192,8 @@ bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_
     for (int a = 0; a < 3; a++) {
         if (lo[a] >= hi[a])
             return true;
-        klo[a] = block_of(lo[a]);
-        khi[a] = block_of(hi[a] - 1);
+        klo[a] = floor_div_i32(lo[a], GRID_B);
+        khi[a] = floor_div_i32(hi[a] - 1, GRID_B);
     }
     int32_t k[3];
     for (k[2] = klo[2]; k[2] <= khi[2]; k[2]++)

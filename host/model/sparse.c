@@ -7,7 +7,7 @@
 
 static int32_t sparse_local(int32_t i)
 {
-    return i - sparse_block_of(i) * SPARSE_B;
+    return floor_mod_i32(i, SPARSE_B);
 }
 
 static size_t sparse_hash(const int32_t key[3], size_t cap)

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/model/floor_div.h"
 #include "shared/argil_err.h"
 
 #define SPARSE_B 8                               /* lattice points per block edge */
@@ -32,10 +33,11 @@ typedef struct {
 argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults);
 void sparse_free(sparse_t *s);
 
-/* Floor division of a lattice index by SPARSE_B (inline: the tools call it per coefficient). */
+/* The block key of lattice index i: floor(i / SPARSE_B) (inline: the tools call it per
+ * coefficient). */
 static inline int32_t sparse_block_of(int32_t i)
 {
-    return i >= 0 ? i / SPARSE_B : -((-i + SPARSE_B - 1) / SPARSE_B);
+    return floor_div_i32(i, SPARSE_B);
 }
 
 /* The block holding key, or NULL. */
