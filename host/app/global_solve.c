@@ -5,13 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/model/floor_div.h"
 #include "host/model/material.h"
 #include "host/model/tools.h"
-
-static int32_t floordiv(int32_t a, int32_t b)
-{
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
 
 static float clamp01(float v)
 {
@@ -269,8 +265,8 @@ static void coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3],
                      int32_t chi[3])
 {
     for (int a = 0; a < 3; a++) {
-        clo[a] = floordiv(lo[a], f->ratio);
-        chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
+        clo[a] = floor_div_i32(lo[a], f->ratio);
+        chi[a] = floor_div_i32(hi[a] - 1, f->ratio) + 1;
         if (chi[a] - clo[a] < 4)
             chi[a] = clo[a] + 4;
     }
