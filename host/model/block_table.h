@@ -1,6 +1,5 @@
-/* One open-addressing hash of 3-D integer block keys (any sign) to fixed-size entries, for every
- * sparse store of blocks on the host: linear probing over a power-of-two capacity that doubles
- * at half load, every probe loop bounded by the capacity, backward-shift deletion (no tombstones). */
+/* The block-key hash of every sparse block store on the host: linear probing bounded by the
+ * capacity, doubling at half load, deletion by backward shift (no tombstones). */
 #ifndef ARGIL_BLOCK_TABLE_H
 #define ARGIL_BLOCK_TABLE_H
 
