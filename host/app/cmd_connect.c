@@ -22,9 +22,9 @@
 #include "host/app/host_tool.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
+#include "host/app/session_files.h"
 #include "host/app/session_undo.h"
 #include "host/io/argil_file.h"
-#include "host/io/ply.h"
 #include "host/link/link.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc.h"
@@ -319,7 +319,6 @@ static int make_dir(const char *path)
 static argil_err_t write_model(const grid_t *g, const host_tool_t *ht, const char *dir,
                                uint32_t edits, size_t *triangles, char *err, size_t err_len)
 {
-    char path[4096];
     mesh_t m;
     mesh_init(&m);
     int32_t rlo[3], rn[3];
@@ -330,17 +329,11 @@ static argil_err_t write_model(const grid_t *g, const host_tool_t *ht, const cha
                                             : grid_mesh_extract(g, g->iso, &m);
     if (rc != ARGIL_OK) {
         snprintf(err, err_len, "meshing the clay failed");
-    } else {
-        *triangles = m.n_tri;
-        snprintf(path, sizeof(path), "%s/final.ply", dir);
-        if (m.n_tri > 0)
-            rc = ply_write(path, &m, err, err_len);
-    }
-    mesh_free(&m);
-    if (rc != ARGIL_OK) {
+        mesh_free(&m);
         free(rgb);
         return rc;
     }
+    *triangles = m.n_tri;
     argil_doc_t doc;
     argil_doc_init(&doc);
     doc.grid = *g; /* borrowed: the document is not freed */
@@ -353,8 +346,11 @@ static argil_err_t write_model(const grid_t *g, const host_tool_t *ht, const cha
                                         : host_action_default_strength(HOST_ACT_SOFT_PAINT);
     }
     doc.state.edits = edits;
-    snprintf(path, sizeof(path), "%s/model.argil", dir);
-    rc = argil_file_write(path, &doc, err, err_len);
+    char ply_path[4096], model_path[4096];
+    snprintf(ply_path, sizeof(ply_path), "%s/final.ply", dir);
+    snprintf(model_path, sizeof(model_path), "%s/model.argil", dir);
+    rc = session_files_write(ply_path, &m, model_path, &doc, err, err_len);
+    mesh_free(&m);
     free(rgb);
     return rc;
 }

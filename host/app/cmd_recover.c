@@ -8,9 +8,9 @@
 #include <unistd.h>
 
 #include "host/app/commands.h"
+#include "host/app/session_files.h"
 #include "host/io/argil_file.h"
 #include "host/io/journal.h"
-#include "host/io/ply.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh.h"
@@ -157,23 +157,20 @@ int cmd_recover(int argc, char **argv)
         status = 1;
         goto out;
     }
-    if (argil_file_write(model_path, &doc, werr, sizeof(werr)) != ARGIL_OK) {
-        fprintf(stderr, "argil recover: %s\n", werr);
-        status = 1;
-        goto out;
-    }
     mesh_t mesh;
     mesh_init(&mesh);
     const grid_t *g = &doc.grid;
     /* The painted colour (doc.rgb, over the grid's box as COLR) as vertex colours. */
-    argil_err_t me = doc.rgb != NULL ? grid_mesh_region(g, doc.rgb, g->iso, &mesh)
-                                     : grid_mesh_extract(g, g->iso, &mesh);
-    if (me == ARGIL_OK && mesh.n_tri > 0)
-        me = ply_write(ply_path, &mesh, werr, sizeof(werr));
+    const argil_err_t me = doc.rgb != NULL ? grid_mesh_region(g, doc.rgb, g->iso, &mesh)
+                                           : grid_mesh_extract(g, g->iso, &mesh);
+    if (me != ARGIL_OK)
+        mesh_clear(&mesh); /* the model is written all the same */
+    const argil_err_t we =
+        session_files_write(ply_path, &mesh, model_path, &doc, werr, sizeof(werr));
     const size_t tris = mesh.n_tri;
     mesh_free(&mesh);
-    if (me != ARGIL_OK) {
-        fprintf(stderr, "argil recover: %s\n", werr[0] ? werr : "meshing the model failed");
+    if (we != ARGIL_OK || me != ARGIL_OK) {
+        fprintf(stderr, "argil recover: %s\n", we != ARGIL_OK ? werr : "meshing the model failed");
         status = 1;
         goto out;
     }

@@ -5,13 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/model/cgls.h"
+#include "host/model/floor_div.h"
 #include "host/model/material.h"
 #include "host/model/tools.h"
-
-static int32_t floordiv(int32_t a, int32_t b)
-{
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
 
 static float clamp01(float v)
 {
@@ -269,8 +266,8 @@ static void coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3],
                      int32_t chi[3])
 {
     for (int a = 0; a < 3; a++) {
-        clo[a] = floordiv(lo[a], f->ratio);
-        chi[a] = floordiv(hi[a] - 1, f->ratio) + 1;
+        clo[a] = floor_div_i32(lo[a], f->ratio);
+        chi[a] = floor_div_i32(hi[a] - 1, f->ratio) + 1;
         if (chi[a] - clo[a] < 4)
             chi[a] = clo[a] + 4;
     }
@@ -358,12 +355,24 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
     return ARGIL_OK;
 }
 
-static double dot(const float *a, const float *b, size_t n)
+/* A and Aᵀ of seed_fit's least squares: the field's samples in [a0, a1) of coefficients in the
+ * box at clo of nc. */
+typedef struct {
+    const field_t *f;
+    const int32_t *a0, *a1, *clo, *nc;
+    float *tmp;
+} seed_fit_op_t;
+
+static void seed_fit_a(void *ctx, const float *p, float *out)
 {
-    double s = 0.0;
-    for (size_t i = 0; i < n; i++)
-        s += (double)a[i] * b[i];
-    return s;
+    const seed_fit_op_t *o = ctx;
+    field_samples_from(o->f, p, o->clo, o->nc, o->a0, o->a1, out, o->tmp);
+}
+
+static void seed_fit_at(void *ctx, const float *r, float *out)
+{
+    const seed_fit_op_t *o = ctx;
+    field_coefs_from(o->f, r, o->a0, o->a1, o->clo, o->nc, out, o->tmp);
 }
 
 /* Least squares for R > 1: GSOLVE_SEED_FIT_ITERS of CGLS on A p = d over the grid's samples in
@@ -397,26 +406,9 @@ static argil_err_t seed_fit(field_t *f, const grid_t *g, const int32_t lo[3], co
         for (int32_t y = 0; y < ns[1]; y++)
             for (int32_t x = 0; x < ns[0]; x++, k++)
                 Rs[k] = grid_get(g, GRID_DENSITY, a0[0] + x, a0[1] + y, a0[2] + z) - Rs[k];
-    field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
-    memcpy(Q, S, ncoef * sizeof(float));
-    double gamma = dot(S, S, ncoef);
-    for (int it = 0; it < GSOLVE_SEED_FIT_ITERS && gamma > 0.0; it++) {
-        field_samples_from(f, Q, clo, nc, a0, a1, T, tmp);
-        const double tt = dot(T, T, nsamp);
-        if (!(tt > 0.0))
-            break;
-        const float alpha = (float)(gamma / tt);
-        for (size_t i = 0; i < ncoef; i++)
-            P[i] += alpha * Q[i];
-        for (size_t i = 0; i < nsamp; i++)
-            Rs[i] -= alpha * T[i];
-        field_coefs_from(f, Rs, a0, a1, clo, nc, S, tmp);
-        const double gamma1 = dot(S, S, ncoef);
-        const float beta = (float)(gamma1 / gamma);
-        gamma = gamma1;
-        for (size_t i = 0; i < ncoef; i++)
-            Q[i] = S[i] + beta * Q[i];
-    }
+    seed_fit_op_t o = {f, a0, a1, clo, nc, tmp};
+    const cgls_op_t op = {seed_fit_a, seed_fit_at, &o, ncoef, nsamp};
+    (void)cgls_solve(&op, GSOLVE_SEED_FIT_ITERS, P, Rs, S, Q, T);
     const argil_err_t e = sparse_write_box(&f->coef, FC_P, clo, nc, P);
     free(buf);
     return e;

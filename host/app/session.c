@@ -15,9 +15,9 @@
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
 #include "host/app/script.h"
+#include "host/app/session_files.h"
 #include "host/app/session_undo.h"
 #include "host/io/journal.h"
-#include "host/io/ply.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
 #include "host/mesh/grid_mesh.h"
@@ -637,12 +637,6 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
                 rc = rc == ARGIL_OK ? ARGIL_ERR_IO : rc;
             }
         }
-        snprintf(path, sizeof(path), "%s/final.ply", opts->out_dir);
-        if (mesh.n_tri > 0 && ply_write(path, &mesh, ferr, sizeof(ferr)) != ARGIL_OK &&
-            rc == ARGIL_OK) {
-            snprintf(err, err_len, "%s", ferr);
-            rc = ARGIL_ERR_IO;
-        }
         snprintf(path, sizeof(path), "%s/session.scn", opts->out_dir);
         if (opts->script_path &&
             copy_file(opts->script_path, path, ferr, sizeof(ferr)) != ARGIL_OK && rc == ARGIL_OK) {
@@ -661,13 +655,16 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
         }
         doc.state.device_offset_m = s->model_offset_m;
         doc.state.edits = s->journaling ? s->journal.seq : 0u;
-        snprintf(path, sizeof(path), "%s/model.argil", opts->out_dir);
+        char model_path[4096];
+        snprintf(path, sizeof(path), "%s/final.ply", opts->out_dir);
+        snprintf(model_path, sizeof(model_path), "%s/model.argil", opts->out_dir);
         if (doc.rgb == NULL && grid_rgb_painted(&s->grid)) {
             if (rc == ARGIL_OK) {
-                snprintf(err, err_len, "%s: out of memory for the painted colour", path);
+                snprintf(err, err_len, "%s: out of memory for the painted colour", model_path);
                 rc = ARGIL_ERR_NOMEM;
             }
-        } else if (argil_file_write(path, &doc, ferr, sizeof(ferr)) != ARGIL_OK &&
+        } else if (session_files_write(path, &mesh, model_path, &doc, ferr, sizeof(ferr)) !=
+                       ARGIL_OK &&
                    rc == ARGIL_OK) {
             snprintf(err, err_len, "%s", ferr);
             rc = ARGIL_ERR_IO;

@@ -51,11 +51,9 @@ static argil_err_t shadow_take(session_undo_t *su, field_t *f)
     su->sh_ready = true;
     su->sh_gen = f->lattice_gen;
     sparse_t *live[2] = {&f->coef, &f->samp}, *sh[2] = {&su->sh_coef, &su->sh_samp};
-    for (int k = 0; k < 2; k++)
-        for (size_t i = 0; i < live[k]->cap; i++) {
-            sparse_block_t *b = &live[k]->slots[i];
-            if (b->data == NULL)
-                continue;
+    for (int k = 0; k < 2; k++) {
+        size_t slot = 0;
+        for (sparse_block_t *b; (b = sparse_next(live[k], &slot)) != NULL;) {
             sparse_block_t *sb;
             e = sparse_touch(sh[k], b->key, &sb);
             if (e != ARGIL_OK)
@@ -63,6 +61,7 @@ static argil_err_t shadow_take(session_undo_t *su, field_t *f)
             memcpy(sb->data, b->data, sizeof(float) * (size_t)sh[k]->nch * SPARSE_BN);
             b->dirty = false;
         }
+    }
     return ARGIL_OK;
 }
 
@@ -216,10 +215,10 @@ static argil_err_t walk_dirty(session_undo_t *su, field_t *f, bool back, bool no
     argil_err_t err = ARGIL_OK;
     sparse_t *live[2] = {&f->coef, &f->samp}, *sh[2] = {&su->sh_coef, &su->sh_samp};
     const int store[2] = {UNDO_STORE_COEF, UNDO_STORE_SAMP};
-    for (int k = 0; k < 2; k++)
-        for (size_t i = 0; i < live[k]->cap; i++) {
-            sparse_block_t *b = &live[k]->slots[i];
-            if (b->data == NULL || !b->dirty)
+    for (int k = 0; k < 2; k++) {
+        size_t slot = 0;
+        for (sparse_block_t *b; (b = sparse_next(live[k], &slot)) != NULL;) {
+            if (!b->dirty)
                 continue;
             const argil_err_t e = block_sync(su, store[k], b, sh[k], back, note && err == ARGIL_OK);
             if (err == ARGIL_OK)
@@ -241,6 +240,7 @@ static argil_err_t walk_dirty(session_undo_t *su, field_t *f, bool back, bool no
                 hi[a] = none || bhi[a] > hi[a] ? bhi[a] : hi[a];
             }
         }
+    }
     return err;
 }
 
@@ -326,12 +326,14 @@ static argil_err_t pend_begin(session_undo_t *su, field_t *f, bool joined)
     su->pend_joined = joined;
     sparse_t *live[2] = {&f->coef, &f->samp};
     size_t need_blocks = 0, need_floats = 0;
-    for (uint32_t k = 0; k < 2; k++)
-        for (size_t i = 0; i < live[k]->cap; i++)
-            if (live[k]->slots[i].data != NULL && live[k]->slots[i].dirty) {
+    for (uint32_t k = 0; k < 2; k++) {
+        size_t slot = 0;
+        for (const sparse_block_t *b; (b = sparse_next(live[k], &slot)) != NULL;)
+            if (b->dirty) {
                 need_blocks++;
                 need_floats += block_floats(su, k);
             }
+    }
     if (need_blocks > su->pend_cap) {
         const size_t cap = need_blocks + need_blocks / 2 + 64;
         session_undo_pend_t *np = realloc(su->pend, cap * sizeof(*np));
@@ -346,10 +348,10 @@ static argil_err_t pend_begin(session_undo_t *su, field_t *f, bool joined)
         reset_history(su, f);
         return ARGIL_ERR_NOMEM;
     }
-    for (uint32_t k = 0; k < 2; k++)
-        for (size_t i = 0; i < live[k]->cap; i++) {
-            sparse_block_t *b = &live[k]->slots[i];
-            if (b->data == NULL || !b->dirty)
+    for (uint32_t k = 0; k < 2; k++) {
+        size_t slot = 0;
+        for (sparse_block_t *b; (b = sparse_next(live[k], &slot)) != NULL;) {
+            if (!b->dirty)
                 continue;
             session_undo_pend_t *q = &su->pend[su->npend++];
             memcpy(q->key, b->key, sizeof(q->key));
@@ -357,6 +359,7 @@ static argil_err_t pend_begin(session_undo_t *su, field_t *f, bool joined)
             q->copy = 0;
             b->dirty = false; /* a write from now on belongs to the next stroke */
         }
+    }
     return su->npend == 0 ? pend_commit(su, f) : ARGIL_OK;
 }
 
@@ -525,11 +528,9 @@ void session_undo_touched(session_undo_t *su)
 /* Zeroes every coefficient velocity: a restored state is at rest. */
 static void zero_velocity(field_t *f)
 {
-    for (size_t i = 0; i < f->coef.cap; i++) {
-        float *d = f->coef.slots[i].data;
-        if (d != NULL)
-            memset(d + (size_t)FC_V * SPARSE_BN, 0, sizeof(float) * SPARSE_BN);
-    }
+    size_t slot = 0;
+    for (sparse_block_t *b; (b = sparse_next(&f->coef, &slot)) != NULL;)
+        memset(b->data + (size_t)FC_V * SPARSE_BN, 0, sizeof(float) * SPARSE_BN);
 }
 
 argil_err_t session_undo_step(session_undo_t *su, field_t *f, bool redo, int32_t slo[3],

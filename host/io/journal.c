@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -288,79 +289,31 @@ static size_t kind_bytes(int kind)
     return kind == KIND_RGB ? 3u : 4u;
 }
 
-static size_t sh_slot(const int32_t k[3], size_t cap)
-{
-    uint64_t h = (uint64_t)(uint32_t)k[0] * 0xD6E8FEB86659FD93ull +
-                 (uint64_t)(uint32_t)k[1] * 0xA0761D6478BD642Full +
-                 (uint64_t)(uint32_t)k[2] * 0xE7037ED1A0B428DBull;
-    h ^= h >> 32;
-    return (size_t)h & (cap - 1);
-}
+_Static_assert(offsetof(journal_block_t, key) == 0, "a block_table entry starts with its key");
 
 static journal_block_t *sh_find(const journal_shadow_t *s, const int32_t k[3])
 {
-    if (s->slots == NULL)
-        return NULL;
-    for (size_t i = sh_slot(k, s->cap), n = 0; n < s->cap; i = (i + 1) & (s->cap - 1), n++) {
-        journal_block_t *b = &s->slots[i];
-        if (!b->used)
-            return NULL;
-        if (b->key[0] == k[0] && b->key[1] == k[1] && b->key[2] == k[2])
-            return b;
-    }
-    return NULL;
-}
-
-static bool sh_grow(journal_shadow_t *s)
-{
-    const size_t cap = s->cap > 0 ? 2 * s->cap : SHADOW_CAP0;
-    journal_block_t *t = calloc(cap, sizeof(*t));
-    if (t == NULL)
-        return false;
-    for (size_t i = 0; i < s->cap; i++) {
-        if (!s->slots[i].used)
-            continue;
-        size_t k = sh_slot(s->slots[i].key, cap);
-        while (t[k].used)
-            k = (k + 1) & (cap - 1);
-        t[k] = s->slots[i];
-    }
-    free(s->slots);
-    s->slots = t;
-    s->cap = cap;
-    return true;
+    return block_table_find(&s->blocks, k);
 }
 
 /* Block k, added (density 0, no arrays) when absent; NULL when out of memory. Adding may move
  * every other block (pointers to them go stale). */
 static journal_block_t *sh_touch(journal_shadow_t *s, const int32_t k[3])
 {
-    journal_block_t *b = sh_find(s, k);
-    if (b != NULL)
-        return b;
-    if ((s->count + 1) * 2 > s->cap && !sh_grow(s))
-        return NULL;
-    size_t i = sh_slot(k, s->cap);
-    while (s->slots[i].used)
-        i = (i + 1) & (s->cap - 1);
-    b = &s->slots[i];
-    memset(b, 0, sizeof(*b));
-    memcpy(b->key, k, sizeof(b->key));
-    b->used = true;
-    s->count++;
-    return b;
+    void *b;
+    return block_table_insert(&s->blocks, k, &b) == ARGIL_OK ? b : NULL;
 }
 
 static void sh_free(journal_shadow_t *s)
 {
-    for (size_t i = 0; s->slots != NULL && i < s->cap; i++) {
-        journal_block_t *b = &s->slots[i];
+    size_t slot = 0;
+    for (journal_block_t *b; (b = block_table_next(&s->blocks, &slot)) != NULL;) {
         free(b->dens);
         free(b->rgb);
         for (int ch = 0; ch < GRID_MAT_N; ch++)
             free(b->mat[ch]);
     }
-    free(s->slots);
+    block_table_free(&s->blocks);
     memset(s, 0, sizeof(*s));
 }
 
@@ -515,7 +468,7 @@ static bool sh_copy_block(journal_shadow_t *s, const grid_t *g, const grid_block
 static bool shadow_take(journal_shadow_t *s, const grid_t *g, const int32_t gl[3],
                         const int32_t gh[3])
 {
-    if (!sh_grow(s))
+    if (block_table_init(&s->blocks, sizeof(journal_block_t), SHADOW_CAP0) != ARGIL_OK)
         return false;
     size_t slot = 0;
     grid_block_view_t v;
@@ -561,10 +514,10 @@ static argil_err_t shadow_dense(const journal_t *j, float **dens, float *mat[GRI
         (*dens)[i] = 0.0f;
     const int32_t gh[3] = {j->lo[0] + j->dims[0], j->lo[1] + j->dims[1], j->lo[2] + j->dims[2]};
     const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
-    for (size_t s = 0; j->shadow.slots != NULL && s < j->shadow.cap; s++) {
-        const journal_block_t *b = &j->shadow.slots[s];
+    size_t slot = 0;
+    for (const journal_block_t *b; (b = block_table_next(&j->shadow.blocks, &slot)) != NULL;) {
         int32_t a0[3], a1[3];
-        if (!b->used || !block_clip(b->key, j->lo, gh, a0, a1))
+        if (!block_clip(b->key, j->lo, gh, a0, a1))
             continue;
         for (int32_t z = a0[2]; z < a1[2]; z++)
             for (int32_t y = a0[1]; y < a1[1]; y++)
@@ -585,7 +538,7 @@ static argil_err_t shadow_dense(const journal_t *j, float **dens, float *mat[GRI
 
 size_t journal_bytes(const journal_t *j)
 {
-    return j->shadow.cap * sizeof(journal_block_t) + j->shadow.arrays_bytes + j->buf_cap +
+    return block_table_bytes(&j->shadow.blocks) + j->shadow.arrays_bytes + j->buf_cap +
            j->views_cap * sizeof(grid_block_view_t);
 }
 
@@ -861,7 +814,7 @@ static bool changed_blocks(journal_t *j, const grid_t *g, int kind, const int32_
         k1[a] = grid_block_index(gh[a] - 1);
         nk *= (uint64_t)(k1[a] - k0[a] + 1);
     }
-    const size_t held = g->count + j->shadow.count;
+    const size_t held = g->blocks.count + j->shadow.blocks.count;
     if (!views_reserve(j, nk < (uint64_t)held ? (size_t)nk : held))
         return false;
     size_t n = 0;
@@ -885,9 +838,9 @@ static bool changed_blocks(journal_t *j, const grid_t *g, int kind, const int32_
         if (block_clip(v.key, gl, gh, a0, a1) &&
             (kind == KIND_DENS || live_arr(g, &v, kind, cst) != NULL))
             j->views[n++] = v;
-    for (size_t s = 0; j->shadow.slots != NULL && s < j->shadow.cap; s++) {
-        const journal_block_t *b = &j->shadow.slots[s];
-        if (b->used && block_clip(b->key, gl, gh, a0, a1) &&
+    size_t sslot = 0;
+    for (const journal_block_t *b; (b = block_table_next(&j->shadow.blocks, &sslot)) != NULL;) {
+        if (block_clip(b->key, gl, gh, a0, a1) &&
             (kind == KIND_DENS || sh_arr(b, kind, cst) != NULL)) {
             (void)grid_block_view(g, b->key, &v);
             j->views[n++] = v;

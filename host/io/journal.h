@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "host/io/argil_file.h"
+#include "host/model/block_table.h"
 #include "host/model/grid.h"
 #include "shared/argil_err.h"
 
@@ -47,8 +48,7 @@ typedef struct {
 /* One grid block of the writer's copy of the model as of the last record (host/io/journal.c):
  * only blocks the grid holds cost memory, and a block at one density holds no array. */
 typedef struct {
-    int32_t key[3];           /* block index, as the grid's (grid_block_index) */
-    bool used;                /* hash slot taken */
+    int32_t key[3];           /* block index, as the grid's; first: the table's key */
     float uniform;            /* the density of every sample when dens is NULL */
     float *dens;              /* GRID_BN densities (x fastest), or NULL */
     float *mat[GRID_MAT_N];   /* GRID_BN values of a painted channel; NULL: its default */
@@ -58,8 +58,7 @@ typedef struct {
 /* The writer's copy of the model: an open-addressing hash of blocks by block index; a block
  * not in it reads density 0, the painted defaults and GRID_RGB_DEFAULT. */
 typedef struct {
-    journal_block_t *slots;   /* NULL: none */
-    size_t cap, count;        /* slots, slots used */
+    block_table_t blocks;     /* journal_block_t by key; entries NULL: none */
     size_t arrays_bytes;      /* bytes of the blocks' arrays */
 } journal_shadow_t;
 

@@ -6,10 +6,12 @@
 #include "host/mesh/mc_blocks.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "host/mesh/mc.h"
+#include "host/model/floor_div.h"
 
 #define MCB_NONE UINT32_MAX
 #define MCB_L (MC_BLOCK_CELLS + 3) /* scratch samples per axis: cells + 1 corners + 2 halo */
@@ -30,11 +32,10 @@ static void mcb_block_free(mc_block_mesh_t *k)
 
 void mc_blocks_free(mc_blocks_t *b)
 {
-    if (b->slots != NULL)
-        for (size_t i = 0; i < b->cap; i++)
-            if (b->slots[i].used)
-                mcb_block_free(&b->slots[i].mesh);
-    free(b->slots);
+    size_t slot = 0;
+    for (mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;)
+        mcb_block_free(&e->mesh);
+    block_table_free(&b->blocks);
     mcb_block_free(&b->spare);
     free(b->keys);
     free(b->tab);
@@ -47,99 +48,26 @@ void mc_blocks_free(mc_blocks_t *b)
     memset(b, 0, sizeof(*b));
 }
 
-/* Block key of padded cell c: floor(c / MC_BLOCK_CELLS) for any sign. */
-static int32_t mcb_block_of(int64_t c)
-{
-    return (int32_t)(c >= 0 ? c / MC_BLOCK_CELLS : -((-c + MC_BLOCK_CELLS - 1) / MC_BLOCK_CELLS));
-}
-
-/* Home slot of block key k in a table of cap (a power of two) slots. */
-static size_t mcb_home(const int32_t k[3], size_t cap)
-{
-    uint64_t h = (uint64_t)(uint32_t)k[0] * 0x9E3779B97F4A7C15ull;
-    h ^= (uint64_t)(uint32_t)k[1] * 0xC2B2AE3D27D4EB4Full;
-    h ^= (uint64_t)(uint32_t)k[2] * 0x165667B19E3779F9ull;
-    h ^= h >> 29;
-    return (size_t)(h & (cap - 1));
-}
-
-static bool mcb_same_key(const int32_t a[3], const int32_t b[3])
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
-}
+_Static_assert(offsetof(mc_block_t, key) == 0, "a block_table entry starts with its key");
 
 /* The slot of block k, or NULL when the hash holds none. */
 static mc_block_t *mcb_find(const mc_blocks_t *b, const int32_t k[3])
 {
-    const size_t mask = b->cap - 1;
-    for (size_t i = mcb_home(k, b->cap), n = 0; n < b->cap; i = (i + 1) & mask, n++) {
-        mc_block_t *e = &b->slots[i];
-        if (!e->used)
-            return NULL;
-        if (mcb_same_key(e->key, k))
-            return e;
-    }
-    return NULL;
-}
-
-/* Doubles the hash; false (hash unchanged) when out of memory. */
-static bool mcb_rehash(mc_blocks_t *b)
-{
-    const size_t cap = b->cap * 2;
-    mc_block_t *s = calloc(cap, sizeof(*s));
-    if (s == NULL)
-        return false;
-    for (size_t i = 0; i < b->cap; i++) {
-        if (!b->slots[i].used)
-            continue;
-        size_t h = mcb_home(b->slots[i].key, cap);
-        while (s[h].used)
-            h = (h + 1) & (cap - 1);
-        s[h] = b->slots[i];
-    }
-    free(b->slots);
-    b->slots = s;
-    b->cap = cap;
-    return true;
+    return block_table_find(&b->blocks, k);
 }
 
 /* The slot of block k, taken (clean, no triangles) when new; NULL when out of memory. */
 static mc_block_t *mcb_insert(mc_blocks_t *b, const int32_t k[3])
 {
-    mc_block_t *e = mcb_find(b, k);
-    if (e != NULL)
-        return e;
-    if (2 * (b->n_blocks + 1) > b->cap && !mcb_rehash(b))
-        return NULL;
-    size_t i = mcb_home(k, b->cap);
-    while (b->slots[i].used)
-        i = (i + 1) & (b->cap - 1);
-    e = &b->slots[i];
-    memset(e, 0, sizeof(*e));
-    memcpy(e->key, k, sizeof(e->key));
-    e->used = 1;
-    b->n_blocks++;
-    return e;
+    void *e;
+    return block_table_insert(&b->blocks, k, &e) == ARGIL_OK ? e : NULL;
 }
 
-/* Frees slot e's arrays and gives the slot up (backward-shift deletion keeps probing exact). */
+/* Frees slot e's arrays and gives the slot up. */
 static void mcb_remove(mc_blocks_t *b, mc_block_t *e)
 {
-    const size_t mask = b->cap - 1;
-    size_t i = (size_t)(e - b->slots);
     mcb_block_free(&e->mesh);
-    for (size_t j = (i + 1) & mask, n = 0; n < b->cap && b->slots[j].used;
-         j = (j + 1) & mask, n++) {
-        const size_t h = mcb_home(b->slots[j].key, b->cap);
-        /* slot j stays when its home lies cyclically in (i, j] */
-        const bool stays = i <= j ? (i < h && h <= j) : (i < h || h <= j);
-        if (!stays) {
-            b->slots[i] = b->slots[j];
-            i = j;
-        }
-    }
-    memset(&b->slots[i], 0, sizeof(b->slots[i]));
-    b->n_blocks--;
+    block_table_remove(&b->blocks, e);
 }
 
 /* True when [lo, hi) is a non-empty box within the indices and span a mesher can hold. */
@@ -168,8 +96,7 @@ argil_err_t mc_blocks_init_box(mc_blocks_t *b, const int32_t lo[3], const int32_
     b->spacing_m = spacing_m;
     b->origin_m = origin_m;
     b->iso = iso;
-    b->cap = MCB_HASH_MIN;
-    b->slots = calloc(b->cap, sizeof(*b->slots));
+    const argil_err_t te = block_table_init(&b->blocks, sizeof(mc_block_t), MCB_HASH_MIN);
     b->tab = malloc(sizeof(*b->tab));
     b->val = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
     b->rd = malloc(sizeof(float) * MCB_L * MCB_L * MCB_L);
@@ -177,7 +104,7 @@ argil_err_t mc_blocks_init_box(mc_blocks_t *b, const int32_t lo[3], const int32_
     b->ins = malloc(MCB_L * MCB_L * MCB_L);
     b->col = malloc(3 * MCB_L * MCB_L * MCB_L);
     b->cache = malloc(sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C);
-    if (b->slots == NULL || b->tab == NULL || b->val == NULL || b->rd == NULL || b->rdc == NULL ||
+    if (te != ARGIL_OK || b->tab == NULL || b->val == NULL || b->rd == NULL || b->rdc == NULL ||
         b->ins == NULL || b->col == NULL || b->cache == NULL) {
         mc_blocks_free(b);
         return ARGIL_ERR_NOMEM;
@@ -199,7 +126,7 @@ argil_err_t mc_blocks_init(mc_blocks_t *b, const int32_t dims[3], float spacing_
 
 argil_err_t mc_blocks_grow(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
 {
-    if (b == NULL || b->slots == NULL || lo == NULL || hi == NULL)
+    if (b == NULL || b->blocks.entries == NULL || lo == NULL || hi == NULL)
         return ARGIL_ERR_ARG;
     for (int a = 0; a < 3; a++)
         if (lo[a] >= hi[a] || lo[a] < -MC_BLOCKS_INDEX_MAX || hi[a] > MC_BLOCKS_INDEX_MAX)
@@ -227,8 +154,8 @@ argil_err_t mc_blocks_grow(mc_blocks_t *b, const int32_t lo[3], const int32_t hi
 static void mcb_box_keys(const mc_blocks_t *b, int32_t klo[3], int32_t khi[3])
 {
     for (int a = 0; a < 3; a++) {
-        klo[a] = mcb_block_of(b->lo[a]);
-        khi[a] = mcb_block_of(b->hi[a]) + 1;
+        klo[a] = floor_div_i32(b->lo[a], MC_BLOCK_CELLS);
+        khi[a] = floor_div_i32(b->hi[a], MC_BLOCK_CELLS) + 1;
     }
 }
 
@@ -247,14 +174,14 @@ static size_t mcb_block_bytes(const mc_block_mesh_t *k)
 
 size_t mc_blocks_bytes(const mc_blocks_t *b)
 {
-    if (b == NULL || b->slots == NULL)
+    if (b == NULL || b->blocks.entries == NULL)
         return 0;
-    size_t n = sizeof(*b) + b->cap * sizeof(mc_block_t) + b->keys_cap * 3 * sizeof(int32_t) +
+    size_t n = sizeof(*b) + block_table_bytes(&b->blocks) + b->keys_cap * 3 * sizeof(int32_t) +
                sizeof(*b->tab) + (2 * sizeof(float) + 2 + 2 * 3) * MCB_L * MCB_L * MCB_L +
                sizeof(uint32_t) * 3 * MCB_C * MCB_C * MCB_C + mcb_block_bytes(&b->spare);
-    for (size_t i = 0; i < b->cap; i++)
-        if (b->slots[i].used)
-            n += mcb_block_bytes(&b->slots[i].mesh);
+    size_t slot = 0;
+    for (const mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;)
+        n += mcb_block_bytes(&e->mesh);
     return n;
 }
 
@@ -278,8 +205,8 @@ void mc_blocks_mark(mc_blocks_t *b, const int32_t lo[3], const int32_t hi[3])
             h = (int64_t)b->hi[a] + 1;
         if (l >= h)
             return;
-        blo[a] = mcb_block_of(l);
-        bhi[a] = mcb_block_of(h - 1) + 1;
+        blo[a] = floor_div_i32((int32_t)l, MC_BLOCK_CELLS); /* l, h within [lo, hi + 1] */
+        bhi[a] = floor_div_i32((int32_t)(h - 1), MC_BLOCK_CELLS) + 1;
     }
     for (int32_t z = blo[2]; z < bhi[2]; z++)
         for (int32_t y = blo[1]; y < bhi[1]; y++)
@@ -642,7 +569,7 @@ static argil_err_t mcb_mesh_block(mc_blocks_t *b, const int32_t key[3], const fl
 static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_t *rgb,
                               mc_read_fn read, mc_read_rgb_fn read_rgb, const void *ctx)
 {
-    if (b == NULL || b->slots == NULL)
+    if (b == NULL || b->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     if (density != NULL)
         for (int a = 0; a < 3; a++)
@@ -668,14 +595,15 @@ static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_
                         return e; /* still all dirty */
                 }
         b->all_dirty = false;
-        for (size_t i = 0; i < b->cap; i++)
-            b->slots[i].dirty = 0; /* every slot lies in the box and was meshed */
+        size_t slot = 0; /* every slot lies in the box and was meshed */
+        for (mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;)
+            e->dirty = 0;
         return ARGIL_OK;
     }
     /* The dirty keys first: meshing moves slots (a block may give its slot up). */
-    size_t n = 0;
-    for (size_t i = 0; i < b->cap; i++)
-        n += b->slots[i].used && b->slots[i].dirty;
+    size_t n = 0, slot = 0;
+    for (const mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;)
+        n += e->dirty;
     if (n > b->keys_cap) {
         int32_t *k = realloc(b->keys, n * 3 * sizeof(int32_t));
         if (k == NULL)
@@ -684,9 +612,10 @@ static argil_err_t mcb_update(mc_blocks_t *b, const float *density, const uint8_
         b->keys_cap = n;
     }
     n = 0;
-    for (size_t i = 0; i < b->cap; i++)
-        if (b->slots[i].used && b->slots[i].dirty)
-            memcpy(b->keys + 3 * n++, b->slots[i].key, 3 * sizeof(int32_t));
+    slot = 0;
+    for (const mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;)
+        if (e->dirty)
+            memcpy(b->keys + 3 * n++, e->key, 3 * sizeof(int32_t));
     for (size_t i = 0; i < n; i++) {
         const argil_err_t e = mcb_mesh_block(b, b->keys + 3 * i, density, rgb, read, read_rgb, ctx);
         if (e != ARGIL_OK)
@@ -713,13 +642,13 @@ static int mcb_cmp_key(const void *pa, const void *pb)
 
 argil_err_t mc_blocks_assemble(const mc_blocks_t *b, mesh_t *out)
 {
-    if (b == NULL || out == NULL || b->slots == NULL)
+    if (b == NULL || out == NULL || b->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     mesh_clear(out);
-    size_t total_v = 0, total_t = 0, max_v = 0, n_blk = 0;
-    for (size_t i = 0; i < b->cap; i++) {
-        const mc_block_mesh_t *k = &b->slots[i].mesh;
-        if (!b->slots[i].used || k->n_tri == 0)
+    size_t total_v = 0, total_t = 0, max_v = 0, n_blk = 0, slot = 0;
+    for (const mc_block_t *e; (e = block_table_next(&b->blocks, &slot)) != NULL;) {
+        const mc_block_mesh_t *k = &e->mesh;
+        if (k->n_tri == 0)
             continue;
         n_blk++;
         total_v += k->n_vert;
@@ -746,9 +675,10 @@ argil_err_t mc_blocks_assemble(const mc_blocks_t *b, mesh_t *out)
     if (keys == NULL || vals == NULL || remap == NULL || order == NULL)
         goto done;
     n_blk = 0;
-    for (size_t i = 0; i < b->cap; i++)
-        if (b->slots[i].used && b->slots[i].mesh.n_tri > 0)
-            order[n_blk++] = &b->slots[i];
+    slot = 0;
+    for (const mc_block_t *blk; (blk = block_table_next(&b->blocks, &slot)) != NULL;)
+        if (blk->mesh.n_tri > 0)
+            order[n_blk++] = blk;
     qsort(order, n_blk, sizeof(*order), mcb_cmp_key);
     memset(keys, 0xff, slots * sizeof(uint64_t)); /* UINT64_MAX = empty; no edge id reaches it */
     e = mesh_reserve(out, total_v, total_t);

@@ -14,6 +14,7 @@
 
 #include "host/mesh/mc_table.h"
 #include "host/mesh/mesh.h"
+#include "host/model/block_table.h"
 #include "shared/argil_err.h"
 #include "shared/vec3.h"
 
@@ -35,8 +36,7 @@ typedef struct {
 /* A slot of the block hash: block key k holds the padded cells [16 k, 16 k + 16) per axis
  * (padded cell c has its lower corner at sample c - 1), keys of any sign. */
 typedef struct {
-    int32_t key[3];
-    uint8_t used;        /* slot taken */
+    int32_t key[3];      /* block key; first: the table's key */
     uint8_t dirty;       /* must be meshed at the next update */
     mc_block_mesh_t mesh;
 } mc_block_t;
@@ -51,9 +51,7 @@ typedef struct {
     float spacing_m;
     vec3_t origin_m;     /* position of sample (0,0,0) */
     float iso;
-    mc_block_t *slots;   /* open-addressing hash of the blocks that hold triangles or are dirty */
-    size_t cap;          /* slots (a power of two) */
-    size_t n_blocks;     /* slots used */
+    block_table_t blocks; /* mc_block_t of the blocks that hold triangles or are dirty */
     bool all_dirty;      /* every block of the box must be meshed at the next update */
     mc_outside_fn outside; /* optional (NULL after init): asked before a reader reads a block */
     mc_block_mesh_t spare; /* scratch: a block without a slot is meshed here */

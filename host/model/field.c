@@ -2,6 +2,7 @@
  * tensor-product separability of A), evaluation with gradient, quasi-interpolating fill. */
 #include "host/model/field.h"
 
+#include "host/model/floor_div.h"
 #include "host/model/model_hot.h"
 
 #include <math.h>
@@ -86,14 +87,9 @@ vec3_t field_sample_pos(const field_t *f, const int32_t s[3])
                 f->origin_m.z + h * (float)s[2]);
 }
 
-static int32_t field_floordiv(int32_t a, int32_t b)
-{
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
-
 int32_t field_sample_taps(const field_t *f, int32_t s, float w[4])
 {
-    const int32_t q = field_floordiv(s, f->ratio);
+    const int32_t q = floor_div_i32(s, f->ratio);
     memcpy(w, f->wtab[s - q * f->ratio], sizeof(float) * 4);
     return q - 1;
 }
@@ -102,8 +98,8 @@ void field_coefs_of_samples(const field_t *f, const int32_t slo[3], const int32_
                             int32_t clo[3], int32_t chi[3])
 {
     for (int a = 0; a < 3; a++) {
-        clo[a] = field_floordiv(slo[a], f->ratio) - 1;
-        chi[a] = field_floordiv(shi[a] - 1, f->ratio) + 3;
+        clo[a] = floor_div_i32(slo[a], f->ratio) - 1;
+        chi[a] = floor_div_i32(shi[a] - 1, f->ratio) + 3;
     }
 }
 
@@ -431,11 +427,8 @@ argil_err_t field_refine(field_t *f)
 {
     if (f->ratio % 2 != 0)
         return ARGIL_ERR_ARG;
-    size_t nkeys = 0;
-    for (size_t i = 0; i < f->coef.cap; i++) {
-        const sparse_block_t *b = &f->coef.slots[i];
-        if (b->data == NULL)
-            continue;
+    size_t nkeys = 0, slot = 0;
+    for (const sparse_block_t *b; (b = sparse_next(&f->coef, &slot)) != NULL;) {
         for (int a = 0; a < 3; a++)
             if (b->key[a] > SPARSE_INDEX_MAX / (4 * SPARSE_B) || b->key[a] < -SPARSE_INDEX_MAX / (4 * SPARSE_B))
                 return ARGIL_ERR_ARG;
@@ -453,10 +446,8 @@ argil_err_t field_refine(field_t *f)
         return ARGIL_ERR_NOMEM;
     }
     float *A = buf, *B = A + FIELD_REF_OUT * FIELD_REF_OUT * FIELD_REF_OUT, *C = B + FIELD_REF_OUT * FIELD_REF_OUT * FIELD_REF_OUT;
-    for (size_t i = 0; i < f->coef.cap && e == ARGIL_OK; i++) {
-        const sparse_block_t *b = &f->coef.slots[i];
-        if (b->data == NULL)
-            continue;
+    slot = 0;
+    for (const sparse_block_t *b; e == ARGIL_OK && (b = sparse_next(&f->coef, &slot)) != NULL;) {
         int32_t lo[3], flo[3];
         for (int a = 0; a < 3; a++) {
             lo[a] = b->key[a] * SPARSE_B - 2;
@@ -476,14 +467,15 @@ argil_err_t field_refine(field_t *f)
     }
     free(buf);
     size_t nsb = 0;
-    int32_t (*keys)[3] = e == ARGIL_OK ? malloc(sizeof(int32_t[3]) * (f->samp.count + 1)) : NULL;
+    int32_t (*keys)[3] =
+        e == ARGIL_OK ? malloc(sizeof(int32_t[3]) * (f->samp.blocks.count + 1)) : NULL;
     if (keys == NULL) {
         sparse_free(&fine);
         return e != ARGIL_OK ? e : ARGIL_ERR_NOMEM;
     }
-    for (size_t i = 0; i < f->samp.cap; i++)
-        if (f->samp.slots[i].data != NULL)
-            memcpy(keys[nsb++], f->samp.slots[i].key, sizeof(keys[0]));
+    slot = 0;
+    for (const sparse_block_t *b; (b = sparse_next(&f->samp, &slot)) != NULL;)
+        memcpy(keys[nsb++], b->key, sizeof(keys[0]));
     sparse_free(&f->coef);
     f->coef = fine;
     f->lattice_gen++;

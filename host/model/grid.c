@@ -4,43 +4,26 @@
 #include "host/model/grid.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "host/model/floor_div.h"
 
 /* Largest |sample index| computed from a position; keeps int32 arithmetic far from overflow. */
 #define GRID_INDEX_LIMIT 1.0e9
 #define GRID_CAP0 64 /* hash slots of a new grid */
+
+_Static_assert(offsetof(grid_block_t, key) == 0, "a block_table entry starts with its key");
 
 static bool same_bits(float a, float b)
 {
     return memcmp(&a, &b, sizeof(float)) == 0;
 }
 
-static int32_t block_of(int32_t i)
-{
-    return i >= 0 ? i / GRID_B : -((-i + GRID_B - 1) / GRID_B);
-}
-
-static size_t hash_key(const int32_t k[3], size_t cap)
-{
-    const uint64_t h = (uint64_t)(uint32_t)k[0] * 0x9E3779B97F4A7C15ull ^
-                       (uint64_t)(uint32_t)k[1] * 0xC2B2AE3D27D4EB4Full ^
-                       (uint64_t)(uint32_t)k[2] * 0x165667B19E3779F9ull;
-    return (size_t)(h ^ (h >> 29)) & (cap - 1);
-}
-
 static grid_block_t *block_find(const grid_t *g, const int32_t k[3])
 {
-    if (g->slots == NULL)
-        return NULL;
-    for (size_t i = hash_key(k, g->cap), n = 0; n < g->cap; i = (i + 1) & (g->cap - 1), n++) {
-        grid_block_t *b = &g->slots[i];
-        if (!b->used)
-            return NULL;
-        if (b->key[0] == k[0] && b->key[1] == k[1] && b->key[2] == k[2])
-            return b;
-    }
-    return NULL;
+    return block_table_find(&g->blocks, k);
 }
 
 /* Grows the bounds of what the blocks hold by the sample box [lo, hi). */
@@ -68,43 +51,11 @@ static void bounds_sample(grid_t *g, int32_t x, int32_t y, int32_t z)
     bounds_box(g, lo, hi);
 }
 
-static bool grow_table(grid_t *g)
-{
-    const size_t cap = g->cap * 2;
-    grid_block_t *s = calloc(cap, sizeof(*s));
-    if (s == NULL)
-        return false;
-    for (size_t i = 0; i < g->cap; i++) {
-        if (!g->slots[i].used)
-            continue;
-        size_t j = hash_key(g->slots[i].key, cap);
-        while (s[j].used)
-            j = (j + 1) & (cap - 1);
-        s[j] = g->slots[i];
-    }
-    free(g->slots);
-    g->slots = s;
-    g->cap = cap;
-    return true;
-}
-
 /* The block at k, made (uniform 0: empty clay) when absent; NULL when out of memory. */
 static grid_block_t *block_touch(grid_t *g, const int32_t k[3])
 {
-    grid_block_t *b = block_find(g, k);
-    if (b != NULL)
-        return b;
-    if ((g->count + 1) * 2 > g->cap && !grow_table(g))
-        return NULL;
-    size_t i = hash_key(k, g->cap);
-    while (g->slots[i].used)
-        i = (i + 1) & (g->cap - 1);
-    b = &g->slots[i];
-    memset(b, 0, sizeof(*b));
-    memcpy(b->key, k, sizeof(b->key));
-    b->used = true;
-    g->count++;
-    return b;
+    void *b;
+    return block_table_insert(&g->blocks, k, &b) == ARGIL_OK ? b : NULL;
 }
 
 /* What an array-less block holds in channel ch. */
@@ -148,9 +99,9 @@ static bool block_mat(grid_t *g, grid_block_t *b)
 
 static void split(int32_t x, int32_t y, int32_t z, int32_t k[3], int *li)
 {
-    k[0] = block_of(x);
-    k[1] = block_of(y);
-    k[2] = block_of(z);
+    k[0] = floor_div_i32(x, GRID_B);
+    k[1] = floor_div_i32(y, GRID_B);
+    k[2] = floor_div_i32(z, GRID_B);
     *li = (x - k[0] * GRID_B) + GRID_B * ((y - k[1] * GRID_B) + GRID_B * (z - k[2] * GRID_B));
 }
 
@@ -194,25 +145,22 @@ argil_err_t grid_init(grid_t *g, const int32_t dims[3], float spacing_m, vec3_t 
     g->iso = 0.5f;
     g->band_m = 4.0f * spacing_m;
     spring_material_default(&g->material);
-    g->slots = calloc(GRID_CAP0, sizeof(*g->slots));
-    if (g->slots == NULL) {
+    const argil_err_t e = block_table_init(&g->blocks, sizeof(grid_block_t), GRID_CAP0);
+    if (e != ARGIL_OK)
         grid_free(g);
-        return ARGIL_ERR_NOMEM;
-    }
-    g->cap = GRID_CAP0;
-    return ARGIL_OK;
+    return e;
 }
 
 void grid_free(grid_t *g)
 {
-    for (size_t i = 0; g->slots != NULL && i < g->cap; i++) {
-        free(g->slots[i].data);
-        free(g->slots[i].mat);
-        free(g->slots[i].rgb);
+    size_t slot = 0;
+    for (grid_block_t *b; (b = block_table_next(&g->blocks, &slot)) != NULL;) {
+        free(b->data);
+        free(b->mat);
+        free(b->rgb);
     }
-    free(g->slots);
-    g->slots = NULL;
-    g->cap = g->count = g->data_blocks = g->mat_blocks = g->rgb_blocks = 0;
+    block_table_free(&g->blocks);
+    g->data_blocks = g->mat_blocks = g->rgb_blocks = 0;
     for (int c = 0; c < GRID_MAT_N; c++)
         g->painted[c] = false;
     g->dims[0] = g->dims[1] = g->dims[2] = 0;
@@ -246,7 +194,7 @@ void grid_bounds(const grid_t *g, int32_t lo[3], int32_t hi[3])
 
 size_t grid_count(const grid_t *g)
 {
-    if (g->slots == NULL)
+    if (g->blocks.entries == NULL)
         return 0;
     int32_t lo[3], hi[3];
     grid_bounds(g, lo, hi);
@@ -288,7 +236,7 @@ float grid_get(const grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z)
 
 argil_err_t grid_set(grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z, float v)
 {
-    if ((unsigned)ch >= GRID_CH_N || !grid_holds(g, x, y, z) || g->slots == NULL)
+    if ((unsigned)ch >= GRID_CH_N || !grid_holds(g, x, y, z) || g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     int32_t k[3];
     int li;
@@ -331,8 +279,8 @@ static bool for_blocks(const grid_t *g, const int32_t lo[3], const int32_t n[3],
         return true;
     int32_t k0[3], k1[3];
     for (int a = 0; a < 3; a++) {
-        k0[a] = block_of(c0[a]);
-        k1[a] = block_of(c1[a] - 1);
+        k0[a] = floor_div_i32(c0[a], GRID_B);
+        k1[a] = floor_div_i32(c1[a] - 1, GRID_B);
     }
     int32_t k[3];
     for (k[2] = k0[2]; k[2] <= k1[2]; k[2]++)
@@ -485,7 +433,7 @@ void grid_read_box(const grid_t *g, grid_ch_t ch, const int32_t lo[3], const int
 argil_err_t grid_write_box(grid_t *g, grid_ch_t ch, const int32_t lo[3], const int32_t n[3],
                            const float *in)
 {
-    if ((unsigned)ch >= GRID_CH_N || g->slots == NULL)
+    if ((unsigned)ch >= GRID_CH_N || g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     return box_io(g, ch, lo, n, (float *)in, true);
 }
@@ -505,7 +453,7 @@ float grid_mat_get(const grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t
 
 argil_err_t grid_mat_set(grid_t *g, grid_mat_t ch, int32_t x, int32_t y, int32_t z, float v)
 {
-    if ((unsigned)ch >= GRID_MAT_N || !grid_holds(g, x, y, z) || g->slots == NULL)
+    if ((unsigned)ch >= GRID_MAT_N || !grid_holds(g, x, y, z) || g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     g->painted[ch] = true;
     int32_t k[3];
@@ -537,7 +485,7 @@ void grid_mat_read_box(const grid_t *g, grid_mat_t ch, const int32_t lo[3], cons
 argil_err_t grid_mat_write_box(grid_t *g, grid_mat_t ch, const int32_t lo[3], const int32_t n[3],
                                const float *in)
 {
-    if ((unsigned)ch >= GRID_MAT_N || g->slots == NULL)
+    if ((unsigned)ch >= GRID_MAT_N || g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     g->painted[ch] = true;
     return box_io(g, GRID_CH_N + (int)ch, lo, n, (float *)in, true);
@@ -606,7 +554,7 @@ void grid_rgb_get(const grid_t *g, int32_t x, int32_t y, int32_t z, uint8_t rgb[
 
 argil_err_t grid_rgb_set(grid_t *g, int32_t x, int32_t y, int32_t z, const uint8_t rgb[3])
 {
-    if (!grid_holds(g, x, y, z) || g->slots == NULL)
+    if (!grid_holds(g, x, y, z) || g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     int32_t k[3];
     int li;
@@ -691,7 +639,7 @@ void grid_rgb_read_box(const grid_t *g, const int32_t lo[3], const int32_t n[3],
 argil_err_t grid_rgb_write_box(grid_t *g, const int32_t lo[3], const int32_t n[3],
                                const uint8_t *in)
 {
-    if (g->slots == NULL)
+    if (g->blocks.entries == NULL)
         return ARGIL_ERR_ARG;
     rgb_ctx_t c = {g, lo, n, (uint8_t *)in, true, ARGIL_OK};
     (void)for_blocks(g, lo, n, rgb_block, &c);
@@ -705,9 +653,10 @@ bool grid_rgb_any(const grid_t *g)
 
 bool grid_rgb_painted(const grid_t *g)
 {
-    for (size_t i = 0; g->slots != NULL && g->rgb_blocks > 0 && i < g->cap; i++)
-        if (g->slots[i].used && g->slots[i].rgb != NULL &&
-            !rgb_default(g->slots[i].rgb, 3 * GRID_BN))
+    size_t slot = 0;
+    const grid_block_t *b;
+    while (g->rgb_blocks > 0 && (b = block_table_next(&g->blocks, &slot)) != NULL)
+        if (b->rgb != NULL && !rgb_default(b->rgb, 3 * GRID_BN))
             return true;
     return false;
 }
@@ -780,7 +729,7 @@ vec3_t grid_box_origin(const grid_t *g, const int32_t lo[3])
 
 size_t grid_bytes(const grid_t *g)
 {
-    return g->cap * sizeof(grid_block_t) +
+    return block_table_bytes(&g->blocks) +
            (g->data_blocks * GRID_CH_N + g->mat_blocks * GRID_MAT_N) * GRID_BN * sizeof(float) +
            g->rgb_blocks * 3 * GRID_BN;
 }
@@ -836,10 +785,8 @@ void grid_compact(grid_t *g)
         g->blo[a] = 1;
         g->bhi[a] = 0;
     }
-    for (size_t i = 0; g->slots != NULL && i < g->cap; i++) {
-        grid_block_t *b = &g->slots[i];
-        if (!b->used)
-            continue;
+    size_t slot = 0;
+    for (grid_block_t *b; (b = block_table_next(&g->blocks, &slot)) != NULL;) {
         if (b->data != NULL && data_uniform(b)) {
             free(b->data);
             b->data = NULL;
@@ -986,7 +933,8 @@ static bool fill_block(void *vctx, const int32_t k[3], const int32_t a0[3], cons
 
 void grid_fill_sphere(grid_t *g, vec3_t centre_m, float radius_m)
 {
-    if (!vec3_isfinite(centre_m) || !isfinite(radius_m) || radius_m < 0.0f || g->slots == NULL)
+    if (!vec3_isfinite(centre_m) || !isfinite(radius_m) || radius_m < 0.0f ||
+        g->blocks.entries == NULL)
         return;
     const int32_t zero[3] = {0, 0, 0};
     fill_ctx_t c = {g, centre_m, radius_m, ARGIL_OK};
@@ -1162,7 +1110,7 @@ static void block_view_fill(const grid_block_t *b, const int32_t k[3], grid_bloc
 
 int32_t grid_block_index(int32_t i)
 {
-    return block_of(i);
+    return floor_div_i32(i, GRID_B);
 }
 
 bool grid_block_view(const grid_t *g, const int32_t k[3], grid_block_view_t *v)
@@ -1174,15 +1122,10 @@ bool grid_block_view(const grid_t *g, const int32_t k[3], grid_block_view_t *v)
 
 bool grid_block_next(const grid_t *g, size_t *slot, grid_block_view_t *v)
 {
-    for (; g->slots != NULL && *slot < g->cap; (*slot)++) {
-        const grid_block_t *b = &g->slots[*slot];
-        if (!b->used)
-            continue;
+    const grid_block_t *b = block_table_next(&g->blocks, slot);
+    if (b != NULL)
         block_view_fill(b, b->key, v);
-        (*slot)++;
-        return true;
-    }
-    return false;
+    return b != NULL;
 }
 
 /* ---- Queries for the live mesher (host/mesh/grid_mesh.c) ---- */
@@ -1195,8 +1138,8 @@ bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_
     for (int a = 0; a < 3; a++) {
         if (lo[a] >= hi[a])
             return true;
-        klo[a] = block_of(lo[a]);
-        khi[a] = block_of(hi[a] - 1);
+        klo[a] = floor_div_i32(lo[a], GRID_B);
+        khi[a] = floor_div_i32(hi[a] - 1, GRID_B);
     }
     int32_t k[3];
     for (k[2] = klo[2]; k[2] <= khi[2]; k[2]++)

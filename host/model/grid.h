@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/model/block_table.h"
 #include "shared/argil_err.h"
 #include "shared/density_springs.h"
 #include "shared/vec3.h"
@@ -35,8 +36,7 @@ typedef enum {
 
 /* One block of the hash (internal to grid.c). */
 typedef struct {
-    int32_t key[3];             /* block index: sample index / GRID_B, rounded down */
-    bool used;                  /* slot taken */
+    int32_t key[3];             /* block index: floor(sample index / GRID_B); the table's key */
     float uniform;              /* data NULL: density = rest = uniform, velocity = force = 0 */
     float *data;                /* GRID_CH_N * GRID_BN floats, channel-major, x fastest */
     float *mat;                 /* GRID_MAT_N * GRID_BN floats; NULL = every channel default */
@@ -50,8 +50,7 @@ typedef struct {
     float iso;                  /* surface level, 0.5 */
     float band_m;               /* half-width of the density ramp across the surface */
     spring_material_t material;
-    grid_block_t *slots;        /* open-addressing hash of blocks; NULL = not initialised */
-    size_t cap, count;          /* slots, slots used */
+    block_table_t blocks;       /* grid_block_t by key; entries NULL = not initialised */
     size_t data_blocks, mat_blocks; /* blocks holding sample / painted arrays */
     size_t rgb_blocks;          /* blocks holding a colour array */
     int32_t blo[3], bhi[3];     /* sample box of the blocks that hold anything (lo > hi: none) */

@@ -1,24 +1,17 @@
-/* Hash table of blocks keyed by block coordinates (linear probing, grows at half load). */
+/* Blocks of channels in the block-key hash (host/model/block_table.h). */
 #include "host/model/sparse.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 static int32_t sparse_local(int32_t i)
 {
-    return i - sparse_block_of(i) * SPARSE_B;
+    return floor_mod_i32(i, SPARSE_B);
 }
 
-static size_t sparse_hash(const int32_t key[3], size_t cap)
-{
-    uint32_t h = (uint32_t)key[0] * 73856093u ^ (uint32_t)key[1] * 19349663u ^
-                 (uint32_t)key[2] * 83492791u;
-    h ^= h >> 15;
-    h *= 0x2c1b3c6du;
-    h ^= h >> 12;
-    return (size_t)h & (cap - 1);
-}
+_Static_assert(offsetof(sparse_block_t, key) == 0, "a block_table entry starts with its key");
 
 argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults)
 {
@@ -30,76 +23,46 @@ argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults)
             return ARGIL_ERR_NONFINITE;
     s->nch = nch;
     memcpy(s->defaults, defaults, sizeof(float) * (size_t)nch);
-    s->cap = 64;
-    s->slots = calloc(s->cap, sizeof(sparse_block_t));
-    return s->slots == NULL ? ARGIL_ERR_NOMEM : ARGIL_OK;
+    return block_table_init(&s->blocks, sizeof(sparse_block_t), 64);
 }
 
 void sparse_free(sparse_t *s)
 {
-    for (size_t i = 0; i < s->cap && s->slots != NULL; i++)
-        free(s->slots[i].data);
-    free(s->slots);
-    s->slots = NULL;
-    s->cap = s->count = 0;
+    size_t slot = 0;
+    for (sparse_block_t *b; (b = sparse_next(s, &slot)) != NULL;)
+        free(b->data);
+    block_table_free(&s->blocks);
 }
 
 sparse_block_t *sparse_find(const sparse_t *s, const int32_t key[3])
 {
-    size_t h = sparse_hash(key, s->cap);
-    for (;;) {
-        sparse_block_t *b = &s->slots[h];
-        if (b->data == NULL)
-            return NULL;
-        if (b->key[0] == key[0] && b->key[1] == key[1] && b->key[2] == key[2])
-            return b;
-        h = (h + 1) & (s->cap - 1);
-    }
+    return block_table_find(&s->blocks, key);
 }
 
-static argil_err_t sparse_grow(sparse_t *s)
+sparse_block_t *sparse_next(const sparse_t *s, size_t *slot)
 {
-    const size_t ncap = s->cap * 2;
-    sparse_block_t *ns = calloc(ncap, sizeof(sparse_block_t));
-    if (ns == NULL)
-        return ARGIL_ERR_NOMEM;
-    for (size_t i = 0; i < s->cap; i++) {
-        if (s->slots[i].data == NULL)
-            continue;
-        size_t h = sparse_hash(s->slots[i].key, ncap);
-        while (ns[h].data != NULL)
-            h = (h + 1) & (ncap - 1);
-        ns[h] = s->slots[i];
-    }
-    free(s->slots);
-    s->slots = ns;
-    s->cap = ncap;
-    return ARGIL_OK;
+    return block_table_next(&s->blocks, slot);
 }
 
 argil_err_t sparse_touch(sparse_t *s, const int32_t key[3], sparse_block_t **out)
 {
     sparse_block_t *b = sparse_find(s, key);
     if (b == NULL) {
-        if ((s->count + 1) * 2 > s->cap) {
-            argil_err_t e = sparse_grow(s);
-            if (e != ARGIL_OK)
-                return e;
-        }
         float *data = malloc(sizeof(float) * (size_t)s->nch * SPARSE_BN);
         if (data == NULL)
             return ARGIL_ERR_NOMEM;
         for (int c = 0; c < s->nch; c++)
             for (int i = 0; i < SPARSE_BN; i++)
                 data[c * SPARSE_BN + i] = s->defaults[c];
-        size_t h = sparse_hash(key, s->cap);
-        while (s->slots[h].data != NULL)
-            h = (h + 1) & (s->cap - 1);
-        b = &s->slots[h];
-        memcpy(b->key, key, sizeof(b->key));
+        void *e;
+        const argil_err_t err = block_table_insert(&s->blocks, key, &e);
+        if (err != ARGIL_OK) {
+            free(data);
+            return err;
+        }
+        b = e;
         b->data = data;
         b->dirty = true;
-        s->count++;
     }
     *out = b;
     return ARGIL_OK;
@@ -227,10 +190,9 @@ argil_err_t sparse_write_box(sparse_t *s, int ch, const int32_t lo[3], const int
 
 size_t sparse_take_dirty(sparse_t *s, int32_t (*keys)[3], size_t max)
 {
-    size_t n = 0;
-    for (size_t i = 0; i < s->cap; i++) {
-        sparse_block_t *b = &s->slots[i];
-        if (b->data == NULL || !b->dirty)
+    size_t n = 0, slot = 0;
+    for (sparse_block_t *b; (b = sparse_next(s, &slot)) != NULL;) {
+        if (!b->dirty)
             continue;
         if (keys != NULL) {
             if (n < max)
@@ -244,5 +206,6 @@ size_t sparse_take_dirty(sparse_t *s, int32_t (*keys)[3], size_t max)
 
 size_t sparse_bytes(const sparse_t *s)
 {
-    return s->count * sizeof(float) * (size_t)s->nch * SPARSE_BN + s->cap * sizeof(sparse_block_t);
+    return s->blocks.count * sizeof(float) * (size_t)s->nch * SPARSE_BN +
+           block_table_bytes(&s->blocks);
 }

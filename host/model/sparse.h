@@ -8,6 +8,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "host/model/block_table.h"
+#include "host/model/floor_div.h"
 #include "shared/argil_err.h"
 
 #define SPARSE_B 8                               /* lattice points per block edge */
@@ -16,30 +18,34 @@
 #define SPARSE_INDEX_MAX (1 << 28)               /* |index| bound per axis */
 
 typedef struct {
-    int32_t key[3];      /* block coordinates (index / SPARSE_B, rounded down) */
+    int32_t key[3];      /* block coordinates floor(index / SPARSE_B); the table's key */
     bool dirty;          /* changed since the mesher last took it */
-    float *data;         /* nch * SPARSE_BN floats, channel-major, x fastest; NULL = empty slot */
+    float *data;         /* nch * SPARSE_BN floats, channel-major, x fastest */
 } sparse_block_t;
 
 typedef struct {
     int nch;
     float defaults[SPARSE_CH_MAX];  /* value of every point of an absent block */
-    sparse_block_t *slots;          /* open-addressing hash table */
-    size_t cap, count;
+    block_table_t blocks;           /* sparse_block_t by key */
 } sparse_t;
 
 /* An empty store of nch channels with the given default values. ARGIL_ERR_ARG, ARGIL_ERR_NOMEM. */
 argil_err_t sparse_init(sparse_t *s, int nch, const float *defaults);
 void sparse_free(sparse_t *s);
 
-/* Floor division of a lattice index by SPARSE_B (inline: the tools call it per coefficient). */
+/* The block key of lattice index i: floor(i / SPARSE_B) (inline: the tools call it per
+ * coefficient). */
 static inline int32_t sparse_block_of(int32_t i)
 {
-    return i >= 0 ? i / SPARSE_B : -((-i + SPARSE_B - 1) / SPARSE_B);
+    return floor_div_i32(i, SPARSE_B);
 }
 
 /* The block holding key, or NULL. */
 sparse_block_t *sparse_find(const sparse_t *s, const int32_t key[3]);
+
+/* The next block held at slot *slot or after it, *slot moved past it; NULL when none is left.
+ * Start with *slot = 0; the order is the hash's. */
+sparse_block_t *sparse_next(const sparse_t *s, size_t *slot);
 
 /* The block holding key, allocated (filled with defaults) when absent. */
 argil_err_t sparse_touch(sparse_t *s, const int32_t key[3], sparse_block_t **out);

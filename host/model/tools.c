@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/model/cgls.h"
+
 #define TOOL_POSES_MAX 4096
 #define TOOL_BOX_MAX ((int64_t)1 << 26)
 
@@ -415,14 +417,6 @@ typedef struct {
     const int32_t *clo, *cn, *blo, *bn, *slo, *shi, *klo, *kn;
 } tool_box_t;
 
-static double tool_dot(const float *a, const float *b, size_t n)
-{
-    double v = 0.0;
-    for (size_t i = 0; i < n; i++)
-        v += (double)a[i] * b[i];
-    return v;
-}
-
 /* Zeroes every coefficient of the C box outside the free box. */
 static void tool_mask_free(const tool_box_t *B, float *x)
 {
@@ -442,6 +436,26 @@ static void tool_mask_free(const tool_box_t *B, float *x)
             memset(r, 0, sizeof(float) * (size_t)lo[0]);
             memset(r + hi[0], 0, sizeof(float) * (row - (size_t)hi[0]));
         }
+}
+
+/* A and Aᵀ of tool_fit_lsq's least squares over the box B; Aᵀ keeps only the free coefficients. */
+typedef struct {
+    const field_t *f;
+    const tool_box_t *B;
+    float *tmp;
+} tool_fit_op_t;
+
+static void tool_fit_a(void *ctx, const float *p, float *out)
+{
+    const tool_fit_op_t *o = ctx;
+    field_samples_from(o->f, p, o->B->clo, o->B->cn, o->B->slo, o->B->shi, out, o->tmp);
+}
+
+static void tool_fit_at(void *ctx, const float *r, float *out)
+{
+    const tool_fit_op_t *o = ctx;
+    field_coefs_from(o->f, r, o->B->slo, o->B->shi, o->B->clo, o->B->cn, out, o->tmp);
+    tool_mask_free(o->B, out);
 }
 
 /* Hua & Qin §6.2 least-squares fit: the free coefficients minimise Σ_s (A p - d_target)² over the
@@ -483,28 +497,9 @@ static argil_err_t tool_fit_lsq(field_t *f, const tool_union_t *U, const tool_pa
     field_samples_from(f, P, B->clo, B->cn, B->slo, B->shi, r, tmp);
     for (i = 0; i < ns; i++)
         r[i] = dt[i] - r[i];
-    field_coefs_from(f, r, B->slo, B->shi, B->clo, B->cn, g, tmp);
-    tool_mask_free(B, g);
-    memcpy(dir, g, sizeof(float) * nc);
-    double gamma = tool_dot(g, g, nc);
-    for (int32_t it = 0; it < p->fit_iters && gamma > 0.0; it++) {
-        field_samples_from(f, dir, B->clo, B->cn, B->slo, B->shi, q, tmp);
-        const double qq = tool_dot(q, q, ns);
-        if (!(qq > 0.0))
-            break;
-        const float alpha = (float)(gamma / qq);
-        for (i = 0; i < nc; i++)
-            P[i] += alpha * dir[i];
-        for (i = 0; i < ns; i++)
-            r[i] -= alpha * q[i];
-        field_coefs_from(f, r, B->slo, B->shi, B->clo, B->cn, g, tmp);
-        tool_mask_free(B, g);
-        const double gn = tool_dot(g, g, nc);
-        const float beta = (float)(gn / gamma);
-        gamma = gn;
-        for (i = 0; i < nc; i++)
-            dir[i] = g[i] + beta * dir[i];
-    }
+    tool_fit_op_t o = {f, B, tmp};
+    const cgls_op_t op = {tool_fit_a, tool_fit_at, &o, nc, ns};
+    (void)cgls_solve(&op, p->fit_iters, P, r, g, dir, q);
     /* the fitted coefficients become the change list */
     *nch = 0;
     size_t nk = 1;

@@ -247,7 +247,7 @@ int main(int argc, char **argv)
     printf("  incremental re-mesh after a 40^3 stroke: %.3f ms (%zu of %zu blocks); goal <= 2 ms\n",
            1e3 * median(inc, 21), blocks, mc_blocks_box_blocks(&b));
     printf("  live mesher memory, 256^3 sphere r=100: %.2f MB (%zu block slots; per-block tables "
-           "over the box alone: %.2f MB)\n", (double)mc_blocks_bytes(&b) / 1048576.0, b.n_blocks,
+           "over the box alone: %.2f MB)\n", (double)mc_blocks_bytes(&b) / 1048576.0, b.blocks.count,
            (double)(mc_blocks_box_blocks(&b) * (sizeof(mc_block_mesh_t) + 1)) / 1048576.0);
     double ta[RUNS];
     for (int r = 0; r < RUNS; r++) {

@@ -253,10 +253,10 @@ static void test_refine_keeps_the_field(void **state)
         before[k] = field_eval(&f, pts[k], NULL);
     }
     const float d_before = sparse_get(&f.samp, FS_D, 3, -5, 7);
-    const size_t ncoef_before = f.coef.count;
+    const size_t ncoef_before = f.coef.blocks.count;
     assert_int_equal(field_refine(&f), ARGIL_OK);
     assert_true(f.ratio == 2 && f.coef_spacing_m == 0.01f);
-    assert_true(f.coef.count > 4 * ncoef_before);
+    assert_true(f.coef.blocks.count > 4 * ncoef_before);
     double worst = 0.0;
     int inside = 0;
     for (int k = 0; k < NPTS; k++) {

@@ -118,7 +118,7 @@ static void refine_keeps_the_shape(int32_t r0)
     for (int32_t r = r0; r > 1; r /= 2) {
         gv_copy(g, GRID_DENSITY, before);
         const size_t verts = mesh_vertices(g);
-        const size_t coef_blocks = gs.field.coef.count;
+        const size_t coef_blocks = gs.field.coef.blocks.count;
         float dd = -1.0f;
         int32_t lo[3], hi[3];
         assert_int_equal(gsolve_refine(&gs, g, &dd, lo, hi), ARGIL_OK);
@@ -126,10 +126,10 @@ static void refine_keeps_the_shape(int32_t r0)
         assert_true(fabsf(gs.field.coef_spacing_m - H * (float)(r / 2)) < 1e-9f);
         print_message("# refine R %d -> %d: max |dd| %.2e over the grid, coefficient blocks "
                       "%zu -> %zu, mesh %zu vertices\n",
-                      (int)r, (int)(r / 2), (double)dd, coef_blocks, gs.field.coef.count, verts);
+                      (int)r, (int)(r / 2), (double)dd, coef_blocks, gs.field.coef.blocks.count, verts);
         /* density is 0..1: 1e-5 relative is 1e-5 */
         assert_true(dd >= 0.0f && dd < 1e-5f);
-        assert_true(gs.field.coef.count > 4 * coef_blocks);
+        assert_true(gs.field.coef.blocks.count > 4 * coef_blocks);
         /* nothing crossed the view's threshold: the grid, so the mesh and the board's window,
          * stayed as they were */
         assert_int_equal(hi[0] - lo[0], 0);

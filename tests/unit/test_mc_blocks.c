@@ -103,7 +103,7 @@ static void test_incremental_equals_full(void **state)
     const size_t all_blocks = inc.blocks_meshed;
     assert_int_equal(all_blocks, mc_blocks_box_blocks(&inc)); /* 97 padded cells: 7^3 blocks */
     assert_int_equal(all_blocks, 343);
-    assert_true(inc.n_blocks * 2 < all_blocks); /* only the blocks the surface crosses keep a slot */
+    assert_true(inc.blocks.count * 2 < all_blocks); /* only the blocks the surface crosses keep a slot */
     mesh_t a, b;
     mesh_init(&a);
     mesh_init(&b);
@@ -355,8 +355,8 @@ static void test_memory_follows_surface_and_growth(void **state)
     assert_true(inc.blocks_read * 10 < box_blocks);
     /* The tables over the box as they were: one block record and one dirty flag per block. */
     const size_t dense_tables = box_blocks * (sizeof(mc_block_mesh_t) + 1);
-    const size_t table = inc.cap * sizeof(mc_block_t);
-    assert_true(inc.n_blocks >= 50 && inc.n_blocks <= 120); /* the blocks the shell crosses: 74 */
+    const size_t table = block_table_bytes(&inc.blocks);
+    assert_true(inc.blocks.count >= 50 && inc.blocks.count <= 120); /* the blocks the shell crosses: 74 */
     assert_true(table * 4 < dense_tables); /* 18 KB against 98 KB */
     /* Everything it holds, the sphere's triangles (≈ 1.6 MB of the 1.8) included. */
     const size_t bytes0 = mc_blocks_bytes(&inc);
@@ -373,7 +373,7 @@ static void test_memory_follows_surface_and_growth(void **state)
     add_ball(&g, vec3(0.1275f, 0.0f, 0.0f), 0.006f, lo1, hi1);
     add_ball(&g, vec3(0.0f, 0.01f, -0.1175f), 0.006f, lo2, hi2);
     assert_true(grid_mesh_view_stale(&view, &g));
-    const size_t slots_before = inc.n_blocks;
+    const size_t slots_before = inc.blocks.count;
     assert_int_equal(grid_mesh_grow(&inc, &view, &g), ARGIL_OK);
     assert_false(grid_mesh_view_stale(&view, &g));
     assert_true(view.lo[2] < -20 && view.hi[0] > 210);
@@ -386,10 +386,10 @@ static void test_memory_follows_surface_and_growth(void **state)
     const size_t grown_blocks = mc_blocks_box_blocks(&inc);
     assert_true(grown_blocks * 3 > 4 * box_blocks); /* 225 x 176 x 215 samples: 2700 blocks */
     assert_true(inc.blocks_meshed * 50 < grown_blocks);
-    assert_true(inc.n_blocks > slots_before && inc.n_blocks <= slots_before + 2 * 27);
+    assert_true(inc.blocks.count > slots_before && inc.blocks.count <= slots_before + 2 * 27);
     /* Memory grew by the balls' surfaces only, not with the box (the tables alone would double). */
     assert_true(mc_blocks_bytes(&inc) < bytes0 + 300 * 1024);
-    assert_true(inc.cap * sizeof(mc_block_t) * 4 < grown_blocks * (sizeof(mc_block_mesh_t) + 1));
+    assert_true(block_table_bytes(&inc.blocks) * 4 < grown_blocks * (sizeof(mc_block_mesh_t) + 1));
     assert_int_equal(mc_blocks_assemble(&inc, &a), ARGIL_OK);
     assert_true(a.n_tri > tri0 + 2000);
 
@@ -428,13 +428,13 @@ static void test_slots_released_and_grow_errors(void **state)
     grid_mesh_view_t view;
     assert_int_equal(grid_mesh_blocks_init(&inc, &view, &g, 0.5f), ARGIL_OK);
     assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
-    assert_int_equal(inc.n_blocks, 8); /* 41 padded cells: the sphere's 8 blocks round the centre */
+    assert_int_equal(inc.blocks.count, 8); /* 41 padded cells: the sphere's 8 blocks round the centre */
     int32_t lo[3], hi[3];
     grid_carve_sphere(&g, vec3(0, 0, 0), 0.019f, lo, hi);
     grid_mesh_mark(&inc, &view, lo, hi);
     assert_int_equal(mc_blocks_update_read(&inc, grid_mesh_read, &view), ARGIL_OK);
     assert_int_equal(inc.blocks_meshed, 27);
-    assert_int_equal(inc.n_blocks, 0);
+    assert_int_equal(inc.blocks.count, 0);
     mesh_t m;
     mesh_init(&m);
     assert_int_equal(mc_blocks_assemble(&inc, &m), ARGIL_OK);

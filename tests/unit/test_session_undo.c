@@ -113,11 +113,11 @@ static float grid_diff(const rig_t *r, const state_t *st)
 static bool velocities_zero(const rig_t *r)
 {
     const sparse_t *c = &r->gs.field.coef;
-    for (size_t i = 0; i < c->cap; i++)
-        if (c->slots[i].data != NULL)
-            for (int k = 0; k < SPARSE_BN; k++)
-                if (c->slots[i].data[FC_V * SPARSE_BN + k] != 0.0f)
-                    return false;
+    size_t slot = 0;
+    for (const sparse_block_t *b; (b = sparse_next(c, &slot)) != NULL;)
+        for (int k = 0; k < SPARSE_BN; k++)
+            if (b->data[FC_V * SPARSE_BN + k] != 0.0f)
+                return false;
     return true;
 }
 

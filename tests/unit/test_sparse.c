@@ -37,7 +37,7 @@ static void test_negative_indices_and_block_of(void **state)
     assert_true(sparse_get(&s, 1, -5, 3, -1000) == 0.8f); /* absent: the default */
     assert_int_equal(sparse_set(&s, 0, -1, -8, -9, 2.5f), ARGIL_OK);
     assert_int_equal(sparse_set(&s, 0, 0, -8, -9, 3.5f), ARGIL_OK);
-    assert_int_equal(s.count, 2); /* x = -1 and x = 0 lie in different blocks */
+    assert_int_equal(s.blocks.count, 2); /* x = -1 and x = 0 lie in different blocks */
     assert_true(sparse_get(&s, 0, -1, -8, -9) == 2.5f);
     assert_true(sparse_get(&s, 0, 0, -8, -9) == 3.5f);
     assert_true(sparse_get(&s, 1, -1, -8, -9) == 0.8f); /* other channel of an allocated block */
@@ -65,10 +65,10 @@ static void test_blocks_only_where_values_differ(void **state)
     for (int i = 0; i < 64000; i++)
         v[i] = def;
     assert_int_equal(sparse_write_box(&s, 0, lo, dims, v), ARGIL_OK);
-    assert_int_equal(s.count, 0); /* writing defaults into empty space allocates nothing */
+    assert_int_equal(s.blocks.count, 0); /* writing defaults into empty space allocates nothing */
     v[5 + 40 * (5 + 40 * 5)] = 1.0f; /* point (-15, -15, -15) */
     assert_int_equal(sparse_write_box(&s, 0, lo, dims, v), ARGIL_OK);
-    assert_int_equal(s.count, 1);
+    assert_int_equal(s.blocks.count, 1);
     assert_true(sparse_get(&s, 0, -15, -15, -15) == 1.0f);
     const int32_t bad[3] = {1, -1, 1};
     assert_int_equal(sparse_write_box(&s, 0, lo, bad, v), ARGIL_ERR_ARG);
@@ -91,7 +91,7 @@ static size_t shell_bytes(int32_t r, size_t *blocks)
                     assert_int_equal(sparse_set(&s, 0, x, y, z, 1.0f), ARGIL_OK);
             }
     const size_t b = sparse_bytes(&s);
-    *blocks = s.count;
+    *blocks = s.blocks.count;
     sparse_free(&s);
     return b;
 }
@@ -120,7 +120,7 @@ static void test_dirty_flags(void **state)
     for (int i = 0; i < 512; i++)
         v[i] = 1.0f;
     assert_int_equal(sparse_write_box(&s, 0, lo, dims, v), ARGIL_OK);
-    assert_int_equal(s.count, 8);
+    assert_int_equal(s.blocks.count, 8);
     assert_int_equal(sparse_take_dirty(&s, NULL, 0), 8); /* counting does not clear */
     int32_t keys[8][3];
     assert_int_equal(sparse_take_dirty(&s, keys, 8), 8);
