@@ -38,6 +38,7 @@ SHARED_SRC := $(wildcard shared/*.c)
 CORE_SRC := $(wildcard firmware/core/*.c)
 HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
+# host/: model/ (representations) <- solve/ (the global solve) <- app/, with mesh/ io/ fit/ render/ link/.
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 # The host's USB link cuts its byte stream with the board's own framer (host/link/link_usb.c).
 HOST_FRAMER_SRC := firmware/hal/link_framer.c

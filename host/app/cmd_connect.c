@@ -21,7 +21,7 @@
 #include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
 #include "host/app/session_undo.h"

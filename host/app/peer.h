@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/model/grid.h"
 #include "shared/proto.h"
 
@@ -38,7 +38,7 @@ typedef void (*peer_telemetry_fn)(void *ctx, const msg_telemetry_t *t);
 /* What the global solve steps (docs/model.md "In the session"). */
 typedef enum {
     PEER_SOLVE_SPRINGS = 0,           /* explicit density springs on the dense grid */
-    PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/app/global_solve.h) */
+    PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/solve/gsolve.h) */
 } peer_global_solve_t;
 
 #define PEER_SOLVE_HIST_BINS 5001u    /* solve step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
@@ -190,7 +190,7 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
  * (already one coefficient per sample), nothing changed; ARGIL_ERR_NOMEM. */
 argil_err_t peer_refine(peer_t *p, float *max_dd);
 
-/* What the board's carve tool does on the host while button 1 is held (host/app/host_tool.h;
+/* What the board's carve tool does on the host while button 1 is held (host/model/host_tool.h;
  * carve with a sphere, no mirror by default): one application per solve period at the stylus,
  * with the tool's radius and axis (gsolve_apply_tool). ARGIL_ERR_ARG for a setting out of
  * range; ARGIL_ERR_STATE for anything but the default with the springs solve (it carves the

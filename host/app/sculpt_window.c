@@ -63,7 +63,7 @@ static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussia
                                                            "cylindrical", "conical"};
 
 #define PANEL_SOLVE_STEP (-1)         /* panel row that is no PARAM_*: the solve period */
-/* Rows for the host tool (what carve does on the host, host/app/host_tool.h): -/+ cycle the
+/* Rows for the host tool (what carve does on the host, host/model/host_tool.h): -/+ cycle the
  * action, shape and mirror planes, scale the strength; the keys A, S, X, Y, Z reach them too. */
 #define PANEL_HOST_ACTION (-2)
 #define PANEL_HOST_SHAPE (-3)

@@ -1,4 +1,4 @@
-/* The session's global solve on the B-spline model (host/app/global_solve.c): the grid as the
+/* The session's global solve on the B-spline model (host/solve/gsolve.c): the grid as the
  * model's view, impulses moving as much clay as the density springs do, carving through the
  * model's tools, painted material, a field at rest staying put, and the script's paint verb. */
 #include <stdarg.h>
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
