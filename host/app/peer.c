@@ -7,7 +7,6 @@
 #include <time.h>
 
 #include "firmware/core/safety.h"
-#include "host/app/histogram.h"
 
 void peer_cfg_default(peer_cfg_t *cfg)
 {
@@ -35,8 +34,7 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
     p->on_telemetry = on_telemetry;
     p->ctx = ctx;
     p->next_version = 1;
-    p->margin = PEER_MARGIN_MAX;
-    p->stats.margin_min = PEER_MARGIN_MAX;
+    solve_sched_init(&p->sched, cfg->adaptive_region);
     /* Densities, then room for the per-node stiffness of a painted window (channels 2). */
     p->win_samples = malloc((size_t)PROTO_WINDOW_CHANNELS_MAX * (size_t)cfg->window_edge *
                             (size_t)cfg->window_edge * (size_t)cfg->window_edge * sizeof(float));
@@ -357,8 +355,8 @@ static void solve_springs(peer_t *p)
         return;
     peer_box_t box;
     for (int a = 0; a < 3; a++) {
-        box.lo[a] = p->current.corner[a] - p->margin;
-        box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
+        box.lo[a] = p->current.corner[a] - p->sched.margin;
+        box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->sched.margin;
     }
     if (p->have_box && memcmp(&box, &p->box, sizeof(box)) != 0)
         remember_settling(p, &p->box);
@@ -474,8 +472,8 @@ static void solve_bspline(peer_t *p)
     if (p->have_current) {
         peer_box_t box;
         for (int a = 0; a < 3; a++) {
-            box.lo[a] = p->current.corner[a] - p->margin;
-            box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
+            box.lo[a] = p->current.corner[a] - p->sched.margin;
+            box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->sched.margin;
         }
         p->box = box;
         p->have_box = true;
@@ -494,30 +492,6 @@ static void solve_bspline(peer_t *p)
     clear_forces(p);
 }
 
-/* A solver that falls behind lowers its region, never the board's rate: the margin around the
- * board's window shrinks while steps overrun their budget and grows back after a run of fast
- * steps (the board's own window is always solved). */
-void peer_adapt_region(peer_t *p, double step_ms)
-{
-    const double period_ms = (double)p->cfg.solve_period_us * 1e-3;
-    if (step_ms > 0.8 * period_ms) {
-        p->fast_steps = 0;
-        if (p->margin > 0) {
-            p->margin--;
-            p->stats.region_shrinks++;
-            if (p->margin < p->stats.margin_min)
-                p->stats.margin_min = p->margin;
-        }
-    } else if (step_ms < 0.4 * period_ms) {
-        if (++p->fast_steps >= PEER_MARGIN_GROW_STEPS && p->margin < PEER_MARGIN_MAX) {
-            p->margin++;
-            p->fast_steps = 0;
-        }
-    } else {
-        p->fast_steps = 0;
-    }
-}
-
 static void solve(peer_t *p)
 {
     struct timespec t0, t1;
@@ -529,18 +503,12 @@ static void solve(peer_t *p)
         solve_springs(p);
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
     const double ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
-    const double bin = ms * 100.0;
-    p->stats.solve_hist_10us[bin < (double)(PEER_SOLVE_HIST_BINS - 1u) ? (uint32_t)bin
-                                                                      : PEER_SOLVE_HIST_BINS - 1u]++;
-    if (ms > p->stats.solve_max_ms)
-        p->stats.solve_max_ms = ms;
-    if (p->cfg.adaptive_region)
-        peer_adapt_region(p, ms);
+    solve_sched_record(&p->sched, p->cfg.solve_period_us, ms);
 }
 
 bool peer_solve_due(const peer_t *p, uint32_t dt_us)
 {
-    return p->board_seen && p->since_solve_us + dt_us >= p->cfg.solve_period_us;
+    return p->board_seen && solve_sched_due(&p->sched, p->cfg.solve_period_us, dt_us);
 }
 
 void peer_tick(peer_t *p, uint32_t dt_us)
@@ -548,7 +516,7 @@ void peer_tick(peer_t *p, uint32_t dt_us)
     p->time_us += dt_us;
     p->since_window_us += dt_us;
     p->since_heartbeat_us += dt_us;
-    p->since_solve_us += dt_us;
+    solve_sched_advance(&p->sched, dt_us);
     proto_msg_t *m = &p->scratch;
 
     if (!p->board_seen)
@@ -559,10 +527,8 @@ void peer_tick(peer_t *p, uint32_t dt_us)
         if (send_msg(p, m))
             p->tool_dirty = false;
     }
-    if (p->since_solve_us >= p->cfg.solve_period_us) {
-        p->since_solve_us = 0;
+    if (solve_sched_take(&p->sched, p->cfg.solve_period_us))
         solve(p);
-    }
     /* A new window when the tool nears the edge, or when the field under it changed. */
     if (!p->sending_active &&
         (tool_near_edge(p) ||
@@ -682,16 +648,12 @@ int32_t peer_knot_ratio(const peer_t *p)
 
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max)
 {
-    *median = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.5) * 0.01;
-    *p99 = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.99) * 0.01;
-    *max = p->stats.solve_max_ms;
+    solve_sched_times_ms(&p->sched, median, p99, max);
 }
 
 void peer_set_solve_period_us(peer_t *p, uint32_t us)
 {
-    if (us < PEER_SOLVE_PERIOD_MIN_US) us = PEER_SOLVE_PERIOD_MIN_US;
-    if (us > PEER_SOLVE_PERIOD_MAX_US) us = PEER_SOLVE_PERIOD_MAX_US;
-    p->cfg.solve_period_us = us;
+    p->cfg.solve_period_us = solve_period_clamp_us(us);
 }
 
 void peer_model_restored(peer_t *p, const int32_t lo[3], const int32_t hi[3])

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "host/solve/gsolve.h"
+#include "host/solve/solve_sched.h"
 #include "host/model/grid.h"
 #include "shared/proto.h"
 
@@ -41,8 +42,6 @@ typedef enum {
     PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/solve/gsolve.h) */
 } peer_global_solve_t;
 
-#define PEER_SOLVE_HIST_BINS 5001u    /* solve step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
-
 typedef struct {
     int32_t window_edge;              /* samples per axis of the board's window */
     peer_global_solve_t global_solve; /* PEER_SOLVE_SPRINGS by default here (argil connect,
@@ -53,15 +52,11 @@ typedef struct {
     uint32_t heartbeat_period_us;     /* 5 ms */
     uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
     uint32_t window_min_period_us;    /* refresh an edited window at most this often */
-    bool adaptive_region;             /* real-time hosts (argil connect): a solve step that takes
-                                       * over 80 % of its period (thread CPU time) shrinks the
-                                       * solve's margin around the board's window by a sample
-                                       * (PEER_MARGIN_MAX → 0); 50 steps under 40 % grow it back.
-                                       * Off for lockstep sessions, which must stay reproducible. */
+    bool adaptive_region;             /* real-time hosts (argil connect): slow solve steps shrink
+                                       * the solve's margin around the board's window
+                                       * (host/solve/solve_sched.h). Off for lockstep sessions,
+                                       * which must stay reproducible. */
 } peer_cfg_t;
-
-#define PEER_MARGIN_MAX 4             /* samples of margin around the board's window */
-#define PEER_MARGIN_GROW_STEPS 50u    /* fast steps in a row before the margin grows again */
 
 typedef struct {
     uint32_t frames_rx;
@@ -77,10 +72,6 @@ typedef struct {
     double impulse_total_ns;          /* Σ|J| applied */
     uint32_t solve_errors;            /* B-spline steps that failed (the field kept its state) */
     argil_err_t last_solve_error;
-    uint32_t solve_hist_10us[PEER_SOLVE_HIST_BINS]; /* thread CPU time of each solve step */
-    double solve_max_ms;
-    uint32_t region_shrinks;          /* adaptive_region: times the margin was lowered */
-    int32_t margin_min;               /* the smallest margin used (samples) */
     uint32_t refines;                 /* knot insertions (peer_refine) */
     float refine_max_dd;              /* the largest |density change| one of them made */
     uint32_t host_tool_edits;         /* host tool applications that changed the model */
@@ -114,7 +105,6 @@ typedef struct {
     bool field_dirty;
     uint32_t since_window_us;
     uint32_t since_heartbeat_us;
-    uint32_t since_solve_us;
     uint32_t impulse_seq_received;    /* newest IMPULSE batch taken in */
     uint32_t impulse_seq_applied;     /* newest batch integrated by a solve step */
     int32_t dirty_lo[3], dirty_hi[3]; /* samples changed since the last mesh (lo > hi: none) */
@@ -127,9 +117,7 @@ typedef struct {
     gsolve_t *gs;                     /* the B-spline model (PEER_SOLVE_BSPLINE), else NULL */
     spring_material_t gs_mat;         /* grid material the model last took */
     int32_t force_lo[3], force_hi[3]; /* samples holding external force (lo > hi: none) */
-    int32_t margin;                   /* samples of the solve's margin (PEER_MARGIN_MAX unless
-                                       * adaptive_region lowered it) */
-    uint32_t fast_steps;              /* solve steps in a row under 40 % of the period */
+    solve_sched_t sched;              /* when the solve steps, its margin, its step times */
     host_tool_t host_tool;            /* what the board's carve does on the host (B-spline) */
     vec3_t host_prev_m;               /* stylus at the last host tool application */
     bool host_prev_valid;             /* button 1 held since then */
@@ -173,9 +161,7 @@ typedef enum { PEER_MAT_STIFFNESS, PEER_MAT_MASS } peer_material_t;
  * model; 1.0 everywhere with the springs solve (its material is uniform). */
 float peer_material_at(const peer_t *p, peer_material_t ch, vec3_t x_m);
 
-/* Sets the global solve's period, clamped to PEER_SOLVE_PERIOD_MIN_US..PEER_SOLVE_PERIOD_MAX_US. */
-#define PEER_SOLVE_PERIOD_MIN_US 2000u
-#define PEER_SOLVE_PERIOD_MAX_US 50000u
+/* Sets the global solve's period, clamped to SOLVE_PERIOD_MIN_US..SOLVE_PERIOD_MAX_US. */
 void peer_set_solve_period_us(peer_t *p, uint32_t us);
 
 /* Paints the stiffness or mass scale toward `scale` within radius of centre (linear falloff);
@@ -202,11 +188,6 @@ int32_t peer_knot_ratio(const peer_t *p);
 
 /* Median, 99th percentile (10 µs resolution) and max of the solve steps' thread CPU times, ms. */
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max);
-
-/* adaptive_region's rule after a solve step of step_ms (thread CPU time): over 80 % of the
- * solve period lowers the margin by one sample (not below 0); PEER_MARGIN_GROW_STEPS steps in a
- * row under 40 % raise it by one (not above PEER_MARGIN_MAX). Called by the peer itself. */
-void peer_adapt_region(peer_t *p, double step_ms);
 
 /* The model was set back to an earlier state (undo or redo, host/app/session_undo.h) and the
  * grid follows in sample box [lo, hi): re-mesh it (dirty box; the journal records it with the

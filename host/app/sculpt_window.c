@@ -88,8 +88,8 @@ static const struct {
     {PARAM_YIELD_FORCE_N, "yield N", 0.0f, 10.0f, 1.25f, 0.05f},
     {PARAM_MAX_FORCE_N, "max force N", 0.1f, 10.0f, 1.1f, 0.1f},
     /* The host's global solve step: a peer setting, not a script parameter. */
-    {PANEL_SOLVE_STEP, "solve step ms", PEER_SOLVE_PERIOD_MIN_US * 1e-3f,
-     PEER_SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, PEER_SOLVE_PERIOD_MIN_US * 1e-3f},
+    {PANEL_SOLVE_STEP, "solve step ms", SOLVE_PERIOD_MIN_US * 1e-3f,
+     SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, SOLVE_PERIOD_MIN_US * 1e-3f},
     {PANEL_HOST_ACTION, "carve does", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_SHAPE, "host shape", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_MIRROR, "mirror", 0.0f, 0.0f, 1.0f, 0.0f},

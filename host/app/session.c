@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "firmware/core/board_hal.h"
-#include "host/app/histogram.h"
+#include "host/solve/histogram.h"
 #include "firmware/hal/hal_sim.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"

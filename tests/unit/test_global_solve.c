@@ -266,9 +266,9 @@ static void test_painted_material(void **st)
     assert_float_equal(peer_material_at(bs, PEER_MAT_STIFFNESS, vec3(hs, 10e-3f, hs)), 1.0f, 0.0f);
     assert_float_equal(peer_material_at(bs, PEER_MAT_MASS, vec3(hs, hs, hs)), 1.0f, 0.0f);
     peer_set_solve_period_us(bs, 1u);
-    assert_int_equal(bs->cfg.solve_period_us, PEER_SOLVE_PERIOD_MIN_US);
+    assert_int_equal(bs->cfg.solve_period_us, SOLVE_PERIOD_MIN_US);
     peer_set_solve_period_us(bs, 1000000u);
-    assert_int_equal(bs->cfg.solve_period_us, PEER_SOLVE_PERIOD_MAX_US);
+    assert_int_equal(bs->cfg.solve_period_us, SOLVE_PERIOD_MAX_US);
     peer_free(bs);
     peer_free(springs);
     free(bs);
