@@ -1,7 +1,7 @@
-/* The host's half of the board protocol: keeps the global field in step with the board —
- * applies the board's impulses, sends versioned windows around the tool, the tool settings
- * and heartbeats — and hands telemetry to whoever records it. Transport-neutral: bytes in,
- * frames out through a callback. */
+/* The host's half of the board protocol: keeps the sculpted representation (host/model/rep.h) in
+ * step with the board — applies the board's impulses, sends versioned windows around the tool,
+ * the tool settings and heartbeats — and hands telemetry to whoever records it.
+ * Transport-neutral: bytes in, frames out through a callback. */
 #ifndef ARGIL_PEER_H
 #define ARGIL_PEER_H
 
@@ -9,17 +9,16 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "host/solve/gsolve.h"
-#include "host/solve/solve_sched.h"
 #include "host/model/grid.h"
+#include "host/model/rep.h"
+#include "host/solve/gsolve.h"
+#include "host/solve/rep_bspline.h"
+#include "host/solve/solve_sched.h"
 #include "shared/proto.h"
 
 #define PEER_VERSIONS_KEPT 32u        /* window versions whose layout is remembered */
 #define PEER_CHUNKS_PER_TICK 2u       /* WINDOW chunks sent per millisecond at most (the board
                                        * decodes two per tick) */
-
-#define PEER_SETTLING_MAX 4u          /* regions the tool left that still settle */
-#define PEER_REST_ACCEL 1e-3f         /* |density acceleration| (1/s²) below which a region rests */
 
 typedef struct {
     int32_t lo[3], hi[3];             /* sample index box [lo, hi) */
@@ -79,7 +78,10 @@ typedef struct {
 
 typedef struct {
     peer_cfg_t cfg;
-    grid_t *grid;
+    rep_t rep;                        /* what is sculpted: every model access goes through it */
+    rep_bspline_t own;                /* the representation peer_init made over a grid */
+    bool owns_rep;
+    grid_t *grid;                     /* rep's sample grid (NULL: it keeps none) */
     peer_send_fn send;
     peer_telemetry_fn on_telemetry;
     void *ctx;
@@ -110,13 +112,10 @@ typedef struct {
     int32_t dirty_lo[3], dirty_hi[3]; /* samples changed since the last mesh (lo > hi: none) */
     peer_box_t box;                   /* the solve's physical window now */
     bool have_box;
-    peer_box_t settling[PEER_SETTLING_MAX];
-    uint32_t settling_count;
     peer_stats_t stats;
     proto_msg_t scratch;
-    gsolve_t *gs;                     /* the B-spline model (PEER_SOLVE_BSPLINE), else NULL */
-    spring_material_t gs_mat;         /* grid material the model last took */
-    int32_t force_lo[3], force_hi[3]; /* samples holding external force (lo > hi: none) */
+    gsolve_t *gs;                     /* peer_init's B-spline model (PEER_SOLVE_BSPLINE), else
+                                       * NULL; for the session's undo and live window */
     solve_sched_t sched;              /* when the solve steps, its margin, its step times */
     host_tool_t host_tool;            /* what the board's carve does on the host (B-spline) */
     vec3_t host_prev_m;               /* stylus at the last host tool application */
@@ -129,6 +128,10 @@ void peer_cfg_default(peer_cfg_t *cfg);
  * is seeded from the grid's densities and the grid becomes its view. */
 argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
                       peer_telemetry_fn on_telemetry, void *ctx);
+/* Sets up the peer over any representation (the caller's, kept; cfg's global_solve and
+ * knot_ratio are not used). ARGIL_ERR_ARG, ARGIL_ERR_NOMEM. */
+argil_err_t peer_init_rep(peer_t *p, const peer_cfg_t *cfg, rep_t rep, peer_send_fn send,
+                          peer_telemetry_fn on_telemetry, void *ctx);
 void peer_free(peer_t *p);
 
 /* Takes in bytes of whole frames from the board. */

@@ -261,7 +261,7 @@ static void host_panel(session_frame_t *f, int row, float value)
                                  : (t.strength / 1.25f < 0.1f ? 0.0f : t.strength / 1.25f);
         t.strength = v > HOST_STRENGTH_MAX ? HOST_STRENGTH_MAX : v;
     }
-    if (f->peer->gs == NULL && !host_tool_is_default(&t))
+    if (!f->peer->rep.ops->tool_supported(f->peer->rep.st, &t))
         return; /* springs: refused by peer_set_host_tool too */
     pl->host_tool = t;
     pl->params_changed = 1;

@@ -11,7 +11,7 @@
 #define SOLVE_PERIOD_MAX_US 50000u
 #define SOLVE_MARGIN_MAX 4            /* samples of margin around the board's window */
 #define SOLVE_MARGIN_GROW_STEPS 50u   /* fast steps in a row before the margin grows again */
-#define SOLVE_HIST_BINS 5001u         /* solve step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
+#define SOLVE_HIST_BINS 5001u         /* step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
 
 typedef struct {
     uint32_t since_us;                /* since the last solve step */
