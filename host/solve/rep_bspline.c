@@ -9,6 +9,7 @@
 
 static const rep_box_t box_none = {{1, 1, 1}, {0, 0, 0}};
 
+/* True when b holds a sample (the boxes the grid and the solve give: hi > lo on x). */
 static bool box_some(const rep_box_t *b)
 {
     return b->hi[0] > b->lo[0];
@@ -30,12 +31,14 @@ static void box_grow(rep_box_t *acc, const int32_t lo[3], const int32_t hi[3])
     }
 }
 
+/* c says nothing changed. */
 static void change_none(rep_change_t *c)
 {
     c->box = box_none;
     c->felt = false;
 }
 
+/* c is box [lo, hi), felt by the board when felt and not empty. */
 static void change_set(rep_change_t *c, const int32_t lo[3], const int32_t hi[3], bool felt)
 {
     memcpy(c->box.lo, lo, sizeof(c->box.lo));
@@ -73,6 +76,7 @@ argil_err_t rep_bspline_init(rep_bspline_t *b, grid_t *g, bool implicit, int32_t
     return ARGIL_OK;
 }
 
+/* Releases the B-spline model (the grid stays the caller's). */
 static void bs_free(void *st)
 {
     rep_bspline_t *b = st;
@@ -83,6 +87,7 @@ static void bs_free(void *st)
     }
 }
 
+/* The grid's lattice and material. */
 static void bs_lattice(const void *st, rep_lattice_t *out)
 {
     const grid_t *g = ((const rep_bspline_t *)st)->grid;
@@ -93,6 +98,7 @@ static void bs_lattice(const void *st, rep_lattice_t *out)
     out->material = g->material;
 }
 
+/* grid_window_corner on the grid. */
 static void bs_window_corner(const void *st, vec3_t centre_m, const int32_t dims[3],
                              int32_t corner[3])
 {
@@ -116,6 +122,7 @@ static bool bs_window_samples(const void *st, const int32_t corner[3], const int
     return true;
 }
 
+/* grid_add_force, remembering the box that holds force. */
 static argil_err_t bs_add_node_force(void *st, const int32_t node[3], float force_per_s)
 {
     rep_bspline_t *b = st;
@@ -187,6 +194,7 @@ static void step_springs(rep_bspline_t *b, const rep_box_t *region, float dt_s,
     }
 }
 
+/* The springs' step or the implicit step (forces outside its window dropped). */
 static argil_err_t bs_step(void *st, const rep_box_t *region, float dt_s, rep_change_t *changed)
 {
     rep_bspline_t *b = st;
@@ -209,12 +217,14 @@ static argil_err_t bs_step(void *st, const rep_box_t *region, float dt_s, rep_ch
     return e;
 }
 
+/* Any valid setting on the B-spline model; the default carve only on the springs. */
 static bool bs_tool_supported(const void *st, const host_tool_t *tool)
 {
     return host_tool_valid(tool) &&
            (((const rep_bspline_t *)st)->gs != NULL || host_tool_is_default(tool));
 }
 
+/* The springs carve a sphere at the stylus; the model applies the whole setting. */
 static argil_err_t bs_apply_tool(void *st, const host_tool_t *tool, float radius_m, vec3_t axis,
                                  const vec3_t *pts_m, size_t n_pts, float dt_s,
                                  rep_change_t *changed)
@@ -238,6 +248,7 @@ static argil_err_t bs_apply_tool(void *st, const host_tool_t *tool, float radius
     return e;
 }
 
+/* The model's channel for the seam's. */
 static gsolve_material_t gs_channel(rep_material_t ch)
 {
     return ch == REP_MAT_MASS ? GSOLVE_MAT_MASS : GSOLVE_MAT_STIFFNESS;
@@ -277,12 +288,14 @@ static argil_err_t bs_paint(void *st, rep_material_t ch, vec3_t centre_m, float 
     return ARGIL_OK;
 }
 
+/* The model's painted scale; 1 on the springs. */
 static float bs_material_at(const void *st, rep_material_t ch, vec3_t x_m)
 {
     const rep_bspline_t *b = st;
     return b->gs ? gsolve_material_at(b->gs, gs_channel(ch), x_m) : 1.0f;
 }
 
+/* Knot insertion on the model (gsolve_refine); ARGIL_ERR_STATE on the springs. */
 static argil_err_t bs_refine(void *st, float *max_change, rep_change_t *changed)
 {
     rep_bspline_t *b = st;
@@ -300,12 +313,14 @@ static argil_err_t bs_refine(void *st, float *max_change, rep_change_t *changed)
     return e;
 }
 
+/* R, samples per knot span; 0 on the springs. */
 static int32_t bs_samples_per_dof(const void *st)
 {
     const rep_bspline_t *b = st;
     return b->gs ? gsolve_ratio(b->gs) : 0;
 }
 
+/* gsolve_restored; ARGIL_ERR_STATE on the springs (they keep no history). */
 static argil_err_t bs_restored(void *st, const rep_box_t *box, rep_change_t *changed)
 {
     rep_bspline_t *b = st;
@@ -319,12 +334,14 @@ static argil_err_t bs_restored(void *st, const rep_box_t *box, rep_change_t *cha
     return e;
 }
 
+/* Marching cubes of the whole grid at its iso level. */
 static argil_err_t bs_surface(const void *st, mesh_t *out)
 {
     const grid_t *g = ((const rep_bspline_t *)st)->grid;
     return grid_mesh_extract(g, g->iso, out);
 }
 
+/* The grid itself: it is what files, the journal and undo record. */
 static grid_t *bs_samples(void *st)
 {
     return ((rep_bspline_t *)st)->grid;

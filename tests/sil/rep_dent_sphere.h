@@ -22,6 +22,7 @@ typedef struct {
     rep_box_t force_box;              /* nodes holding force (hi[0] <= lo[0]: none) */
 } dent_sphere_t;
 
+/* True when n is a lattice node; its array index then goes to i. */
 static inline bool ds_node(const dent_sphere_t *s, const int32_t n[3], size_t *i)
 {
     for (int a = 0; a < 3; a++)
@@ -31,6 +32,7 @@ static inline bool ds_node(const dent_sphere_t *s, const int32_t n[3], size_t *i
     return true;
 }
 
+/* Model-space position of node n. */
 static inline vec3_t ds_pos_m(const dent_sphere_t *s, const int32_t n[3])
 {
     return vec3(s->lat.origin_m.x + (float)n[0] * s->lat.spacing_m,
@@ -46,17 +48,20 @@ static inline float ds_sd_m(const dent_sphere_t *s, const int32_t n[3])
     return ds_node(s, n, &i) ? sd + s->offset_m[i] : sd;
 }
 
+/* The density profile of node n's signed distance; 0 beyond the lattice. */
 static inline float ds_density(const dent_sphere_t *s, const int32_t n[3])
 {
     size_t i;
     return ds_node(s, n, &i) ? grid_profile(ds_sd_m(s, n), s->lat.band_m) : 0.0f;
 }
 
+/* The sphere's lattice and material. */
 static void ds_lattice(const void *st, rep_lattice_t *out)
 {
     *out = ((const dent_sphere_t *)st)->lat;
 }
 
+/* The corner of the dims window centred nearest centre_m. */
 static void ds_window_corner(const void *st, vec3_t centre_m, const int32_t dims[3],
                              int32_t corner[3])
 {
@@ -69,6 +74,7 @@ static void ds_window_corner(const void *st, vec3_t centre_m, const int32_t dims
                                    : 0;
 }
 
+/* Every node's density; the material is uniform, so no stiffness channel. */
 static bool ds_window_samples(const void *st, const int32_t corner[3], const int32_t dims[3],
                               float *density, float *stiffness_n_per_m)
 {
@@ -83,6 +89,7 @@ static bool ds_window_samples(const void *st, const int32_t corner[3], const int
     return false;
 }
 
+/* b grows to hold node n (b with hi[0] <= lo[0] counts as none). */
 static void ds_grow(rep_box_t *b, const int32_t n[3])
 {
     const bool none = b->hi[0] <= b->lo[0];
@@ -92,6 +99,7 @@ static void ds_grow(rep_box_t *b, const int32_t n[3])
     }
 }
 
+/* Adds the force to the node, for the next step. */
 static argil_err_t ds_add_node_force(void *st, const int32_t node[3], float force_per_s)
 {
     dent_sphere_t *s = st;
@@ -136,6 +144,7 @@ static argil_err_t ds_step(void *st, const rep_box_t *region, float dt_s, rep_ch
     return ARGIL_OK;
 }
 
+/* Only the default carve. */
 static bool ds_tool_supported(const void *st, const host_tool_t *tool)
 {
     (void)st;
@@ -172,6 +181,7 @@ static argil_err_t ds_apply_tool(void *st, const host_tool_t *tool, float radius
     return ARGIL_OK;
 }
 
+/* Its material is uniform. */
 static argil_err_t ds_paint(void *st, rep_material_t ch, vec3_t centre_m, float radius_m,
                             float scale, rep_change_t *changed)
 {
@@ -180,12 +190,14 @@ static argil_err_t ds_paint(void *st, rep_material_t ch, vec3_t centre_m, float 
     return ARGIL_ERR_STATE;
 }
 
+/* Uniform: 1 everywhere. */
 static float ds_material_at(const void *st, rep_material_t ch, vec3_t x_m)
 {
     (void)st, (void)ch, (void)x_m;
     return 1.0f;
 }
 
+/* Its nodes are its state: nothing finer to make. */
 static argil_err_t ds_refine(void *st, float *max_change, rep_change_t *changed)
 {
     (void)st;
@@ -195,12 +207,14 @@ static argil_err_t ds_refine(void *st, float *max_change, rep_change_t *changed)
     return ARGIL_ERR_STATE;
 }
 
+/* Its nodes are its state. */
 static int32_t ds_samples_per_dof(const void *st)
 {
     (void)st;
     return 0;
 }
 
+/* It keeps no history. */
 static argil_err_t ds_restored(void *st, const rep_box_t *box, rep_change_t *changed)
 {
     (void)st, (void)box;
@@ -224,12 +238,14 @@ static argil_err_t ds_surface(const void *st, mesh_t *out)
     return e;
 }
 
+/* No sample grid: it is not saved. */
 static grid_t *ds_samples(void *st)
 {
     (void)st;
     return NULL;
 }
 
+/* Frees the offset and force arrays. */
 static void ds_free(void *st)
 {
     dent_sphere_t *s = st;

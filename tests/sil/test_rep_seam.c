@@ -61,11 +61,9 @@ static void test_peer_drives_a_second_representation(void **st)
     rig_move(r, vec3(0, 0, z_before + r_tool + 0.002f), 200);
 
     /* Push: the board yields the clay and sends impulses; the host's step dents the sphere. */
-    msg_tool_t t = rig_tool(r, TOOL_PUSH, 1.0f);
-    t.yield_force_n = 0.3f;
-    rig_set_tool(r, &t);
-    for (int i = 0; i < 50; i++)
-        rig_tick(r);
+    const msg_tool_t push = rig_tool(r, TOOL_PUSH, 1.0f);
+    rig_set_tool(r, &push);
+    rig_move(r, r->hand_model_m, 50);
     r->btn1 = true;
     rig_move(r, vec3(0, 0, z_before + r_tool - 0.005f), 140);
     for (int i = 0; i < 600; i++)
