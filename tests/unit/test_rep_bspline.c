@@ -18,12 +18,26 @@
 #define H 1e-3f
 #define EDGE 8
 
+/* A 10 mm clay sphere on N³ samples behind the seam: implicit (the B-spline model, R = 1) or
+ * the grid's springs; model_free frees both. */
+static grid_t *model_new(rep_bspline_t *b, bool implicit)
+{
+    grid_t *g = sphere_grid_new(N, H, 0.010f);
+    assert_int_equal(rep_bspline_init(b, g, implicit, 1), ARGIL_OK);
+    return g;
+}
+
+static void model_free(rep_bspline_t *b, grid_t *g)
+{
+    rep_bspline(b).ops->free(b);
+    sphere_grid_free(g);
+}
+
 static void test_window_is_the_grid_and_carries_painted_stiffness(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid_new(N, H, 0.010f);
     rep_bspline_t b;
-    assert_int_equal(rep_bspline_init(&b, g, true, 1), ARGIL_OK);
+    grid_t *g = model_new(&b, true);
     const rep_t rep = rep_bspline(&b);
     const int32_t dims[3] = {EDGE, EDGE, EDGE};
     int32_t corner[3], want[3];
@@ -53,8 +67,7 @@ static void test_window_is_the_grid_and_carries_painted_stiffness(void **st)
                 k_max = k[i] > k_max ? k[i] : k_max;
             }
     assert_true(k_max > 3.0f * g->material.stiffness);
-    rep.ops->free(rep.st);
-    sphere_grid_free(g);
+    model_free(&b, g);
 }
 
 /* A push on one surface node: the springs move that node's density within the step's region,
@@ -62,9 +75,8 @@ static void test_window_is_the_grid_and_carries_painted_stiffness(void **st)
 static void test_impulse_moves_the_node_it_was_put_on(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid_new(N, H, 0.010f);
     rep_bspline_t b;
-    assert_int_equal(rep_bspline_init(&b, g, false, 1), ARGIL_OK);
+    grid_t *g = model_new(&b, false);
     const rep_t rep = rep_bspline(&b);
     const int32_t far[3] = {GRID_INDEX_MAX, 0, 0};
     assert_int_equal(rep.ops->add_node_force(rep.st, far, -50.0f), ARGIL_ERR_ARG);
@@ -90,8 +102,7 @@ static void test_impulse_moves_the_node_it_was_put_on(void **st)
     float dd = 1.0f;
     assert_int_equal(rep.ops->refine(rep.st, &dd, &c), ARGIL_ERR_STATE);
     assert_true(dd == 0.0f && c.box.hi[0] <= c.box.lo[0]);
-    rep.ops->free(rep.st);
-    sphere_grid_free(g);
+    model_free(&b, g);
 }
 
 /* The implicit step takes the forces in its region; one left outside it does not wait for a
@@ -99,9 +110,8 @@ static void test_impulse_moves_the_node_it_was_put_on(void **st)
 static void test_implicit_step_drops_forces_outside_its_region(void **st)
 {
     (void)st;
-    grid_t *g = sphere_grid_new(N, H, 0.010f);
     rep_bspline_t b;
-    assert_int_equal(rep_bspline_init(&b, g, true, 1), ARGIL_OK);
+    grid_t *g = model_new(&b, true);
     const rep_t rep = rep_bspline(&b);
     const int32_t outside[3] = {2, 2, 2};
     assert_int_equal(rep.ops->add_node_force(rep.st, outside, 30.0f), ARGIL_OK);
@@ -110,8 +120,7 @@ static void test_implicit_step_drops_forces_outside_its_region(void **st)
     rep_change_t c;
     assert_int_equal(rep.ops->step(rep.st, &region, 0.01f, &c), ARGIL_OK);
     assert_true(grid_get(g, GRID_FORCE, 2, 2, 2) == 0.0f);
-    rep.ops->free(rep.st);
-    sphere_grid_free(g);
+    model_free(&b, g);
 }
 
 int main(void)
