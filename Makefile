@@ -40,6 +40,7 @@ HAL_SIM_SRC := firmware/hal/hal_sim.c firmware/hal/link_bind.c
 SIM_SRC := $(wildcard sim/*.c)
 # The lockstep rig (sim/rig/rig.h): the simulated arm, the sim HAL and the board core together.
 RIG_SRC := $(wildcard sim/rig/*.c)
+# host/: model/ (representations) <- solve/ (the global solve) <- app/, with mesh/ io/ fit/ render/ link/.
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 # The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c

@@ -19,7 +19,7 @@
 #include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
 #include "host/app/session_files.h"
@@ -1086,7 +1086,7 @@ int cmd_connect(int argc, char **argv)
                    "percentile %.2f ms, max %.2f ms; region narrowed %u times (margin %d..%d "
                    "samples)\n",
                    cli_global_solve_text(o.global_solve), s->peer.stats.solves, med, p99, mx,
-                   s->peer.stats.region_shrinks, (int)s->peer.stats.margin_min, PEER_MARGIN_MAX);
+                   s->peer.sched.shrinks, (int)s->peer.sched.margin_min, SOLVE_MARGIN_MAX);
         }
         if (o.global_solve == PEER_SOLVE_BSPLINE)
             printf("  knots               %d sample%s per knot span\n", o.knot_ratio,

@@ -6,7 +6,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "host/app/histogram.h"
 #include "shared/safety_codes.h"
 
 void peer_cfg_default(peer_cfg_t *cfg)
@@ -20,23 +19,21 @@ void peer_cfg_default(peer_cfg_t *cfg)
     cfg->adaptive_region = false;
 }
 
-argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
-                      peer_telemetry_fn on_telemetry, void *ctx)
+argil_err_t peer_init_rep(peer_t *p, const peer_cfg_t *cfg, rep_t rep, peer_send_fn send,
+                          peer_telemetry_fn on_telemetry, void *ctx)
 {
-    if (cfg->window_edge < 4 || cfg->window_edge > ARGIL_WINDOW_MAX ||
-        (cfg->global_solve != PEER_SOLVE_SPRINGS && cfg->global_solve != PEER_SOLVE_BSPLINE) ||
-        (cfg->knot_ratio != 1 && cfg->knot_ratio != 2 && cfg->knot_ratio != 4))
+    if (cfg->window_edge < 4 || cfg->window_edge > ARGIL_WINDOW_MAX)
         return ARGIL_ERR_ARG;
     memset(p, 0, sizeof(*p));
     host_tool_default(&p->host_tool);
     p->cfg = *cfg;
-    p->grid = grid;
+    p->rep = rep;
+    p->grid = rep.ops->samples(rep.st);
     p->send = send;
     p->on_telemetry = on_telemetry;
     p->ctx = ctx;
     p->next_version = 1;
-    p->margin = PEER_MARGIN_MAX;
-    p->stats.margin_min = PEER_MARGIN_MAX;
+    solve_sched_init(&p->sched, cfg->adaptive_region);
     /* Densities, then room for the per-node stiffness of a painted window (channels 2). */
     p->win_samples = malloc((size_t)PROTO_WINDOW_CHANNELS_MAX * (size_t)cfg->window_edge *
                             (size_t)cfg->window_edge * (size_t)cfg->window_edge * sizeof(float));
@@ -45,32 +42,29 @@ argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_
     for (int a = 0; a < 3; a++) {
         p->dirty_lo[a] = 1;
         p->dirty_hi[a] = 0;
-        p->force_lo[a] = 1;
-        p->force_hi[a] = 0;
     }
-    if (cfg->global_solve == PEER_SOLVE_BSPLINE) {
-        p->gs = calloc(1, sizeof(*p->gs));
-        if (!p->gs) {
-            peer_free(p);
-            return ARGIL_ERR_NOMEM;
-        }
-        argil_err_t e = gsolve_init_ratio(p->gs, grid, cfg->knot_ratio);
-        /* A loaded model's painted material (.argil MTLS, journal recovery). */
-        if (e == ARGIL_OK) {
-            e = gsolve_material_from_grid(p->gs, grid);
-            if (e == ARGIL_OK) /* and its painted colour (grid rgb, from .argil COLR) */
-                e = gsolve_colour_from_grid(p->gs, grid);
-            if (e != ARGIL_OK)
-                gsolve_free(p->gs);
-        }
-        if (e != ARGIL_OK) {
-            free(p->gs);
-            p->gs = NULL;
-            peer_free(p);
-            return e;
-        }
-        p->gs_mat = grid->material;
+    return ARGIL_OK;
+}
+
+argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
+                      peer_telemetry_fn on_telemetry, void *ctx)
+{
+    if (cfg->global_solve != PEER_SOLVE_SPRINGS && cfg->global_solve != PEER_SOLVE_BSPLINE)
+        return ARGIL_ERR_ARG;
+    rep_bspline_t own;
+    argil_err_t e = rep_bspline_init(&own, grid, cfg->global_solve == PEER_SOLVE_BSPLINE,
+                                     cfg->knot_ratio);
+    if (e != ARGIL_OK)
+        return e;
+    e = peer_init_rep(p, cfg, rep_bspline(&own), send, on_telemetry, ctx);
+    if (e != ARGIL_OK) {
+        rep_bspline(&own).ops->free(&own);
+        return e;
     }
+    p->own = own;
+    p->rep = rep_bspline(&p->own);
+    p->owns_rep = true;
+    p->gs = own.gs;
     return ARGIL_OK;
 }
 
@@ -78,11 +72,10 @@ void peer_free(peer_t *p)
 {
     free(p->win_samples);
     p->win_samples = NULL;
-    if (p->gs) {
-        gsolve_free(p->gs);
-        free(p->gs);
-        p->gs = NULL;
-    }
+    if (p->owns_rep)
+        p->rep.ops->free(p->rep.st);
+    p->owns_rep = false;
+    p->gs = NULL;
 }
 
 static bool send_msg(peer_t *p, const proto_msg_t *m)
@@ -173,17 +166,10 @@ static void apply_impulses(peer_t *p, const msg_impulse_t *im)
         const int32_t y = r->corner[1] + (int32_t)((e->node / nx) % ny);
         const int32_t z = r->corner[2] + (int32_t)(e->node / (nx * ny));
         /* The impulse acts over the next solve step as a force J/dt. */
-        if (grid_add_force(p->grid, x, y, z, e->impulse_ns * inv_dt)) {
+        const int32_t at[3] = {x, y, z};
+        if (p->rep.ops->add_node_force(p->rep.st, at, e->impulse_ns * inv_dt) == ARGIL_OK) {
             p->stats.impulse_total_ns += fabs((double)e->impulse_ns);
             p->field_dirty = true;
-            const int32_t at[3] = {x, y, z};
-            const bool none = p->force_lo[0] > p->force_hi[0];
-            for (int a = 0; a < 3; a++) {
-                if (none || at[a] < p->force_lo[a])
-                    p->force_lo[a] = at[a];
-                if (none || at[a] + 1 > p->force_hi[a])
-                    p->force_hi[a] = at[a] + 1;
-            }
         } else {
             p->stats.impulses_unmapped++;
         }
@@ -262,39 +248,35 @@ static vec3_t tool_pos(const peer_t *p)
 /* Starts sending a new window version centred on the tool. */
 static void start_window(peer_t *p)
 {
-    const grid_t *g = p->grid;
+    rep_lattice_t lat;
+    p->rep.ops->lattice(p->rep.st, &lat);
     const int32_t e = p->cfg.window_edge;
     const int32_t dims[3] = {e, e, e};
     peer_window_ref_t r;
     r.version = p->next_version++;
-    grid_window_corner(g, p->have_tm ? tool_pos(p) : vec3(0, 0, 0), dims, r.corner);
+    p->rep.ops->window_corner(p->rep.st, p->have_tm ? tool_pos(p) : vec3(0, 0, 0), dims,
+                              r.corner);
     for (int a = 0; a < 3; a++)
         r.dims[a] = e;
-    grid_extract(g, r.corner, dims, p->win_samples);
+    /* Painted stiffness is felt: a painted window carries each node's spring stiffness as a
+     * second channel; an unpainted window stays one channel, as cheap as before. */
+    float *node_k = p->win_samples + (size_t)e * (size_t)e * (size_t)e;
+    const bool painted =
+        p->rep.ops->window_samples(p->rep.st, r.corner, dims, p->win_samples, node_k);
     memset(&p->head, 0, sizeof(p->head));
     p->head.version = r.version;
     for (int a = 0; a < 3; a++)
         p->head.dims[a] = (uint8_t)e;
-    p->head.origin_m[0] = g->origin_m.x + (float)r.corner[0] * g->spacing_m;
-    p->head.origin_m[1] = g->origin_m.y + (float)r.corner[1] * g->spacing_m;
-    p->head.origin_m[2] = g->origin_m.z + (float)r.corner[2] * g->spacing_m;
-    p->head.spacing_m = g->spacing_m;
-    p->head.iso = g->iso;
-    p->head.node_mass = g->material.node_mass;
-    p->head.stiffness = g->material.stiffness;
-    p->head.damping = g->material.damping;
-    p->head.plastic_rate_hz = g->material.plastic_rate_hz;
+    p->head.origin_m[0] = lat.origin_m.x + (float)r.corner[0] * lat.spacing_m;
+    p->head.origin_m[1] = lat.origin_m.y + (float)r.corner[1] * lat.spacing_m;
+    p->head.origin_m[2] = lat.origin_m.z + (float)r.corner[2] * lat.spacing_m;
+    p->head.spacing_m = lat.spacing_m;
+    p->head.iso = lat.iso;
+    p->head.node_mass = lat.material.node_mass;
+    p->head.stiffness = lat.material.stiffness;
+    p->head.damping = lat.material.damping;
+    p->head.plastic_rate_hz = lat.material.plastic_rate_hz;
     p->head.impulse_seq = p->impulse_seq_applied;
-    /* Painted stiffness is felt: when any node of the window has a painted scale, the window
-     * carries each node's spring stiffness (base × scale) as a second channel; an unpainted
-     * window stays one channel, as cheap as before. Painted mass acts in the global solve only
-     * (the wire has one node_mass per window: docs/model.md "In the session"). */
-    float *node_k = p->win_samples + (size_t)e * (size_t)e * (size_t)e;
-    const bool painted =
-        p->gs && gsolve_material_box(p->gs, GSOLVE_MAT_STIFFNESS, r.corner, dims, node_k);
-    if (painted)
-        for (int32_t i = 0; i < e * e * e; i++)
-            node_k[i] *= g->material.stiffness;
     p->head.channels = painted ? 2 : 1;
     p->head.chunk_count = window_chunk_count(p->head.dims, p->head.channels);
     p->sending = r;
@@ -310,97 +292,19 @@ static bool tool_near_edge(const peer_t *p)
 {
     if (!p->have_current || !p->have_tm)
         return !p->have_current;
-    const grid_t *g = p->grid;
+    rep_lattice_t lat;
+    p->rep.ops->lattice(p->rep.st, &lat);
     const vec3_t t = tool_pos(p);
     const float pos[3] = {t.x, t.y, t.z};
-    const float org[3] = {g->origin_m.x, g->origin_m.y, g->origin_m.z};
-    const float margin = p->tool.radius_m + 2.0f * g->spacing_m;
+    const float org[3] = {lat.origin_m.x, lat.origin_m.y, lat.origin_m.z};
+    const float margin = p->tool.radius_m + 2.0f * lat.spacing_m;
     for (int a = 0; a < 3; a++) {
-        const float lo = org[a] + (float)p->current.corner[a] * g->spacing_m;
-        const float hi = lo + (float)(p->current.dims[a] - 1) * g->spacing_m;
+        const float lo = org[a] + (float)p->current.corner[a] * lat.spacing_m;
+        const float hi = lo + (float)(p->current.dims[a] - 1) * lat.spacing_m;
         if (pos[a] - lo < margin || hi - pos[a] < margin)
             return true;
     }
     return false;
-}
-
-/* Keeps box simulated until it comes to rest; with no room, merges the two oldest boxes. */
-static void remember_settling(peer_t *p, const peer_box_t *box)
-{
-    if (p->settling_count == PEER_SETTLING_MAX) {
-        peer_box_t *a = &p->settling[0];
-        const peer_box_t *b = &p->settling[1];
-        for (int k = 0; k < 3; k++) {
-            if (b->lo[k] < a->lo[k]) a->lo[k] = b->lo[k];
-            if (b->hi[k] > a->hi[k]) a->hi[k] = b->hi[k];
-        }
-        p->settling[1] = p->settling[--p->settling_count];
-    }
-    p->settling[p->settling_count++] = *box;
-}
-
-static void solve_springs(peer_t *p)
-{
-    grid_t *g = p->grid;
-    const bool active = p->have_tm && p->last_tm.state == SAFETY_ACTIVE;
-    if (active && p->last_tm.tool_kind == TOOL_CARVE && (p->last_tm.buttons & 1u)) {
-        int32_t lo[3], hi[3];
-        grid_carve_sphere(g, tool_pos(p), p->tool.radius_m, lo, hi);
-        if (hi[0] > lo[0]) {
-            mark_dirty(p, lo, hi);
-            p->field_dirty = true;
-        }
-    }
-    /* The physical window of the global solve: the board's window and a margin around it;
-     * plus the regions the tool left that are still moving (elastic clay springing back). */
-    if (!p->have_current)
-        return;
-    peer_box_t box;
-    for (int a = 0; a < 3; a++) {
-        box.lo[a] = p->current.corner[a] - p->margin;
-        box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
-    }
-    if (p->have_box && memcmp(&box, &p->box, sizeof(box)) != 0)
-        remember_settling(p, &p->box);
-    p->box = box;
-    p->have_box = true;
-    /* Impulses received so far act in this step: from now on windows include them. */
-    p->impulse_seq_applied = p->impulse_seq_received;
-    const float dt_s = (float)p->cfg.solve_period_us * 1e-6f;
-    const float acc = grid_springs_step(g, box.lo, box.hi, dt_s);
-    if (acc > 0.0f) {
-        mark_dirty(p, box.lo, box.hi);
-        p->field_dirty = true;
-    }
-    for (uint32_t k = 0; k < p->settling_count;) {
-        const peer_box_t *s = &p->settling[k];
-        const float a = grid_springs_step(g, s->lo, s->hi, dt_s);
-        if (a > 0.0f)
-            mark_dirty(p, s->lo, s->hi);
-        if (a < PEER_REST_ACCEL) {
-            /* At rest: stop simulating it. */
-            p->settling[k] = p->settling[--p->settling_count];
-        } else {
-            k++;
-        }
-    }
-}
-
-/* Drops the external forces the step did not take (outside its window). */
-static void clear_forces(peer_t *p)
-{
-    grid_t *g = p->grid;
-    if (p->force_lo[0] > p->force_hi[0])
-        return;
-    for (int32_t z = p->force_lo[2]; z < p->force_hi[2]; z++)
-        for (int32_t y = p->force_lo[1]; y < p->force_hi[1]; y++)
-            for (int32_t x = p->force_lo[0]; x < p->force_hi[0]; x++)
-                if (grid_get(g, GRID_FORCE, x, y, z) != 0.0f)
-                    (void)grid_set(g, GRID_FORCE, x, y, z, 0.0f);
-    for (int a = 0; a < 3; a++) {
-        p->force_lo[a] = 1;
-        p->force_hi[a] = 0;
-    }
 }
 
 static void solve_error(peer_t *p, argil_err_t e)
@@ -409,16 +313,27 @@ static void solve_error(peer_t *p, argil_err_t e)
     p->stats.last_solve_error = e;
 }
 
+/* Re-meshes (and journals) what a model call changed; a change the board feels makes its
+ * window stale. */
+static void take_change(peer_t *p, const rep_change_t *c)
+{
+    if (c->box.hi[0] > c->box.lo[0])
+        mark_dirty(p, c->box.lo, c->box.hi);
+    p->field_dirty = p->field_dirty || c->felt;
+}
+
 /* The host tool at the stylus (peer_set_host_tool), once this solve period. A stylus that
  * moved more than band / 2 (2.5 mm) since the last application (faster than 0.25 m/s at
  * 10 ms) gets the poses in between too, so a fast stroke leaves no gaps; a slower one is one
  * pose, exactly the eraser the session always applied. */
-static argil_err_t apply_host_tool(peer_t *p, int32_t lo[3], int32_t hi[3])
+static argil_err_t apply_host_tool(peer_t *p, rep_change_t *changed)
 {
+    rep_lattice_t lat;
+    p->rep.ops->lattice(p->rep.st, &lat);
     const vec3_t at = tool_pos(p);
     vec3_t pts[2] = {at, at};
     size_t n = 1;
-    const float step_m = 0.5f * p->grid->band_m;
+    const float step_m = 0.5f * lat.band_m;
     if (p->host_prev_valid) {
         const vec3_t d = vec3_sub(at, p->host_prev_m);
         const float len = vec3_norm(d);
@@ -432,90 +347,56 @@ static argil_err_t apply_host_tool(peer_t *p, int32_t lo[3], int32_t hi[3])
     p->host_prev_m = at;
     p->host_prev_valid = true;
     const vec3_t axis = vec3(p->tool.axis[0], p->tool.axis[1], p->tool.axis[2]);
-    return gsolve_apply_tool(p->gs, p->grid, &p->host_tool, p->tool.radius_m,
-                             vec3_norm(axis) > 1e-6f ? axis : vec3(0, 0, 1), pts, n,
-                             (float)p->cfg.solve_period_us * 1e-6f, lo, hi);
+    return p->rep.ops->apply_tool(p->rep.st, &p->host_tool, p->tool.radius_m,
+                                  vec3_norm(axis) > 1e-6f ? axis : vec3(0, 0, 1), pts, n,
+                                  (float)p->cfg.solve_period_us * 1e-6f, changed);
 }
 
 argil_err_t peer_set_host_tool(peer_t *p, const host_tool_t *t)
 {
     if (!host_tool_valid(t))
         return ARGIL_ERR_ARG;
-    if (!p->gs && !host_tool_is_default(t))
+    if (!p->rep.ops->tool_supported(p->rep.st, t))
         return ARGIL_ERR_STATE;
     p->host_tool = *t;
     return ARGIL_OK;
 }
 
-/* The global solve on the B-spline model: carving through host/model/tools.c, then one
- * implicit step in the physical window (the board's window and a margin). */
-static void solve_bspline(peer_t *p)
+/* The global solve period: the host tool while carve's button 1 is held, then one step of the
+ * model in the physical window (the board's window and the schedule's margin). */
+static void solve_model(peer_t *p)
 {
-    grid_t *g = p->grid;
-    if (memcmp(&p->gs_mat, &g->material, sizeof(p->gs_mat)) != 0) {
-        gsolve_set_material(p->gs, &g->material);
-        p->gs_mat = g->material;
-    }
+    rep_change_t c;
     const bool active = p->have_tm && p->last_tm.state == SAFETY_ACTIVE;
     if (active && p->last_tm.tool_kind == TOOL_CARVE && (p->last_tm.buttons & 1u)) {
-        int32_t lo[3], hi[3];
-        const argil_err_t e = apply_host_tool(p, lo, hi);
+        const argil_err_t e = apply_host_tool(p, &c);
         if (e != ARGIL_OK) {
             solve_error(p, e);
-        } else if (hi[0] > lo[0]) {
-            /* Re-meshed (and journaled) either way; a paint leaves the board's densities be. */
+        } else if (c.box.hi[0] > c.box.lo[0]) {
             p->stats.host_tool_edits++;
-            mark_dirty(p, lo, hi);
-            p->field_dirty = p->field_dirty || !host_action_paints(p->host_tool.action);
+            take_change(p, &c);
         }
     } else {
         p->host_prev_valid = false;
     }
+    rep_box_t box;
     if (p->have_current) {
-        peer_box_t box;
         for (int a = 0; a < 3; a++) {
-            box.lo[a] = p->current.corner[a] - p->margin;
-            box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->margin;
+            box.lo[a] = p->current.corner[a] - p->sched.margin;
+            box.hi[a] = p->current.corner[a] + p->current.dims[a] + p->sched.margin;
         }
-        p->box = box;
+        memcpy(p->box.lo, box.lo, sizeof(box.lo));
+        memcpy(p->box.hi, box.hi, sizeof(box.hi));
         p->have_box = true;
+        /* Impulses received so far act in this step: from now on windows include them. */
         p->impulse_seq_applied = p->impulse_seq_received;
-        int32_t lo[3], hi[3];
-        float change = 0.0f;
-        const argil_err_t e = gsolve_step(p->gs, g, box.lo, box.hi,
-                                          (float)p->cfg.solve_period_us * 1e-6f, lo, hi, &change);
-        if (e != ARGIL_OK) {
-            solve_error(p, e);
-        } else if (hi[0] > lo[0]) {
-            mark_dirty(p, lo, hi);
-            p->field_dirty = true;
-        }
     }
-    clear_forces(p);
-}
-
-/* A solver that falls behind lowers its region, never the board's rate: the margin around the
- * board's window shrinks while steps overrun their budget and grows back after a run of fast
- * steps (the board's own window is always solved). */
-void peer_adapt_region(peer_t *p, double step_ms)
-{
-    const double period_ms = (double)p->cfg.solve_period_us * 1e-3;
-    if (step_ms > 0.8 * period_ms) {
-        p->fast_steps = 0;
-        if (p->margin > 0) {
-            p->margin--;
-            p->stats.region_shrinks++;
-            if (p->margin < p->stats.margin_min)
-                p->stats.margin_min = p->margin;
-        }
-    } else if (step_ms < 0.4 * period_ms) {
-        if (++p->fast_steps >= PEER_MARGIN_GROW_STEPS && p->margin < PEER_MARGIN_MAX) {
-            p->margin++;
-            p->fast_steps = 0;
-        }
-    } else {
-        p->fast_steps = 0;
-    }
+    const argil_err_t e = p->rep.ops->step(p->rep.st, p->have_current ? &box : NULL,
+                                           (float)p->cfg.solve_period_us * 1e-6f, &c);
+    if (e != ARGIL_OK)
+        solve_error(p, e);
+    else
+        take_change(p, &c);
 }
 
 static void solve(peer_t *p)
@@ -523,24 +404,15 @@ static void solve(peer_t *p)
     struct timespec t0, t1;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
     p->stats.solves++;
-    if (p->gs)
-        solve_bspline(p);
-    else
-        solve_springs(p);
+    solve_model(p);
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
     const double ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
-    const double bin = ms * 100.0;
-    p->stats.solve_hist_10us[bin < (double)(PEER_SOLVE_HIST_BINS - 1u) ? (uint32_t)bin
-                                                                      : PEER_SOLVE_HIST_BINS - 1u]++;
-    if (ms > p->stats.solve_max_ms)
-        p->stats.solve_max_ms = ms;
-    if (p->cfg.adaptive_region)
-        peer_adapt_region(p, ms);
+    solve_sched_record(&p->sched, p->cfg.solve_period_us, ms);
 }
 
 bool peer_solve_due(const peer_t *p, uint32_t dt_us)
 {
-    return p->board_seen && p->since_solve_us + dt_us >= p->cfg.solve_period_us;
+    return p->board_seen && solve_sched_due(&p->sched, p->cfg.solve_period_us, dt_us);
 }
 
 void peer_tick(peer_t *p, uint32_t dt_us)
@@ -548,7 +420,7 @@ void peer_tick(peer_t *p, uint32_t dt_us)
     p->time_us += dt_us;
     p->since_window_us += dt_us;
     p->since_heartbeat_us += dt_us;
-    p->since_solve_us += dt_us;
+    solve_sched_advance(&p->sched, dt_us);
     proto_msg_t *m = &p->scratch;
 
     if (!p->board_seen)
@@ -559,10 +431,8 @@ void peer_tick(peer_t *p, uint32_t dt_us)
         if (send_msg(p, m))
             p->tool_dirty = false;
     }
-    if (p->since_solve_us >= p->cfg.solve_period_us) {
-        p->since_solve_us = 0;
+    if (solve_sched_take(&p->sched, p->cfg.solve_period_us))
         solve(p);
-    }
     /* A new window when the tool nears the edge, or when the field under it changed. */
     if (!p->sending_active &&
         (tool_near_edge(p) ||
@@ -601,97 +471,67 @@ void peer_tick(peer_t *p, uint32_t dt_us)
     }
 }
 
+static rep_material_t rep_channel(peer_material_t ch)
+{
+    return ch == PEER_MAT_MASS ? REP_MAT_MASS : REP_MAT_STIFFNESS;
+}
+
 float peer_material_at(const peer_t *p, peer_material_t ch, vec3_t x_m)
 {
-    if (!p->gs)
-        return 1.0f; /* the springs solve's material is uniform */
-    return gsolve_material_at(p->gs, ch == PEER_MAT_MASS ? GSOLVE_MAT_MASS : GSOLVE_MAT_STIFFNESS,
-                              x_m);
+    return p->rep.ops->material_at(p->rep.st, rep_channel(ch), x_m);
 }
 
 argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, float radius_m,
                                 float scale)
 {
-    if (!p->gs)
-        return ARGIL_ERR_STATE;
-    const argil_err_t e = gsolve_paint(p->gs, ch == PEER_MAT_MASS ? GSOLVE_MAT_MASS
-                                                                   : GSOLVE_MAT_STIFFNESS,
-                                       centre_m, radius_m, scale);
-    if (e == ARGIL_OK) {
-        /* The densities did not change, but the surface there must be re-meshed to show the
-         * new material (colour maps): the painted ball's sample box becomes dirty. */
-        const grid_t *g = p->grid;
-        int32_t lo[3], hi[3], b0[3], b1[3];
-        grid_bounds(g, b0, b1);
-        const float c[3] = {centre_m.x - g->origin_m.x, centre_m.y - g->origin_m.y,
-                            centre_m.z - g->origin_m.z};
-        for (int a = 0; a < 3; a++) {
-            const float l = floorf((c[a] - radius_m) / g->spacing_m);
-            const float h = ceilf((c[a] + radius_m) / g->spacing_m) + 1.0f;
-            const float fl = (float)b0[a], fh = (float)b1[a];
-            lo[a] = l < fl ? b0[a] : l > fh ? b1[a] : (int32_t)l;
-            hi[a] = h < fl ? b0[a] : h > fh ? b1[a] : (int32_t)h;
-        }
-        if (lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2]) {
-            /* The grid's painted channels follow (what .argil files and the journal keep). */
-            const argil_err_t me = gsolve_material_to_grid(p->gs, p->grid, lo, hi);
-            if (me != ARGIL_OK)
-                return me;
-            mark_dirty(p, lo, hi);
-            /* A paint that reaches the board's window changes what the hand feels there: the
-             * window is sent again (with its per-node stiffness) like an edited one. */
-            const peer_window_ref_t *w = p->sending_active ? &p->sending : &p->current;
-            bool overlaps = p->sending_active || p->have_current;
-            for (int a = 0; a < 3; a++)
-                overlaps = overlaps && lo[a] < w->corner[a] + w->dims[a] && hi[a] > w->corner[a];
-            if (overlaps)
-                p->field_dirty = true;
-        }
-    }
+    rep_change_t c;
+    const argil_err_t e =
+        p->rep.ops->paint(p->rep.st, rep_channel(ch), centre_m, radius_m, scale, &c);
+    if (e != ARGIL_OK || c.box.hi[0] <= c.box.lo[0])
+        return e;
+    mark_dirty(p, c.box.lo, c.box.hi);
+    /* A paint that reaches the board's window changes what the hand feels there: the window is
+     * sent again (with its per-node stiffness) like an edited one. */
+    const peer_window_ref_t *w = p->sending_active ? &p->sending : &p->current;
+    bool overlaps = c.felt && (p->sending_active || p->have_current);
+    for (int a = 0; a < 3; a++)
+        overlaps = overlaps && c.box.lo[a] < w->corner[a] + w->dims[a] &&
+                   c.box.hi[a] > w->corner[a];
+    if (overlaps)
+        p->field_dirty = true;
     return e;
 }
 
 argil_err_t peer_refine(peer_t *p, float *max_dd)
 {
-    if (max_dd)
-        *max_dd = 0.0f;
-    if (!p->gs)
-        return ARGIL_ERR_STATE;
-    int32_t lo[3], hi[3];
+    rep_change_t c;
     float dd = 0.0f;
-    const argil_err_t e = gsolve_refine(p->gs, p->grid, &dd, lo, hi);
+    const argil_err_t e = p->rep.ops->refine(p->rep.st, &dd, &c);
     if (max_dd)
         *max_dd = dd;
-    if (e == ARGIL_OK) {
-        p->stats.refines++;
-        if (dd > p->stats.refine_max_dd)
-            p->stats.refine_max_dd = dd;
-    }
-    if (e == ARGIL_OK && hi[0] > lo[0]) {
-        /* Only where rounding moved a density past the view's threshold (none measured). */
-        mark_dirty(p, lo, hi);
-        p->field_dirty = true;
-    }
+    if (e != ARGIL_OK)
+        return e;
+    p->stats.refines++;
+    if (dd > p->stats.refine_max_dd)
+        p->stats.refine_max_dd = dd;
+    /* Only where rounding moved a density past the view's threshold (none measured). */
+    take_change(p, &c);
     return e;
 }
 
 int32_t peer_knot_ratio(const peer_t *p)
 {
-    return p->gs ? gsolve_ratio(p->gs) : 0;
+    return p->rep.ops->samples_per_dof(p->rep.st);
 }
 
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max)
 {
-    *median = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.5) * 0.01;
-    *p99 = hist_quantile_bin(p->stats.solve_hist_10us, PEER_SOLVE_HIST_BINS, 0.99) * 0.01;
-    *max = p->stats.solve_max_ms;
+    solve_sched_times_ms(&p->sched, median, p99, max);
 }
 
 void peer_set_solve_period_us(peer_t *p, uint32_t us)
 {
-    if (us < PEER_SOLVE_PERIOD_MIN_US) us = PEER_SOLVE_PERIOD_MIN_US;
-    if (us > PEER_SOLVE_PERIOD_MAX_US) us = PEER_SOLVE_PERIOD_MAX_US;
-    p->cfg.solve_period_us = us;
+    p->cfg.solve_period_us = solve_period_clamp_us(us);
 }
 
 void peer_model_restored(peer_t *p, const int32_t lo[3], const int32_t hi[3])

@@ -1,7 +1,7 @@
-/* The host's half of the board protocol: keeps the global field in step with the board —
- * applies the board's impulses, sends versioned windows around the tool, the tool settings
- * and heartbeats — and hands telemetry to whoever records it. Transport-neutral: bytes in,
- * frames out through a callback. */
+/* The host's half of the board protocol: keeps the sculpted representation (host/model/rep.h) in
+ * step with the board — applies the board's impulses, sends versioned windows around the tool,
+ * the tool settings and heartbeats — and hands telemetry to whoever records it.
+ * Transport-neutral: bytes in, frames out through a callback. */
 #ifndef ARGIL_PEER_H
 #define ARGIL_PEER_H
 
@@ -9,16 +9,16 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "host/app/global_solve.h"
 #include "host/model/grid.h"
+#include "host/model/rep.h"
+#include "host/solve/gsolve.h"
+#include "host/solve/rep_bspline.h"
+#include "host/solve/solve_sched.h"
 #include "shared/proto.h"
 
 #define PEER_VERSIONS_KEPT 32u        /* window versions whose layout is remembered */
 #define PEER_CHUNKS_PER_TICK 2u       /* WINDOW chunks sent per millisecond at most (the board
                                        * decodes two per tick) */
-
-#define PEER_SETTLING_MAX 4u          /* regions the tool left that still settle */
-#define PEER_REST_ACCEL 1e-3f         /* |density acceleration| (1/s²) below which a region rests */
 
 typedef struct {
     int32_t lo[3], hi[3];             /* sample index box [lo, hi) */
@@ -38,10 +38,8 @@ typedef void (*peer_telemetry_fn)(void *ctx, const msg_telemetry_t *t);
 /* What the global solve steps (docs/model.md "In the session"). */
 typedef enum {
     PEER_SOLVE_SPRINGS = 0,           /* explicit density springs on the dense grid */
-    PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/app/global_solve.h) */
+    PEER_SOLVE_BSPLINE                /* implicit B-spline model (host/solve/gsolve.h) */
 } peer_global_solve_t;
-
-#define PEER_SOLVE_HIST_BINS 5001u    /* solve step thread CPU time, 10 µs bins (last: ≥ 50 ms) */
 
 typedef struct {
     int32_t window_edge;              /* samples per axis of the board's window */
@@ -53,15 +51,11 @@ typedef struct {
     uint32_t heartbeat_period_us;     /* 5 ms */
     uint32_t solve_period_us;         /* global solve at 100 Hz: 10 ms */
     uint32_t window_min_period_us;    /* refresh an edited window at most this often */
-    bool adaptive_region;             /* real-time hosts (argil connect): a solve step that takes
-                                       * over 80 % of its period (thread CPU time) shrinks the
-                                       * solve's margin around the board's window by a sample
-                                       * (PEER_MARGIN_MAX → 0); 50 steps under 40 % grow it back.
-                                       * Off for lockstep sessions, which must stay reproducible. */
+    bool adaptive_region;             /* real-time hosts (argil connect): slow solve steps shrink
+                                       * the solve's margin around the board's window
+                                       * (host/solve/solve_sched.h). Off for lockstep sessions,
+                                       * which must stay reproducible. */
 } peer_cfg_t;
-
-#define PEER_MARGIN_MAX 4             /* samples of margin around the board's window */
-#define PEER_MARGIN_GROW_STEPS 50u    /* fast steps in a row before the margin grows again */
 
 typedef struct {
     uint32_t frames_rx;
@@ -77,10 +71,6 @@ typedef struct {
     double impulse_total_ns;          /* Σ|J| applied */
     uint32_t solve_errors;            /* B-spline steps that failed (the field kept its state) */
     argil_err_t last_solve_error;
-    uint32_t solve_hist_10us[PEER_SOLVE_HIST_BINS]; /* thread CPU time of each solve step */
-    double solve_max_ms;
-    uint32_t region_shrinks;          /* adaptive_region: times the margin was lowered */
-    int32_t margin_min;               /* the smallest margin used (samples) */
     uint32_t refines;                 /* knot insertions (peer_refine) */
     float refine_max_dd;              /* the largest |density change| one of them made */
     uint32_t host_tool_edits;         /* host tool applications that changed the model */
@@ -88,7 +78,10 @@ typedef struct {
 
 typedef struct {
     peer_cfg_t cfg;
-    grid_t *grid;
+    rep_t rep;                        /* what is sculpted: every model access goes through it */
+    rep_bspline_t own;                /* the representation peer_init made over a grid */
+    bool owns_rep;
+    grid_t *grid;                     /* rep's sample grid (NULL: it keeps none) */
     peer_send_fn send;
     peer_telemetry_fn on_telemetry;
     void *ctx;
@@ -114,22 +107,16 @@ typedef struct {
     bool field_dirty;
     uint32_t since_window_us;
     uint32_t since_heartbeat_us;
-    uint32_t since_solve_us;
     uint32_t impulse_seq_received;    /* newest IMPULSE batch taken in */
     uint32_t impulse_seq_applied;     /* newest batch integrated by a solve step */
     int32_t dirty_lo[3], dirty_hi[3]; /* samples changed since the last mesh (lo > hi: none) */
     peer_box_t box;                   /* the solve's physical window now */
     bool have_box;
-    peer_box_t settling[PEER_SETTLING_MAX];
-    uint32_t settling_count;
     peer_stats_t stats;
     proto_msg_t scratch;
-    gsolve_t *gs;                     /* the B-spline model (PEER_SOLVE_BSPLINE), else NULL */
-    spring_material_t gs_mat;         /* grid material the model last took */
-    int32_t force_lo[3], force_hi[3]; /* samples holding external force (lo > hi: none) */
-    int32_t margin;                   /* samples of the solve's margin (PEER_MARGIN_MAX unless
-                                       * adaptive_region lowered it) */
-    uint32_t fast_steps;              /* solve steps in a row under 40 % of the period */
+    gsolve_t *gs;                     /* peer_init's B-spline model (PEER_SOLVE_BSPLINE), else
+                                       * NULL; for the session's undo and live window */
+    solve_sched_t sched;              /* when the solve steps, its margin, its step times */
     host_tool_t host_tool;            /* what the board's carve does on the host (B-spline) */
     vec3_t host_prev_m;               /* stylus at the last host tool application */
     bool host_prev_valid;             /* button 1 held since then */
@@ -141,6 +128,10 @@ void peer_cfg_default(peer_cfg_t *cfg);
  * is seeded from the grid's densities and the grid becomes its view. */
 argil_err_t peer_init(peer_t *p, const peer_cfg_t *cfg, grid_t *grid, peer_send_fn send,
                       peer_telemetry_fn on_telemetry, void *ctx);
+/* Sets up the peer over any representation (the caller's, kept; cfg's global_solve and
+ * knot_ratio are not used). ARGIL_ERR_ARG, ARGIL_ERR_NOMEM. */
+argil_err_t peer_init_rep(peer_t *p, const peer_cfg_t *cfg, rep_t rep, peer_send_fn send,
+                          peer_telemetry_fn on_telemetry, void *ctx);
 void peer_free(peer_t *p);
 
 /* Takes in bytes of whole frames from the board. */
@@ -173,9 +164,7 @@ typedef enum { PEER_MAT_STIFFNESS, PEER_MAT_MASS } peer_material_t;
  * model; 1.0 everywhere with the springs solve (its material is uniform). */
 float peer_material_at(const peer_t *p, peer_material_t ch, vec3_t x_m);
 
-/* Sets the global solve's period, clamped to PEER_SOLVE_PERIOD_MIN_US..PEER_SOLVE_PERIOD_MAX_US. */
-#define PEER_SOLVE_PERIOD_MIN_US 2000u
-#define PEER_SOLVE_PERIOD_MAX_US 50000u
+/* Sets the global solve's period, clamped to SOLVE_PERIOD_MIN_US..SOLVE_PERIOD_MAX_US. */
 void peer_set_solve_period_us(peer_t *p, uint32_t us);
 
 /* Paints the stiffness or mass scale toward `scale` within radius of centre (linear falloff);
@@ -190,7 +179,7 @@ argil_err_t peer_paint_material(peer_t *p, peer_material_t ch, vec3_t centre_m, 
  * (already one coefficient per sample), nothing changed; ARGIL_ERR_NOMEM. */
 argil_err_t peer_refine(peer_t *p, float *max_dd);
 
-/* What the board's carve tool does on the host while button 1 is held (host/app/host_tool.h;
+/* What the board's carve tool does on the host while button 1 is held (host/model/host_tool.h;
  * carve with a sphere, no mirror by default): one application per solve period at the stylus,
  * with the tool's radius and axis (gsolve_apply_tool). ARGIL_ERR_ARG for a setting out of
  * range; ARGIL_ERR_STATE for anything but the default with the springs solve (it carves the
@@ -202,11 +191,6 @@ int32_t peer_knot_ratio(const peer_t *p);
 
 /* Median, 99th percentile (10 µs resolution) and max of the solve steps' thread CPU times, ms. */
 void peer_solve_times_ms(const peer_t *p, double *median, double *p99, double *max);
-
-/* adaptive_region's rule after a solve step of step_ms (thread CPU time): over 80 % of the
- * solve period lowers the margin by one sample (not below 0); PEER_MARGIN_GROW_STEPS steps in a
- * row under 40 % raise it by one (not above PEER_MARGIN_MAX). Called by the peer itself. */
-void peer_adapt_region(peer_t *p, double step_ms);
 
 /* The model was set back to an earlier state (undo or redo, host/app/session_undo.h) and the
  * grid follows in sample box [lo, hi): re-mesh it (dirty box; the journal records it with the

@@ -119,7 +119,7 @@ static argil_err_t push_cmd(script_t *s, const script_cmd_t *c)
         return ARGIL_ERR_PARSE;                                                                \
     } while (0)
 
-/* The host tool's verbs (host/app/host_tool.h): action NAME [strength S], action_shape NAME,
+/* The host tool's verbs (host/model/host_tool.h): action NAME [strength S], action_shape NAME,
  * mirror none|x|y|z|xy|... */
 static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c, char *err,
                                    size_t err_len)

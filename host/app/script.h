@@ -5,7 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 #include "shared/argil_err.h"
 #include "shared/vec3.h"
 

@@ -63,7 +63,7 @@ static const char *const FILTER_NAMES[BETA_FILTER_COUNT] = {"constant", "gaussia
                                                            "cylindrical", "conical"};
 
 #define PANEL_SOLVE_STEP (-1)         /* panel row that is no PARAM_*: the solve period */
-/* Rows for the host tool (what carve does on the host, host/app/host_tool.h): -/+ cycle the
+/* Rows for the host tool (what carve does on the host, host/model/host_tool.h): -/+ cycle the
  * action, shape and mirror planes, scale the strength; the keys A, S, X, Y, Z reach them too. */
 #define PANEL_HOST_ACTION (-2)
 #define PANEL_HOST_SHAPE (-3)
@@ -88,8 +88,8 @@ static const struct {
     {PARAM_YIELD_FORCE_N, "yield N", 0.0f, 10.0f, 1.25f, 0.05f},
     {PARAM_MAX_FORCE_N, "max force N", 0.1f, 10.0f, 1.1f, 0.1f},
     /* The host's global solve step: a peer setting, not a script parameter. */
-    {PANEL_SOLVE_STEP, "solve step ms", PEER_SOLVE_PERIOD_MIN_US * 1e-3f,
-     PEER_SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, PEER_SOLVE_PERIOD_MIN_US * 1e-3f},
+    {PANEL_SOLVE_STEP, "solve step ms", SOLVE_PERIOD_MIN_US * 1e-3f,
+     SOLVE_PERIOD_MAX_US * 1e-3f, 1.25f, SOLVE_PERIOD_MIN_US * 1e-3f},
     {PANEL_HOST_ACTION, "carve does", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_SHAPE, "host shape", 0.0f, 0.0f, 1.0f, 0.0f},
     {PANEL_HOST_MIRROR, "mirror", 0.0f, 0.0f, 1.0f, 0.0f},
@@ -261,7 +261,7 @@ static void host_panel(session_frame_t *f, int row, float value)
                                  : (t.strength / 1.25f < 0.1f ? 0.0f : t.strength / 1.25f);
         t.strength = v > HOST_STRENGTH_MAX ? HOST_STRENGTH_MAX : v;
     }
-    if (f->peer->gs == NULL && !host_tool_is_default(&t))
+    if (!f->peer->rep.ops->tool_supported(f->peer->rep.st, &t))
         return; /* springs: refused by peer_set_host_tool too */
     pl->host_tool = t;
     pl->params_changed = 1;

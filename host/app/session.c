@@ -11,7 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "host/app/histogram.h"
+#include "host/solve/histogram.h"
 #include "host/app/peer.h"
 #include "host/app/peer_journal.h"
 #include "host/app/script.h"

@@ -8,7 +8,7 @@
 #include <sys/mman.h>
 #include <time.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 
 static float coef_defaults(const field_t *f, int c)
 {

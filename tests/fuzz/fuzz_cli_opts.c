@@ -1,5 +1,5 @@
 /* libFuzzer target for the option values argil sculpt and argil connect share (host/app/
- * cli_opts.h) and the host tool names connect parses (host/app/host_tool.h): arbitrary bytes as
+ * cli_opts.h) and the host tool names connect parses (host/model/host_tool.h): arbitrary bytes as
  * each value. A value that parses must land inside its documented set. */
 #include <math.h>
 #include <stddef.h>
@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "host/app/cli_opts.h"
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

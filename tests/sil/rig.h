@@ -17,6 +17,7 @@
 typedef struct {
     sim_rig_t rig;            /* the simulated arm, the sim HAL and the board */
     grid_t grid;
+    bool rep_given;           /* the peer sculpts the caller's representation, not grid */
     peer_t peer;
     bool manual_host;         /* the test plays the host (rig_send_window, heartbeats here) */
     msg_tool_t tool;
@@ -86,9 +87,10 @@ static inline void rig_send_msg(rig_t *r, proto_msg_t *m)
     assert_int_equal(tries <= 1000, 1);
 }
 
-/* Builds the rig. manual_host: the test provides windows; otherwise argil's peer over a
- * 30 mm clay sphere at the model origin. The stylus starts at model (0, 0, 60 mm). */
-static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
+/* Builds the rig. manual_host: the test provides windows; otherwise argil's peer over rep, or
+ * (rep NULL) over a 30 mm clay sphere at the model origin. The stylus starts at model
+ * (0, 0, 60 mm). */
+static rig_t *rig_new_host(float stiffness_n_per_mm, bool manual_host, const rep_t *rep)
 {
     rig_t *r = calloc(1, sizeof(*r));
     assert_non_null(r);
@@ -104,7 +106,15 @@ static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
     r->hand_model_m = vec3(0, 0, 0.060f);
     r->host_alive = true;
     r->tool = rig_tool(r, TOOL_TOUCH, stiffness_n_per_mm);
-    if (!manual_host) {
+    if (!manual_host && rep) {
+        r->rep_given = true;
+        peer_cfg_t pc;
+        peer_cfg_default(&pc);
+        assert_int_equal(peer_init_rep(&r->peer, &pc, *rep, rig_send, NULL, r), ARGIL_OK);
+        peer_set_tool(&r->peer, &r->tool);
+        peer_request_arm(&r->peer);
+        assert_true(peer_send_hello(&r->peer, "sil rig"));
+    } else if (!manual_host) {
         const int32_t dims[3] = {72, 72, 72};
         const float half = 0.5f * 71 * 0.00125f;
         assert_int_equal(grid_init(&r->grid, dims, 0.00125f, vec3(-half, -half, -half)),
@@ -130,7 +140,12 @@ static rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
     return r;
 }
 
-static rig_t *rig_new(float stiffness_n_per_mm)
+static inline rig_t *rig_new_mode(float stiffness_n_per_mm, bool manual_host)
+{
+    return rig_new_host(stiffness_n_per_mm, manual_host, NULL);
+}
+
+static inline rig_t *rig_new(float stiffness_n_per_mm)
 {
     return rig_new_mode(stiffness_n_per_mm, false);
 }
@@ -139,7 +154,8 @@ static inline void rig_free(rig_t *r)
 {
     if (!r->manual_host) {
         peer_free(&r->peer);
-        grid_free(&r->grid);
+        if (!r->rep_given)
+            grid_free(&r->grid);
     }
     free(r);
 }

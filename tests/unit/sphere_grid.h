@@ -14,7 +14,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
 

@@ -1,4 +1,4 @@
-/* The session's global solve on the B-spline model (host/app/global_solve.c): the grid as the
+/* The session's global solve on the B-spline model (host/solve/gsolve.c): the grid as the
  * model's view, impulses moving as much clay as the density springs do, carving through the
  * model's tools, painted material, a field at rest staying put, and the script's paint verb. */
 #include <stdarg.h>
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/model/grid.h"
@@ -266,9 +266,9 @@ static void test_painted_material(void **st)
     assert_float_equal(peer_material_at(bs, PEER_MAT_STIFFNESS, vec3(hs, 10e-3f, hs)), 1.0f, 0.0f);
     assert_float_equal(peer_material_at(bs, PEER_MAT_MASS, vec3(hs, hs, hs)), 1.0f, 0.0f);
     peer_set_solve_period_us(bs, 1u);
-    assert_int_equal(bs->cfg.solve_period_us, PEER_SOLVE_PERIOD_MIN_US);
+    assert_int_equal(bs->cfg.solve_period_us, SOLVE_PERIOD_MIN_US);
     peer_set_solve_period_us(bs, 1000000u);
-    assert_int_equal(bs->cfg.solve_period_us, PEER_SOLVE_PERIOD_MAX_US);
+    assert_int_equal(bs->cfg.solve_period_us, SOLVE_PERIOD_MAX_US);
     peer_free(bs);
     peer_free(springs);
     free(bs);

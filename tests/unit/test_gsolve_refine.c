@@ -1,4 +1,4 @@
-/* Knot insertion during a session (host/app/global_solve.c, gsolve_refine): a field started at
+/* Knot insertion during a session (host/solve/gsolve.c, gsolve_refine): a field started at
  * R = 2 or 4 grid samples per knot span is seeded close to the grid, solves, shifts its window
  * by whole knot spans and carves; a refinement halves R without changing a sample, the grid or
  * the mesh, and the clay still moves under a push afterwards, as much as at R = 1 from the
@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/app/peer.h"
 #include "host/app/script.h"
 #include "host/mesh/mc.h"

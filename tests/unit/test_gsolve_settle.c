@@ -1,4 +1,4 @@
-/* Clay the board's window leaves while it still moves keeps moving (host/app/global_solve.c
+/* Clay the board's window leaves while it still moves keeps moving (host/solve/gsolve.c
  * settling region): a dent pushed in and released springs back the same whether the window
  * stays over it or goes elsewhere; with settling off it freezes where the window left it. */
 #include <stdarg.h>
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"
 #include "tests/unit/sphere_grid.h"

@@ -53,29 +53,29 @@ static void test_slow_steps_shrink_fast_steps_grow(void **st)
     (void)st;
     rig_t *r = rig_new(true);
     peer_t *p = &r->peer; /* solve period 10 ms: budget 8 ms, fast below 4 ms */
-    assert_int_equal(p->margin, PEER_MARGIN_MAX);
-    peer_adapt_region(p, 7.9);
-    assert_int_equal(p->margin, 4); /* within budget: unchanged */
+    assert_int_equal(p->sched.margin, SOLVE_MARGIN_MAX);
+    solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 7.9);
+    assert_int_equal(p->sched.margin, 4); /* within budget: unchanged */
     for (int i = 0; i < 3; i++)
-        peer_adapt_region(p, 12.0);
-    assert_int_equal(p->margin, 1);
+        solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 12.0);
+    assert_int_equal(p->sched.margin, 1);
     for (int i = 0; i < 5; i++)
-        peer_adapt_region(p, 30.0);
-    assert_int_equal(p->margin, 0); /* never below the board's own window */
-    assert_int_equal(p->stats.region_shrinks, 4);
-    assert_int_equal(p->stats.margin_min, 0);
-    for (uint32_t i = 0; i + 1 < PEER_MARGIN_GROW_STEPS; i++)
-        peer_adapt_region(p, 1.0);
-    assert_int_equal(p->margin, 0); /* 49 fast steps: not yet */
-    peer_adapt_region(p, 5.0);      /* a middling step breaks the run */
-    for (uint32_t i = 0; i + 1 < PEER_MARGIN_GROW_STEPS; i++)
-        peer_adapt_region(p, 1.0);
-    assert_int_equal(p->margin, 0);
-    peer_adapt_region(p, 1.0);
-    assert_int_equal(p->margin, 1); /* the 50th fast step in a row */
-    for (uint32_t i = 0; i < 10 * PEER_MARGIN_GROW_STEPS; i++)
-        peer_adapt_region(p, 1.0);
-    assert_int_equal(p->margin, PEER_MARGIN_MAX); /* and no further */
+        solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 30.0);
+    assert_int_equal(p->sched.margin, 0); /* never below the board's own window */
+    assert_int_equal(p->sched.shrinks, 4);
+    assert_int_equal(p->sched.margin_min, 0);
+    for (uint32_t i = 0; i + 1 < SOLVE_MARGIN_GROW_STEPS; i++)
+        solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 1.0);
+    assert_int_equal(p->sched.margin, 0); /* 49 fast steps: not yet */
+    solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 5.0); /* a middling step breaks the run */
+    for (uint32_t i = 0; i + 1 < SOLVE_MARGIN_GROW_STEPS; i++)
+        solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 1.0);
+    assert_int_equal(p->sched.margin, 0);
+    solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 1.0);
+    assert_int_equal(p->sched.margin, 1); /* the 50th fast step in a row */
+    for (uint32_t i = 0; i < 10 * SOLVE_MARGIN_GROW_STEPS; i++)
+        solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 1.0);
+    assert_int_equal(p->sched.margin, SOLVE_MARGIN_MAX); /* and no further */
     rig_free(r);
 }
 
@@ -89,15 +89,15 @@ static void test_the_solve_box_follows_the_margin(void **st)
         p->have_current = true;
         p->board_seen = true; /* as after the board's HELLO */
         peer_tick(p, p->cfg.solve_period_us);
-        assert_int_equal(p->box.lo[0], 10 - PEER_MARGIN_MAX);
-        assert_int_equal(p->box.hi[2], 14 + 16 + PEER_MARGIN_MAX);
+        assert_int_equal(p->box.lo[0], 10 - SOLVE_MARGIN_MAX);
+        assert_int_equal(p->box.hi[2], 14 + 16 + SOLVE_MARGIN_MAX);
         /* Four steps far over budget: with adaptive_region the next solve is the window alone;
          * without it the peer never calls the rule and keeps its margin. */
         if (adaptive)
             for (int i = 0; i < 4; i++)
-                peer_adapt_region(p, 100.0);
+                solve_sched_adapt(&p->sched, p->cfg.solve_period_us, 100.0);
         peer_tick(p, p->cfg.solve_period_us);
-        const int32_t m = adaptive ? 0 : PEER_MARGIN_MAX;
+        const int32_t m = adaptive ? 0 : SOLVE_MARGIN_MAX;
         assert_int_equal(p->box.lo[0], 10 - m);
         assert_int_equal(p->box.lo[1], 12 - m);
         assert_int_equal(p->box.hi[0], 10 + 16 + m);

@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 #include "host/app/session_undo.h"
 #include "host/model/grid.h"
 #include "tests/unit/grid_view.h"

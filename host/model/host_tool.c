@@ -1,5 +1,5 @@
 /* The session's host tool setting: names, defaults and limits. */
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,5 +1,5 @@
 /* The session's global solve on the B-spline model: field + physical window + grid view. */
-#include "host/app/global_solve.h"
+#include "host/solve/gsolve.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -958,7 +958,7 @@ argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
     return ARGIL_OK;
 }
 
-/* ---- the session's host tool (helper "hosttools"; host/app/host_tool.h) ---- */
+/* ---- the session's host tool (helper "hosttools"; host/model/host_tool.h) ---- */
 
 static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3]);
 

@@ -10,7 +10,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "host/app/host_tool.h"
+#include "host/model/host_tool.h"
 #include "host/model/field.h"
 #include "host/model/grid.h"
 #include "host/model/physwin.h"
@@ -192,7 +192,7 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
  * leave the model's as they are). ARGIL_ERR_NOMEM. */
 argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g);
 
-/* ---- the session's host tool (helper "hosttools"; host/app/host_tool.h) ---- */
+/* ---- the session's host tool (helper "hosttools"; host/model/host_tool.h) ---- */
 
 /* Applies the host tool once (host/model/tools.c, no undo step): its action and shape at the
  * stroke points pts_m[0..n_pts) (n_pts >= 1; between consecutive points the poses are spaced

@@ -1,5 +1,5 @@
 /* Histogram quantiles (see histogram.h). */
-#include "host/app/histogram.h"
+#include "host/solve/histogram.h"
 
 uint32_t hist_quantile_bin(const uint32_t *hist, uint32_t bins, double q)
 {
