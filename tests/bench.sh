@@ -41,7 +41,7 @@ if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/nu
         printf '  window %2d^3: %s instructions in %s ticks = %s per tick (mean)\n' "$edge" "$ir" "$ticks" \
             "$(awk -v a="$ir" -v b="$ticks" 'BEGIN { printf "%d", a / b }')"
     done
-    echo "  (goal for issue 3: worst tick with a 16^3 window <= 150,000 instructions)"
+    echo "  (goal: worst tick with a 16^3 window <= 150,000 instructions)"
 else
     echo "  valgrind not installed: skipped"
 fi
@@ -141,7 +141,7 @@ for row in 16 32 "16 --paint-stiffness 4"; do
         echo "    valgrind (with valgrind/callgrind.h) not installed: instruction counts skipped"
     fi
 done
-echo "  (goal for issue 3: worst tick with a 16^3 window <= 150,000 instructions)"
+echo "  (goal: worst tick with a 16^3 window <= 150,000 instructions)"
 
 echo "== autosave journal (host/io/journal.c): the default session with and without it, $runs runs each"
 : >"$tmp/jon"; : >"$tmp/joff"; : >"$tmp/jms"

@@ -1,4 +1,4 @@
-/* Undo and redo in the live session (issue 5, Ferley §3.3): one step per stroke — everything
+/* Undo and redo in the live session (Ferley §3.3): one step per stroke — everything
  * the B-spline model did from one press of button 1 (or a script's paint) until the next,
  * the clay's springing back and settling after the release included — holding only the
  * coefficients and samples that changed (host/model/undo.h), within a memory budget.

@@ -1,4 +1,4 @@
-/* Material colour maps for the clay (issue 8: painted stiffness / mass): a value per vertex,
+/* Material colour maps for the clay (painted stiffness / mass): a value per vertex,
  * relative to the default material, mapped onto a diverging logarithmic ramp (blue below the
  * default, red above) whose range the HUD's legend shows. */
 #ifndef ARGIL_COLOUR_MAP_H

@@ -903,7 +903,7 @@ bool gsolve_material_box(const gsolve_t *gs, gsolve_material_t ch, const int32_t
     return painted;
 }
 
-/* ---- painted material and the grid's channels (helper "persist": .argil MTLS, journal) ---- */
+/* ---- painted material and the grid's channels (.argil MTLS, journal) ---- */
 
 static const int GSOLVE_GRID_MAT_FS[GRID_MAT_N] = {FS_STIFF, FS_MASS, FS_DAMP, FS_RESTLEN};
 
@@ -958,7 +958,7 @@ argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
     return ARGIL_OK;
 }
 
-/* ---- the session's host tool (helper "hosttools"; host/model/host_tool.h) ---- */
+/* ---- the session's host tool (host/model/host_tool.h) ---- */
 
 static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3]);
 
@@ -1102,7 +1102,7 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
     return ARGIL_OK;
 }
 
-/* ---- painted colour and the grid's rgb (helper "colour") ---- */
+/* ---- painted colour and the grid's rgb ---- */
 
 /* A colour channel value (0..1) as the grid's byte. */
 static uint8_t colour_byte(float v)
@@ -1179,7 +1179,7 @@ argil_err_t gsolve_colour_from_grid(gsolve_t *gs, const grid_t *g)
     return e;
 }
 
-/* ---- undo and redo in the session (helper "undo"; host/app/session_undo.h) ---- */
+/* ---- undo and redo in the session (host/app/session_undo.h) ---- */
 
 argil_err_t gsolve_restored(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3],
                             int32_t glo[3], int32_t ghi[3])

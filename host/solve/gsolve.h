@@ -192,7 +192,7 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
  * leave the model's as they are). ARGIL_ERR_NOMEM. */
 argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g);
 
-/* ---- the session's host tool (helper "hosttools"; host/model/host_tool.h) ---- */
+/* ---- the session's host tool (host/model/host_tool.h) ---- */
 
 /* Applies the host tool once (host/model/tools.c, no undo step): its action and shape at the
  * stroke points pts_m[0..n_pts) (n_pts >= 1; between consecutive points the poses are spaced
@@ -207,7 +207,7 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
                               vec3_t axis, const vec3_t *pts_m, size_t n_pts, float dt_s,
                               int32_t lo[3], int32_t hi[3]);
 
-/* ---- painted colour (helper "colour"; docs/model.md "In the session") ---- */
+/* ---- painted colour (docs/model.md "In the session") ---- */
 
 /* Mirrors the model's colour (FS_R, FS_G, FS_B, 0..1) in sample box [lo, hi) (clipped to the
  * grid) into the grid's rgb as bytes (round(255 v)), a block holding colour only once a sample
@@ -222,7 +222,7 @@ argil_err_t gsolve_colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t l
  * ARGIL_ERR_NOMEM. */
 argil_err_t gsolve_colour_from_grid(gsolve_t *gs, const grid_t *g);
 
-/* ---- undo and redo in the session (helper "undo"; host/app/session_undo.h) ---- */
+/* ---- undo and redo in the session (host/app/session_undo.h) ---- */
 
 /* After the field was set back to an earlier state in sample box [lo, hi) (undo or redo): the
  * physical window and any settling region close (the next step reopens them from the field),

@@ -1,4 +1,4 @@
-/* SIL: the clay grows past the grid's old box (issue 5, Ferley §3.1 sparse working space). A
+/* SIL: the clay grows past the grid's old box (Ferley §3.1 sparse working space). A
  * 4 mm `action add` ball dragged from the sphere's +x side (30 mm) out to 72 mm leaves a rod of
  * clay reaching ~75 mm, far past the 88³ grid's old edge at +54.4 mm, where the dense grid
  * clipped every add. The mesh follows, the file keeps it, the journal rebased onto a box that

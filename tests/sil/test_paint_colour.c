@@ -1,4 +1,4 @@
-/* SIL: painting colour in a scripted session (issue 5, `action paint`; docs/script.md). The
+/* SIL: painting colour in a scripted session (`action paint`; docs/script.md). The
  * board's carve tool is held and drawn 2 mm deep along the top of the clay with the host action
  * `paint rgb 230 20 20`: the final model's mesh must carry that colour on the vertices within the
  * tool's radius of where the stylus went and the clay's grey (GRID_RGB_DEFAULT) two radii away,

@@ -1,4 +1,4 @@
-/* SIL: painted stiffness is felt (issue 5). The same press — the same tool, the same hand
+/* SIL: painted stiffness is felt. The same press — the same tool, the same hand
  * script — once on plain clay and once on the same spot painted 4× stiffer, with the B-spline
  * global solve (which sends the board its window with per-node stiffness once painted): the
  * painted clay gives way much less (the board's window and the host's model both show a

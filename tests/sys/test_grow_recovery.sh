@@ -1,5 +1,5 @@
 #!/bin/sh
-# Crash safety when the clay grows past the grid's old box (issue 5, sparse grid): an `action add`
+# Crash safety when the clay grows past the grid's old box (sparse grid): an `action add`
 # stroke drags clay from the sphere out past x = 54.4 mm (the old 88^3 box's edge); the journal
 # rebases onto checkpoints whose box holds the grown grid (docs/model.md "The session's grid").
 # The session is killed with SIGKILL after such a rebase; `argil recover` must give, byte for

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Painted colour end to end (issue 5, `action paint`): the live window under Xvfb shows a red
+# Painted colour end to end (`action paint`): the live window under Xvfb shows a red
 # stroke where the script paints (and no red before it), the window and a headless run write the
 # same model.argil, `argil info` reports the painted colour and `argil mesh` exports it as vertex
 # colours; the session's own final.ply carries the colour too (byte for byte `argil mesh`'s export

@@ -1,4 +1,4 @@
-/* A solver that falls behind lowers its region, never the board's rate (issue 8): with
+/* A solver that falls behind lowers its region, never the board's rate: with
  * adaptive_region, solve steps over 80 % of their period shrink the margin around the board's
  * window a sample at a time down to the window itself, 50 fast steps in a row grow it back, and
  * the solve's physical window follows the margin; without it the margin never moves. */

@@ -1,4 +1,4 @@
-/* Painted stiffness reaches the board (issue 5): the peer sends its window with one channel
+/* Painted stiffness reaches the board: the peer sends its window with one channel
  * (densities) while nothing in it is painted, and with two (densities, then each node's spring
  * stiffness = base × painted scale) once a paint reaches it; the board's window takes the
  * second channel as its per-node stiffness. */
