@@ -1,6 +1,6 @@
-/* SIL: what the person feels, measured the way a haptics engineer would (issue "haptic
- * rendering"): yielding clay, plastic and elastic recovery, a stiff virtual wall and its
- * passivity, a window swap under load, probing a stiffness step, and broken numbers. */
+/* SIL: what the person feels, measured the way a haptics engineer would: yielding clay,
+ * plastic and elastic recovery, a stiff virtual wall and its passivity, a window swap under
+ * load, probing a stiffness step, and broken numbers. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
