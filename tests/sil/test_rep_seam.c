@@ -56,7 +56,7 @@ static void test_peer_drives_a_second_representation(void **st)
     rig_move(r, vec3(0, 0, z_before + r_tool - 0.002f), 200);
     for (int i = 0; i < 300; i++)
         rig_tick(r);
-    const float touch_n = r->board.force_n.z;
+    const float touch_n = r->rig.board.force_n.z;
     const float touch_pen_m = z_before + r_tool - rig_tip_model(r).z;
     rig_move(r, vec3(0, 0, z_before + r_tool + 0.002f), 200);
 
@@ -74,7 +74,7 @@ static void test_peer_drives_a_second_representation(void **st)
         rig_tick(r);
     const float z_after = top_z_m(&rep, &closed);
     const peer_stats_t ps = r->peer.stats;
-    const board_stats_t bs = r->board.stats;
+    const board_stats_t bs = r->rig.board.stats;
     printf("# seam: touch %.2f N at %.2f mm in; push: top %.2f -> %.2f mm, %u impulse frames, "
            "%u windows sent, %u swapped\n",
            touch_n, touch_pen_m * 1e3, z_before * 1e3, z_after * 1e3, ps.impulse_frames,
