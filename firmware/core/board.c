@@ -79,6 +79,8 @@ argil_err_t board_init(board_t *b, const board_cfg_t *cfg)
     b->host_impulse_ack = 0;
     b->have_tip = false;
     b->tip_device_m = vec3(0, 0, 0);
+    memset(b->tpdos_seen, 0, sizeof(b->tpdos_seen));
+    b->stale_ticks = 0;
     b->pos_m = vec3(0, 0, 0);
     b->vel_m_s = vec3(0, 0, 0);
     b->force_n = vec3(0, 0, 0);
@@ -272,14 +274,30 @@ static bool sense_tool(board_t *b)
     const vec3_t tip = arm_fk(&b->cfg.arm, q);
     if (!vec3_isfinite(tip))
         return false;
-    const float dt_s = (float)b->cfg.tick_us * 1e-6f;
-    if (b->have_tip) {
-        const vec3_t v = vec3_scale(vec3_sub(tip, b->tip_device_m), 1.0f / dt_s);
-        const float a = b->cfg.velocity_filter;
-        b->vel_m_s = vec3_add(vec3_scale(b->vel_m_s, 1.0f - a), vec3_scale(v, a));
+    /* The velocity is the motion since the last new position over the ticks it took: a TPDO
+     * lost, or several arriving in one tick (a late bus), must not read as a standstill and
+     * then a jump of several ticks' motion in one. Stale for longer than
+     * BOARD_STALE_POSITION_TICKS, the arm is taken to be still. */
+    bool fresh = false;
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        if (b->drives.d[j].tpdos != b->tpdos_seen[j])
+            fresh = true;
+        b->tpdos_seen[j] = b->drives.d[j].tpdos;
     }
-    b->tip_device_m = tip;
-    b->have_tip = true;
+    const float dt_s = (float)b->cfg.tick_us * 1e-6f;
+    if (b->have_tip && !fresh && b->stale_ticks < BOARD_STALE_POSITION_TICKS) {
+        b->stale_ticks++;
+    } else {
+        if (b->have_tip) {
+            const float span_s = dt_s * (float)(b->stale_ticks + 1u);
+            const vec3_t v = vec3_scale(vec3_sub(tip, b->tip_device_m), 1.0f / span_s);
+            const float a = b->cfg.velocity_filter;
+            b->vel_m_s = vec3_add(vec3_scale(b->vel_m_s, 1.0f - a), vec3_scale(v, a));
+        }
+        b->stale_ticks = 0;
+        b->tip_device_m = tip;
+        b->have_tip = true;
+    }
     if (b->tool_valid) {
         b->pos_m = board_device_to_model(b, tip);
     }

@@ -25,6 +25,7 @@
 #define BOARD_IMPULSE_LOG 4096u        /* sent impulses remembered until the host's window has them */
 #define BOARD_SUBSTEPS_MAX 8u          /* adaptive step halving: at most 3 halvings */
 #define BOARD_DEFER_FRAMES 2u          /* WINDOW frames a tick that sends impulses puts off */
+#define BOARD_STALE_POSITION_TICKS 20u /* ticks without a new position before the arm counts as still */
 #define BOARD_SETTLE_TICKS 100u        /* the window's springs run this long after the last push */
 
 /* How long a host's ARM waits in FAULT/IDLE for the drives' fault reset to clear a drive trip
@@ -135,6 +136,8 @@ typedef struct {
     uint32_t host_impulse_ack;         /* newest impulse batch the host says it applied */
     bool have_tip;
     vec3_t tip_device_m;
+    uint32_t tpdos_seen[ARGIL_DRIVES]; /* each drive's TPDO count when the tip was last sampled */
+    uint32_t stale_ticks;              /* ticks since then without a new position */
     vec3_t pos_m;                      /* tool, model space */
     vec3_t vel_m_s;
     vec3_t force_n;                    /* rendered this tick, model space */

@@ -26,6 +26,7 @@ void drives_init(drives_t *dr)
         d->emcy_register = 0;
         d->emcy_count = 0;
         d->start_sent = false;
+        d->tpdos = 0;
         dr->controlword[j] = CIA402_CW_DISABLE_VOLTAGE;
     }
     dr->frames_rx = 0;
@@ -107,6 +108,7 @@ void drives_receive(drives_t *dr, const can_batch_t *rx)
             d->position_counts = pos;
             d->torque_permille = tq;
             d->position_valid = true;
+            d->tpdos++;
         } else if (canopen_heartbeat_decode(f, &node, &st) && (d = by_node(dr, node))) {
             if (st == NMT_STATE_BOOTUP)
                 d->start_sent = false; /* the drive (re)booted: start it again */

@@ -35,6 +35,7 @@ typedef struct {
     int32_t position_counts;
     int16_t torque_permille;
     bool position_valid;             /* a TPDO arrived since init */
+    uint32_t tpdos;                  /* TPDOs taken since init (wraps): a new position or not */
     bool emcy;                       /* an EMCY arrived and has not been cleared by a re-arm */
     uint16_t emcy_code;              /* the latest non-zero error code */
     uint8_t emcy_register;           /* its error register (object 0x1001) */

@@ -16,6 +16,8 @@
 
 typedef struct {
     sim_rig_t rig;            /* the simulated arm, the sim HAL and the board */
+    uint32_t can_burst_ticks; /* > 1: the device's frames reach the board in bursts this far apart */
+    can_batch_t can_held;     /* the frames of the burst being gathered */
     grid_t grid;
     bool rep_given;           /* the peer sculpts the caller's representation, not grid */
     peer_t peer;
@@ -218,7 +220,24 @@ static inline void rig_tick(rig_t *r)
     else
         sim_rig_set_hand(&r->rig, vec3_sub(r->hand_model_m, r->offset_m), vec3(0, 0, 0),
                          r->btn1, false);
-    (void)sim_rig_step_ns(&r->rig, 1000);
+    if (r->can_burst_ticks > 1) {
+        /* A late bus: the device's frames reach the board only every can_burst_ticks ticks,
+         * all at once (as argil-sim under emulation answers several SYNCs in one read). */
+        can_batch_t to_board = {0};
+        hal_sim_take_from_board(&r->rig.hal, &r->rig.from_board);
+        sim_device_step(&r->rig.dev, &r->rig.from_board, hal_sim_gpio_out(&r->rig.hal),
+                        &to_board, 1000);
+        for (uint8_t i = 0; i < to_board.n; i++)
+            (void)can_batch_push(&r->can_held, &to_board.f[i]);
+        if (r->ms % r->can_burst_ticks == 0) {
+            hal_sim_put_to_board(&r->rig.hal, &r->can_held);
+            r->can_held.n = 0;
+        }
+        hal_sim_set_gpio_in(&r->rig.hal, sim_device_gpio_in(&r->rig.dev));
+        (void)sim_rig_step_board(&r->rig);
+    } else {
+        (void)sim_rig_step_ns(&r->rig, 1000);
+    }
     const size_t n = sim_rig_host_receive(&r->rig, r->rx, sizeof(r->rx));
     if (r->host_alive && !r->manual_host) {
         peer_receive(&r->peer, r->rx, n);
