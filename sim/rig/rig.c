@@ -36,14 +36,19 @@ vec3_t sim_rig_tip_m(const sim_rig_t *r)
     return sim_device_tip_m(&r->dev);
 }
 
+void sim_rig_step_device_frames(sim_rig_t *r, uint32_t dt_us, can_batch_t *to_board)
+{
+    to_board->n = 0;
+    hal_sim_take_from_board(&r->hal, &r->from_board);
+    sim_device_step(&r->dev, &r->from_board, hal_sim_gpio_out(&r->hal), to_board, dt_us);
+    hal_sim_set_gpio_in(&r->hal, sim_device_gpio_in(&r->dev));
+}
+
 void sim_rig_step_device(sim_rig_t *r, uint32_t dt_us)
 {
     can_batch_t to_board;
-    to_board.n = 0;
-    hal_sim_take_from_board(&r->hal, &r->from_board);
-    sim_device_step(&r->dev, &r->from_board, hal_sim_gpio_out(&r->hal), &to_board, dt_us);
+    sim_rig_step_device_frames(r, dt_us, &to_board);
     hal_sim_put_to_board(&r->hal, &to_board);
-    hal_sim_set_gpio_in(&r->hal, sim_device_gpio_in(&r->dev));
 }
 
 uint32_t sim_rig_step_board(sim_rig_t *r)

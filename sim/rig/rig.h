@@ -65,6 +65,11 @@ uint32_t sim_rig_step_ns(sim_rig_t *r, uint32_t dt_us);
  * GPIO outputs, and their frames and lines wait for the board. */
 void sim_rig_step_device(sim_rig_t *r, uint32_t dt_us);
 
+/* The same step with the device's frames for the board returned in to_board instead of queued
+ * (a test that delivers them late queues them itself with hal_sim_put_to_board); its GPIO lines
+ * are set as usual. */
+void sim_rig_step_device_frames(sim_rig_t *r, uint32_t dt_us, can_batch_t *to_board);
+
 /* The second half: one board tick; returns its compute time. */
 uint32_t sim_rig_step_board(sim_rig_t *r);
 

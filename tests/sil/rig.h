@@ -223,17 +223,14 @@ static inline void rig_tick(rig_t *r)
     if (r->can_burst_ticks > 1) {
         /* A late bus: the device's frames reach the board only every can_burst_ticks ticks,
          * all at once (as argil-sim under emulation answers several SYNCs in one read). */
-        can_batch_t to_board = {0};
-        hal_sim_take_from_board(&r->rig.hal, &r->rig.from_board);
-        sim_device_step(&r->rig.dev, &r->rig.from_board, hal_sim_gpio_out(&r->rig.hal),
-                        &to_board, 1000);
+        can_batch_t to_board;
+        sim_rig_step_device_frames(&r->rig, 1000, &to_board);
         for (uint8_t i = 0; i < to_board.n; i++)
             (void)can_batch_push(&r->can_held, &to_board.f[i]);
         if (r->ms % r->can_burst_ticks == 0) {
             hal_sim_put_to_board(&r->rig.hal, &r->can_held);
             r->can_held.n = 0;
         }
-        hal_sim_set_gpio_in(&r->rig.hal, sim_device_gpio_in(&r->rig.dev));
         (void)sim_rig_step_board(&r->rig);
     } else {
         (void)sim_rig_step_ns(&r->rig, 1000);
