@@ -476,14 +476,25 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     b->stats.ticks++;
     b->time_us += dt_us;
 
-    /* Deadline accounting for the previous tick: late wake-up plus compute past the period. */
+    /* Deadline accounting for the previous tick: late wake-up plus compute past the period. A
+     * tick the platform could not time (preempted on a CPU-time clock) is counted apart: its
+     * figure holds time that was not its own. */
     const uint64_t prev_used_ns = (uint64_t)in->prev_wake_ns + in->prev_compute_ns;
-    const bool overrun = prev_used_ns > dt_us * 1000u;
-    if (b->stats.ticks > 1u)
+    const bool timed = !in->prev_compute_preempted;
+    const bool overrun = timed && prev_used_ns > dt_us * 1000u;
+    if (!timed) {
+        b->stats.preempted_ticks++;
+        if (prev_used_ns > dt_us * 1000u) {
+            if (b->stats.preempted_over_period < BOARD_PREEMPTED_KEPT)
+                b->stats.preempted_over_tick[b->stats.preempted_over_period] = b->stats.ticks - 1u;
+            b->stats.preempted_over_period++;
+        }
+    }
+    if (b->stats.ticks > 1u && timed)
         (void)rt_stats_add(&b->rt, in->prev_wake_ns, in->prev_compute_ns, dt_us * 1000u);
     if (overrun)
         b->stats.deadline_misses++;
-    if (in->prev_compute_ns > b->stats.worst_compute_ns)
+    if (timed && in->prev_compute_ns > b->stats.worst_compute_ns)
         b->stats.worst_compute_ns = in->prev_compute_ns;
 
     /* 1. Sense. */

@@ -69,6 +69,9 @@ typedef struct {
     uint32_t prev_compute_ns;          /* measured compute time of the previous tick */
     uint32_t prev_wake_ns;             /* its wake-up latency (0 when the caller does not
                                         * sleep on a clock, as in the lockstep simulation) */
+    bool prev_compute_preempted;       /* the platform preempted that compute on a clock that
+                                        * charged it time not its own (hal_compute_preemptions):
+                                        * not timed, counted in stats.preempted_ticks */
     uint32_t link_refused_source;      /* the transport's own refusals so far: datagrams from an
                                         * address other than the session host's (UDP), */
     uint32_t link_refused_no_session;  /* … datagrams with no session to belong to, */
@@ -83,10 +86,16 @@ typedef struct {
     size_t link_tx_len;
 } board_out_t;
 
+#define BOARD_PREEMPTED_KEPT 8u
+
 typedef struct {
     uint32_t ticks;
-    uint32_t deadline_misses;
-    uint32_t worst_compute_ns;
+    uint32_t deadline_misses;          /* timed ticks whose wake-up plus compute passed the period */
+    uint32_t worst_compute_ns;         /* of the timed ticks */
+    uint32_t preempted_ticks;          /* ticks not timed (board_in_t.prev_compute_preempted) */
+    uint32_t preempted_over_period;    /* … of them charged past the period: a real overrun
+                                        * among them repeats at the same tick in a rerun */
+    uint32_t preempted_over_tick[BOARD_PREEMPTED_KEPT]; /* the first ones' tick numbers */
     uint32_t link_frames_rx;
     uint32_t link_errors;              /* frames the decoder refused */
     uint32_t refused_no_session;       /* decoded host frames with no session (not a HELLO) */

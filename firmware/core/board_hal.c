@@ -19,6 +19,7 @@ void board_io_init(board_io_t *io)
 
 uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
 {
+    const uint64_t preemptions0 = hal_compute_preemptions(hal);
     const uint64_t t0 = hal_compute_clock_ns(hal);
     board_in_t in;
     (void)hal_can_receive(hal, &io->can_rx);
@@ -28,6 +29,7 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     in.link_rx_len = hal_link_receive(hal, io->link_rx, sizeof(io->link_rx));
     in.prev_compute_ns = io->prev_compute_ns;
     in.prev_wake_ns = io->prev_wake_ns;
+    in.prev_compute_preempted = io->prev_compute_preempted;
     hal_link_refusals_t refused;
     hal_link_refusals(hal, &refused);
     in.link_refused_source = refused.wrong_source;
@@ -46,5 +48,6 @@ uint32_t board_run_tick(board_t *b, board_io_t *io, hal_t *hal)
     hal_link_session(hal, session_state(&b->session), b->session.epoch);
     const uint64_t dt = hal_compute_clock_ns(hal) - t0;
     io->prev_compute_ns = dt > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)dt;
+    io->prev_compute_preempted = hal_compute_preemptions(hal) != preemptions0;
     return io->prev_compute_ns;
 }

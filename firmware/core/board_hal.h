@@ -14,6 +14,7 @@ typedef struct {
     uint8_t link_rx[BOARD_LINK_RX_MAX];
     board_out_t out;
     uint32_t prev_compute_ns;
+    bool prev_compute_preempted;       /* see board_in_t */
     uint32_t prev_wake_ns;             /* set by a caller that sleeps on a clock (0 otherwise) */
     uint32_t can_tx_errors;
     uint32_t link_tx_errors;

@@ -43,5 +43,13 @@ typedef struct {
 void hal_link_refusals(hal_t *h, hal_link_refusals_t *r);
 /* A monotonic nanosecond clock for measuring the tick's compute time. */
 uint64_t hal_compute_clock_ns(hal_t *h);
+/* How many times the platform has taken the core from the calling thread against its will so
+ * far. Where the compute clock is the thread's CPU time (the simulated HAL), a tick during which
+ * this changed was not timed: on a virtual machine that does not report stolen time, the time
+ * the hypervisor held the vCPU is charged to the thread that was running, and that thread is
+ * then preempted for having used its slice (docs/realtime.md, "Timing a simulated tick"). Always
+ * 0 where the compute clock is wall time (a board): there, being preempted is part of the
+ * deadline. */
+uint64_t hal_compute_preemptions(hal_t *h);
 
 #endif

@@ -1,8 +1,9 @@
 /* HAL backend for the in-process simulator: everything is a queue in memory. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* RUSAGE_THREAD */
 #include "hal_sim.h"
 
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 
 void hal_sim_init(hal_t *h)
@@ -104,6 +105,15 @@ uint64_t hal_compute_clock_ns(hal_t *h)
     struct timespec ts;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+uint64_t hal_compute_preemptions(hal_t *h)
+{
+    (void)h;
+    struct rusage ru;
+    if (getrusage(RUSAGE_THREAD, &ru) != 0)
+        return 0;
+    return (uint64_t)ru.ru_nivcsw;
 }
 
 void hal_sim_take_from_board(hal_t *h, can_batch_t *out)

@@ -328,8 +328,17 @@ int cmd_sculpt(int argc, char **argv)
                s.board_ticks, s.tick_hz);
         printf("  worst tick compute  %.1f us of a %u us period, deadline misses %u\n",
                s.worst_compute_ns / 1000.0, 1000000u / s.tick_hz, s.deadline_misses);
-        printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time)\n",
-               s.median_compute_ns / 1000u, s.p99_compute_ns / 1000u);
+        printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time); "
+               "%u ticks preempted by the machine, not timed\n",
+               s.median_compute_ns / 1000u, s.p99_compute_ns / 1000u, s.preempted_ticks);
+        if (s.preempted_over_period > 0) {
+            /* Not misses, but not hidden: a real overrun is past the period again at the same
+             * tick when the same script runs again (docs/board.md, "Timing a simulated tick"). */
+            printf("  preempted, charged  %u past the period, at ticks", s.preempted_over_period);
+            for (uint32_t i = 0; i < s.preempted_over_period && i < SESSION_PREEMPTED_KEPT; i++)
+                printf(" %u", s.preempted_over_tick[i]);
+            printf("%s\n", s.preempted_over_period > SESSION_PREEMPTED_KEPT ? " …" : "");
+        }
         if (s.rt_stats_frames > 0)
             printf("  board RT stats      %u reports, last over %u ticks: wake-up latency "
                    "min/mean/max %.1f/%.1f/%.1f us, compute %.1f/%.1f/%.1f us, %u overruns "

@@ -523,7 +523,8 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
 
         /* The arm's and the board's tick, then the host's. */
         const uint32_t compute_us = sim_rig_step_ns(&s->rig, dt_us) / 1000u;
-        s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
+        if (!s->rig.io.prev_compute_preempted) /* an untimed tick's figure is not its own */
+            s->compute_hist_us[compute_us < COMPUTE_HIST_BINS ? compute_us : COMPUTE_HIST_BINS - 1u]++;
         const size_t n = sim_rig_host_receive(&s->rig, s->rx, sizeof(s->rx));
         peer_receive(&s->peer, s->rx, n);
         session_undo_observe(&s->undo, &s->peer, dt_us); /* a new stroke; its diff a slice a tick */
@@ -563,6 +564,10 @@ argil_err_t session_run(const session_opts_t *opts, session_summary_t *sum, char
     sum->tick_hz = 1000000u / dt_us;
     sum->worst_compute_ns = board.worst_compute_ns;
     sum->deadline_misses = board.deadline_misses;
+    sum->preempted_ticks = board.preempted_ticks;
+    sum->preempted_over_period = board.preempted_over_period;
+    for (uint32_t i = 0; i < SESSION_PREEMPTED_KEPT && i < BOARD_PREEMPTED_KEPT; i++)
+        sum->preempted_over_tick[i] = board.preempted_over_tick[i];
     sum->rt_stats_frames = s->peer.stats.rt_stats_frames;
     sum->rt = s->peer.last_rt;
     sum->median_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.5) * 1000u;

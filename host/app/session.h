@@ -62,14 +62,19 @@ typedef struct {
     void *note_ctx;
 } session_opts_t;
 
+#define SESSION_PREEMPTED_KEPT 8u
+
 typedef struct {
     double sim_seconds;
     uint32_t board_ticks;
     uint32_t tick_hz;
     uint32_t worst_compute_ns;
-    uint32_t median_compute_ns;   /* of every tick, 1 µs resolution */
+    uint32_t median_compute_ns;   /* of every timed tick, 1 µs resolution */
     uint32_t p99_compute_ns;
     uint32_t deadline_misses;
+    uint32_t preempted_ticks;     /* ticks the machine preempted: not timed, in no figure above */
+    uint32_t preempted_over_period; /* … of them charged past the period; the first ones: */
+    uint32_t preempted_over_tick[SESSION_PREEMPTED_KEPT];
     uint32_t rt_stats_frames;     /* RT_STATS reports the host received from the board */
     msg_rt_stats_t rt;            /* the newest one (wake-up latency, compute, overruns) */
     float peak_force_n;

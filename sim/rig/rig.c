@@ -1,6 +1,8 @@
 /* The lockstep rig (rig.h): device, sim HAL and board core, one step at a time. */
 #include "rig.h"
 
+#include <string.h>
+
 void sim_rig_cfg_default(sim_rig_cfg_t *cfg)
 {
     sim_params_default(&cfg->sim);
@@ -77,6 +79,10 @@ void sim_rig_board_stats(const sim_rig_t *r, sim_rig_board_stats_t *out)
     out->ticks = r->board.stats.ticks;
     out->deadline_misses = r->board.stats.deadline_misses;
     out->worst_compute_ns = r->board.stats.worst_compute_ns;
+    out->preempted_ticks = r->board.stats.preempted_ticks;
+    out->preempted_over_period = r->board.stats.preempted_over_period;
+    memcpy(out->preempted_over_tick, r->board.stats.preempted_over_tick,
+           sizeof(out->preempted_over_tick));
     out->link_errors = r->board.stats.link_errors;
     out->peak_force_n = r->board.stats.peak_force_n;
     out->max_force_n = r->board.cfg.max_force_n;

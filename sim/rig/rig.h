@@ -36,6 +36,9 @@ typedef struct {
     uint32_t ticks;
     uint32_t deadline_misses;
     uint32_t worst_compute_ns;
+    uint32_t preempted_ticks;      /* not timed: the machine took the core (board_stats_t) */
+    uint32_t preempted_over_period;
+    uint32_t preempted_over_tick[BOARD_PREEMPTED_KEPT];
     uint32_t link_errors;          /* frames the board's decoder refused */
     float peak_force_n;
     float max_force_n;             /* the board's configured limit */

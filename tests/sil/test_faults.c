@@ -350,6 +350,7 @@ static void fx_tick(fx_t *x)
      * measured time of this sanitizer build was the one thing in the run not on the virtual
      * clock: a loaded run of basic.scn once sent 0 RPDOs with torque where it sends 3,510. */
     r->rig.io.prev_compute_ns = x->overrun_left > 0 ? OVERRUN_NS : 0u; /* the injected load */
+    r->rig.io.prev_compute_preempted = false; /* … timed, whatever the machine did meanwhile */
     if (x->overrun_left > 0)
         x->overrun_left--;
     log_frames(x, now + 500, &r->rig.io.out.can_tx); /* the board's frames, half a tick later */

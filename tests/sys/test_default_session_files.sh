@@ -9,21 +9,35 @@ fail() { echo "FAIL: $*"; exit 1; }
 
 "$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/a" >"$tmp/summary"
 cat "$tmp/summary"
-"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/b" --quiet
+"$bin" sculpt --device sim --script scripts/default.scn --out "$tmp/b" >"$tmp/summary_b"
 for f in final.ply telemetry.csv session.scn; do
     [ -s "$tmp/a/$f" ] || fail "$f missing or empty"
     cmp -s "$tmp/a/$f" "$tmp/b/$f" || fail "$f differs between two runs of the same script"
 done
 ls "$tmp/a" | grep -q '\.tmp$' && fail "a temporary file was left behind"
 
-# Tick compute is thread CPU time; on a shared VM a descheduled vCPU is sometimes charged to the
-# ticking thread (one 2.4 ms "tick" seen in CI with nothing else in it). Speed is make bench's job
-# (bench_ticks, callgrind); what a person would notice is the board's answer to overruns: it must
-# end ACTIVE, never have faulted on a streak (3 in a row), and the files above are byte-identical.
-grep -q 'board state *ACTIVE' "$tmp/summary" || fail "the board did not end ACTIVE"
-streak=$(sed -n 's/.*overruns (worst streak \([0-9]*\)).*/\1/p' "$tmp/summary")
-[ -n "$streak" ] || fail "the summary has no overrun streak"
-[ "$streak" -lt 3 ] || fail "a streak of $streak deadline overruns (3 fault the board)"
+# Tick compute is the thread's CPU time. On a VM that does not report stolen time the time the
+# hypervisor held the vCPU is charged to the running thread, which the guest then preempts: such
+# ticks (seen at 0.4-2.6 ms with ~5 us of work) are counted as "preempted, not timed" and kept out
+# of the deadline figures (docs/board.md, "Timing a simulated tick"). Every timed tick must meet
+# its deadline, enough ticks must be timed for that to mean something, and a preempted tick
+# charged past the period must not be so at the same tick in the second run (real work repeats:
+# the session is deterministic; stolen time does not).
+for run in summary summary_b; do
+    grep -q 'board state *ACTIVE' "$tmp/$run" || fail "$run: the board did not end ACTIVE"
+    grep -q 'deadline misses 0$' "$tmp/$run" || fail "$run: the summary reports deadline misses"
+    streak=$(sed -n 's/.*overruns (worst streak \([0-9]*\)).*/\1/p' "$tmp/$run")
+    [ "$streak" = 0 ] || fail "$run: the board's RT stats report overruns (worst streak ${streak:-none})"
+    ticks=$(sed -n 's/.*(\([0-9]*\) board ticks at.*/\1/p' "$tmp/$run")
+    untimed=$(sed -n 's/.*; \([0-9]*\) ticks preempted by the machine, not timed.*/\1/p' "$tmp/$run")
+    [ -n "$ticks" ] && [ -n "$untimed" ] || fail "$run: no tick count or preempted count"
+    [ $((ticks - untimed)) -ge 1000 ] || fail "$run: only $((ticks - untimed)) of $ticks ticks were timed"
+done
+over() { sed -n 's/.*past the period, at ticks \([0-9 ]*\).*/\1/p' "$1" | tr ' ' '\n' | sed '/^$/d' | sort; }
+over "$tmp/summary" >"$tmp/over_a"
+over "$tmp/summary_b" >"$tmp/over_b"
+both=$(comm -12 "$tmp/over_a" "$tmp/over_b" | tr '\n' ' ')
+[ -z "$both" ] || fail "ticks past the period in both runs (real overruns, not the machine): $both"
 grep -q 'watertight' "$tmp/summary" || fail "the summary does not report a watertight mesh"
 grep -q 'NOT watertight' "$tmp/summary" && fail "the mesh is not watertight"
 # Peak force within the limit, read from the summary.
