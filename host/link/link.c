@@ -30,7 +30,7 @@ argil_err_t link_open_keyed(link_t *l, const char *device, const uint8_t *key, c
         memcpy(l->key, key, LINK_KEY_SIZE);
     }
     switch (l->spec.kind) {
-    case LINK_KIND_SIM: return link_sim_open(l, err, err_len);
+    case LINK_KIND_SIM: return link_sim_open(l, l->spec.sim_hand, err, err_len);
     case LINK_KIND_UDP: return link_dgram_open(l, err, err_len);
     case LINK_KIND_USB: return link_usb_open(l, err, err_len);
     }

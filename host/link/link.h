@@ -81,7 +81,7 @@ void link_transport_down(link_t *l);
 void link_transport_up(link_t *l);
 
 /* Transport constructors (link_open calls them). */
-argil_err_t link_sim_open(link_t *l, char *err, size_t err_len);
+argil_err_t link_sim_open(link_t *l, link_sim_hand_t hand, char *err, size_t err_len);
 argil_err_t link_dgram_open(link_t *l, char *err, size_t err_len);
 argil_err_t link_usb_open(link_t *l, char *err, size_t err_len);
 

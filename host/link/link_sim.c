@@ -1,8 +1,10 @@
 /* The in-process simulated board as a host-link transport, in real time: each poll runs the
- * board core and the simulated arm (the hand holding still at the workspace centre) for the
- * 1 ms ticks the wall clock has reached, so `argil connect --device sim` behaves like a board
- * on a cable. The deterministic lockstep session is `argil sculpt`, not this. */
+ * board core and the simulated arm (the hand holding still at the workspace centre, or pressing
+ * the stylus into the clay: "sim:press") for the 1 ms ticks the wall clock has reached, so
+ * `argil connect --device sim` behaves like a board on a cable. The deterministic lockstep
+ * session is `argil sculpt`, not this. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,10 +15,15 @@
 #include "sim/rig/rig.h"
 
 #define SIM_CATCH_UP_TICKS 50u   /* at most this many ticks per poll; later ones are skipped */
+#define LINK_SIM_PRESS_PERIOD_S 2.0  /* "sim:press": one press every 2 s: */
+#define SIM_PRESS_START_S 0.2        /* … button 1 down 0.2 s into it, */
+#define SIM_PRESS_LEN_S 1.4          /* … for 1.4 s, down and up again (half a sine), */
+#define SIM_PRESS_DEPTH_M 0.014      /* … 14 mm below the hold point: 4 mm into the clay */
 
 typedef struct {
     sim_rig_t rig;
     vec3_t hold_m;                 /* where the hand holds the stylus */
+    link_sim_hand_t hand;
     uint32_t tick_us;
     uint64_t start_us;
     uint64_t ticks;
@@ -51,9 +58,29 @@ static size_t sim_recv(link_t *l, uint8_t *buf, size_t cap)
     return f;
 }
 
+/* Where the hand puts the stylus at board time t_s, its velocity, and button 1. */
+static void hand_at(const sim_link_t *s, double t_s, vec3_t *pos_m, vec3_t *vel_m_s, bool *b1)
+{
+    *pos_m = s->hold_m;
+    *vel_m_s = vec3(0, 0, 0);
+    *b1 = false;
+    if (s->hand != LINK_SIM_HAND_PRESS)
+        return;
+    const double u = (fmod(t_s, LINK_SIM_PRESS_PERIOD_S) - SIM_PRESS_START_S) / SIM_PRESS_LEN_S;
+    if (u <= 0.0 || u >= 1.0)
+        return;
+    const double w = M_PI / SIM_PRESS_LEN_S;
+    pos_m->z -= (float)(SIM_PRESS_DEPTH_M * sin(M_PI * u));
+    vel_m_s->z = (float)(-SIM_PRESS_DEPTH_M * w * cos(M_PI * u));
+    *b1 = true;
+}
+
 static void sim_tick(sim_link_t *s)
 {
-    sim_rig_set_hand(&s->rig, s->hold_m, vec3(0, 0, 0), false, false);
+    vec3_t pos_m, vel_m_s;
+    bool b1;
+    hand_at(s, (double)(s->ticks + s->skipped_ticks) * s->tick_us * 1e-6, &pos_m, &vel_m_s, &b1);
+    sim_rig_set_hand(&s->rig, pos_m, vel_m_s, b1, false);
     (void)sim_rig_step_ns(&s->rig, s->tick_us);
     s->ticks++;
 }
@@ -86,7 +113,7 @@ static void sim_close(link_t *l)
 
 static const link_ops_t SIM_OPS = {sim_send, sim_recv, sim_poll, sim_close};
 
-argil_err_t link_sim_open(link_t *l, char *err, size_t err_len)
+argil_err_t link_sim_open(link_t *l, link_sim_hand_t hand, char *err, size_t err_len)
 {
     sim_link_t *s = calloc(1, sizeof(*s));
     if (!s) {
@@ -102,6 +129,7 @@ argil_err_t link_sim_open(link_t *l, char *err, size_t err_len)
     }
     s->tick_us = cfg.board.tick_us;
     s->hold_m = sim_rig_tip_m(&s->rig);
+    s->hand = hand;
     link_attach(l, &SIM_OPS, s, true);
     return ARGIL_OK;
 }

@@ -113,7 +113,12 @@ link_spec_err_t link_spec_parse(const char *s, link_spec_t *spec)
         return LINK_SPEC_ERR_EMPTY;
     if (strncmp(s, "sim", 3) == 0 && (s[3] == '\0' || s[3] == ':')) {
         spec->kind = LINK_KIND_SIM;
-        return s[3] == '\0' ? LINK_SPEC_OK : LINK_SPEC_ERR_SIM_ARGS;
+        if (s[3] == '\0')
+            return LINK_SPEC_OK;
+        if (strcmp(s + 4, "press") != 0)
+            return LINK_SPEC_ERR_SIM_ARGS;
+        spec->sim_hand = LINK_SIM_HAND_PRESS;
+        return LINK_SPEC_OK;
     }
     if (strncmp(s, "udp", 3) == 0 && (s[3] == '\0' || s[3] == ':')) {
         spec->kind = LINK_KIND_UDP;
@@ -130,9 +135,9 @@ const char *link_spec_err_text(link_spec_err_t err)
 {
     switch (err) {
     case LINK_SPEC_OK: return "ok";
-    case LINK_SPEC_ERR_EMPTY: return "empty; use sim, udp:HOST:PORT or usb[:VID:PID|:BUS-PORT[.PORT...]]";
-    case LINK_SPEC_ERR_KIND: return "unknown kind; use sim, udp:HOST:PORT or usb[:VID:PID|:BUS-PORT[.PORT...]]";
-    case LINK_SPEC_ERR_SIM_ARGS: return "'sim' takes no arguments";
+    case LINK_SPEC_ERR_EMPTY: return "empty; use sim[:press], udp:HOST:PORT or usb[:VID:PID|:BUS-PORT[.PORT...]]";
+    case LINK_SPEC_ERR_KIND: return "unknown kind; use sim[:press], udp:HOST:PORT or usb[:VID:PID|:BUS-PORT[.PORT...]]";
+    case LINK_SPEC_ERR_SIM_ARGS: return "'sim' takes nothing after it but ':press'";
     case LINK_SPEC_ERR_UDP_FORM: return "expected udp:HOST:PORT";
     case LINK_SPEC_ERR_UDP_HOST: return "the UDP host must be an IPv4 address or a host name (letters, digits, '.', '-', '_'; at most 63)";
     case LINK_SPEC_ERR_UDP_PORT: return "the UDP port must be a whole number 1..65535";

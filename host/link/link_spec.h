@@ -1,5 +1,6 @@
 /* The device string of the host link: which board to talk to and over what ("sim",
- * "udp:HOST:PORT", "usb", "usb:VID:PID", "usb:BUS-PORT.PORT…"). Parsing only; nothing opens. */
+ * "sim:press", "udp:HOST:PORT", "usb", "usb:VID:PID", "usb:BUS-PORT.PORT…"). Parsing only;
+ * nothing opens. */
 #ifndef ARGIL_LINK_SPEC_H
 #define ARGIL_LINK_SPEC_H
 
@@ -17,7 +18,7 @@ typedef enum {
     LINK_SPEC_OK = 0,
     LINK_SPEC_ERR_EMPTY = -1,      /* no string, or an empty one */
     LINK_SPEC_ERR_KIND = -2,       /* not sim, udp: or usb */
-    LINK_SPEC_ERR_SIM_ARGS = -3,   /* "sim" takes nothing after it */
+    LINK_SPEC_ERR_SIM_ARGS = -3,   /* "sim" takes nothing after it but ":press" */
     LINK_SPEC_ERR_UDP_FORM = -4,   /* udp without HOST:PORT */
     LINK_SPEC_ERR_UDP_HOST = -5,   /* empty, too long, or bad characters */
     LINK_SPEC_ERR_UDP_PORT = -6,   /* not a whole number 1..65535 */
@@ -28,8 +29,16 @@ typedef enum {
     LINK_SPEC_ERR_USB_FORM = -11   /* neither VID:PID nor BUS-PORT[.PORT…] */
 } link_spec_err_t;
 
+/* What the simulated board's hand does with the stylus. */
+typedef enum {
+    LINK_SIM_HAND_STILL = 0,       /* "sim": holds it still 10 mm above the clay, no button */
+    LINK_SIM_HAND_PRESS            /* "sim:press": presses it into the clay with button 1 held,
+                                    * once every LINK_SIM_PRESS_PERIOD_S (link_sim.c) */
+} link_sim_hand_t;
+
 typedef struct {
     link_kind_t kind;
+    link_sim_hand_t sim_hand;        /* sim */
     char host[LINK_SPEC_HOST_MAX];   /* udp */
     uint16_t port;                   /* udp */
     uint16_t vid, pid;               /* usb: the device to find (default 1209:0001) */

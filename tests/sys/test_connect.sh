@@ -39,7 +39,7 @@ expect_error 2 "bad device 'udp:127.0.0.1': expected udp:HOST:PORT" --device udp
 expect_error 2 "the UDP port must be a whole number 1..65535" --device udp:127.0.0.1:70000 --out "$tmp/o"
 expect_error 2 "1 to 4 hex digits" --device usb:12345:1 --out "$tmp/o"
 expect_error 2 "each USB port must be a number" --device usb:1-x --out "$tmp/o"
-expect_error 2 "'sim' takes no arguments" --device sim:fast --out "$tmp/o"
+expect_error 2 "'sim' takes nothing after it but ':press'" --device sim:fast --out "$tmp/o"
 expect_error 2 "unknown option '--frobnicate'" --frobnicate
 expect_error 2 "--seconds must be a number > 0" --device sim --seconds -1
 expect_error 1 "usb 1209:0001: no such device\|usb: cannot start libusb" --device usb --seconds 1 --out "$tmp/o"

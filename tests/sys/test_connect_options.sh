@@ -12,9 +12,11 @@
 #      what a clean run of the same session writes (the sim hand holds still above the clay, so
 #      nothing edits the clay: the base snapshot alone must give the clean run's model; the
 #      R = 2 "seed" record this test once expected was the empty-model bug that
-#      test_connect_clay_rest.sh now guards).
-# The sim board's hand holds the stylus still 10 mm above the clay with no button pressed
-# (host/link/link_sim.c), so no tool touches the clay here: what each action does to the clay is
+#      test_connect_clay_rest.sh now guards);
+#   5. SIGKILL of a session that carves (the sim hand presses into the clay, "sim:press"): recover
+#      replays its journal's records (at least one) into a model that is not the base.
+# In 1-4 the sim board's hand holds the stylus still 10 mm above the clay with no button pressed
+# (host/link/link_sim.c), so no tool touches the clay: what each action does to the clay is
 # tested in the lockstep session (tests/unit/test_script_host_tool.c, test_gsolve_host_tool.c).
 set -eu
 bin="$REL/argil"
@@ -111,14 +113,16 @@ cpid=
 "$bin" connect --device sim --seconds 30 --arm --knot-ratio 2 --autosave-s 0.05 --quiet \
     --out "$tmp/k" >"$tmp/k.out" 2>"$tmp/k.err" &
 cpid=$!
-# Kill once the seed's record is durable (header 160 bytes + a record), at most 20 s.
+# Kill once the journal is started (its base written and its header durable, 160 bytes; the
+# still hand adds no record), at most 20 s.
 n=0
-while [ "$(stat -c %s "$tmp/k/journal.log" 2>/dev/null || echo 0)" -le 160 ] && [ "$n" -lt 200 ]; do
+while { [ ! -s "$tmp/k/journal-base-0.argil" ] ||
+        [ "$(stat -c %s "$tmp/k/journal.log" 2>/dev/null || echo 0)" -lt 160 ]; } && [ "$n" -lt 200 ]; do
     sleep 0.1
     n=$((n + 1))
 done
 sleep 0.3
-kill -9 "$cpid"
+kill -9 "$cpid" 2>/dev/null || fail "the session ended before it could be killed: $(cat "$tmp/k.err")"
 wait "$cpid" 2>/dev/null || true
 cpid=
 [ -s "$tmp/k/journal.log" ] && [ -s "$tmp/k/journal-base-0.argil" ] ||
@@ -135,4 +139,30 @@ recs=$(number_after "journal records    " "$tmp/r.out")
     fail "clean run failed"
 cmp "$tmp/c/model.argil" "$tmp/k/recovered.argil" ||
     fail "the recovered model differs from a clean run's model.argil"
-echo "argil connect: option errors are one line (exit 2); settings echoed and sent to the board; killed session recovered byte for byte ($recs records)"
+
+# 5. A session that edits the clay: the sim board's hand presses the stylus 4 mm into the clay
+#    every 2 s with button 1 held (--device sim:press) and the host carves. SIGKILL once the
+#    journal holds edits: recover replays at least one record, and the model it rebuilds is not
+#    the journal's base (the carve is in it).
+"$bin" connect --device sim:press --seconds 60 --arm --action carve --autosave-s 0.05 --quiet \
+    --out "$tmp/p" >"$tmp/p.out" 2>"$tmp/p.err" &
+cpid=$!
+n=0
+while [ "$(stat -c %s "$tmp/p/journal.log" 2>/dev/null || echo 0)" -le 4096 ] && [ "$n" -lt 300 ]; do
+    sleep 0.1
+    n=$((n + 1))
+done
+sleep 0.3
+kill -9 "$cpid" 2>/dev/null || fail "the pressing session ended before it could be killed: $(cat "$tmp/p.err")"
+wait "$cpid" 2>/dev/null || true
+cpid=
+[ -s "$tmp/p/journal.log" ] && [ -s "$tmp/p/journal-base-0.argil" ] ||
+    fail "no journal after SIGKILL of the pressing session: $(ls "$tmp/p")"
+"$bin" recover "$tmp/p" >"$tmp/pr.out" 2>&1 || fail "recover: $(cat "$tmp/pr.out")"
+cat "$tmp/pr.out"
+precs=$(number_after "journal records    " "$tmp/pr.out")
+[ -n "$precs" ] && [ "$precs" -ge 1 ] ||
+    fail "recover replayed ${precs:-no} records of a session that carved, want >= 1"
+cmp -s "$tmp/p/journal-base-0.argil" "$tmp/p/recovered.argil" &&
+    fail "the recovered model is the journal's base: the carve was not replayed"
+echo "argil connect: option errors are one line (exit 2); settings echoed and sent to the board; killed session recovered byte for byte ($recs records); a carving session's journal replayed ($precs records)"
