@@ -212,7 +212,8 @@ typedef struct {
  * statistics since it started. All times in ns. */
 typedef struct {
     uint64_t time_us;        /* board clock */
-    uint32_t ticks;          /* ticks measured */
+    uint32_t ticks;          /* ticks measured (in the simulation not those the machine
+                              * preempted: docs/board.md, "Timing a simulated tick") */
     uint32_t period_ns;      /* loop period, > 0 */
     uint32_t wake_min_ns;    /* wake-up latency: min ≤ mean ≤ max */
     uint32_t wake_mean_ns;

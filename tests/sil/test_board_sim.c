@@ -168,6 +168,9 @@ static void test_host_receives_the_boards_rt_stats_every_second(void **st)
     /* some work: the tool goes to the clay and back */
     rig_move(r, vec3(0, 0, 0.031f), 500);
     rig_move(r, vec3(0, 0, 0.045f), 500);
+    while (r->rig.board.stats.ticks < 3000u)
+        rig_tick(r);
+    const uint32_t untimed = r->rig.board.stats.preempted_ticks; /* of ticks 1 … 2999 */
     while (r->rig.board.stats.ticks < 3500u)
         rig_tick(r);
     const msg_rt_stats_t *rt = &r->peer.last_rt;
@@ -177,7 +180,9 @@ static void test_host_receives_the_boards_rt_stats_every_second(void **st)
     /* the newest covers every tick up to its send: within one period of the board's count */
     assert_true(rt->ticks + 1000u >= r->rig.board.stats.ticks);
     assert_true(rt->ticks <= r->rig.board.stats.ticks);
-    assert_int_equal(rt->ticks, 2999u); /* sent in tick 3000, recording ticks 1 … 2999 */
+    /* sent in tick 3000, recording ticks 1 … 2999 but those the machine preempted (not timed
+     * in the simulation: docs/board.md, "Timing a simulated tick") */
+    assert_int_equal(rt->ticks + untimed, 2999u);
     assert_int_equal(rt->period_ns, 1000000u);
     assert_true(rt->time_us == 3000000u);
     /* lockstep: the loop never sleeps late; compute times are real and well under 1 ms */
