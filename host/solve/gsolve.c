@@ -27,13 +27,6 @@ static float *scratch(gsolve_t *gs, size_t n)
     return gs->buf;
 }
 
-/* Intersection of [lo, hi) with the grid; false when empty. */
-static bool clip_to_grid(const grid_t *g, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
-                         int32_t chi[3])
-{
-    return grid_clip(g, lo, hi, clo, chi);
-}
-
 /* Copies the field's densities in sample box [lo, hi) (clipped to the grid) into the grid,
  * clamped to [0, 1], where they differ by more than GSOLVE_VIEW_EPS (so the round-off of a
  * field at rest neither re-sends windows nor fills the journal); returns the largest change
@@ -43,7 +36,7 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
     int32_t hi[3], a0[3], a1[3];
     for (int a = 0; a < 3; a++)
         hi[a] = lo[a] + n[a];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return 0.0f;
     /* The grid's box, changed where the field moved it, stored back when anything changed. */
     int32_t an[3];
@@ -79,7 +72,7 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
 static float view_to_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return 0.0f;
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
@@ -135,18 +128,16 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     return e;
 }
 
-static void close_window(gsolve_t *gs);
-
 void gsolve_free(gsolve_t *gs)
 {
-    close_window(gs);
+    gsolve_close_window(gs);
     field_free(&gs->field);
     free(gs->buf);
     gs->buf = NULL;
     gs->buf_n = 0;
 }
 
-static void close_window(gsolve_t *gs)
+void gsolve_close_window(gsolve_t *gs)
 {
     if (gs->win_open)
         physwin_close(&gs->win);
@@ -273,11 +264,6 @@ static void coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3],
     }
 }
 
-void gsolve_close_window(gsolve_t *gs)
-{
-    close_window(gs);
-}
-
 int32_t gsolve_ratio(const gsolve_t *gs)
 {
     return gs->field.ratio;
@@ -297,7 +283,7 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
      * but not the region: its box is in samples, which the refinement keeps, so its next step
      * reopens it on the fine lattice and the clay in it moves on. */
     const bool settling = gs->settle.active;
-    close_window(gs);
+    gsolve_close_window(gs);
     gs->settle.active = settling;
     int32_t zero[3], top[3], gd[3];
     grid_bounds(g, zero, top);
@@ -381,7 +367,7 @@ static void seed_fit_at(void *ctx, const float *r, float *out)
 static argil_err_t seed_fit(field_t *f, const grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     int32_t a0[3], a1[3], clo[3], chi[3], nc[3], ns[3];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return ARGIL_OK;
     field_coefs_of_samples(f, a0, a1, clo, chi);
     size_t ncoef = 1, nsamp = 1;
@@ -421,7 +407,7 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
     for (int a = 0; a < 3; a++)
         if (hi[a] <= lo[a])
             return ARGIL_ERR_ARG;
-    close_window(gs);
+    gsolve_close_window(gs);
     field_coefs_of_samples(f, lo, hi, clo, chi);
     size_t ncoef = 1, nsamp = 1;
     field_samples_of_coefs(f, clo, chi, slo, shi);
@@ -464,7 +450,7 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
     if (view_to_grid(gs, g, slo, shi) < 0.0f)
         return ARGIL_ERR_NOMEM;
     int32_t a0[3], a1[3];
-    if (clip_to_grid(g, slo, shi, a0, a1))
+    if (grid_clip(g, slo, shi, a0, a1))
         for (int32_t z = a0[2]; z < a1[2]; z++)
             for (int32_t y = a0[1]; y < a1[1]; y++)
                 for (int32_t x = a0[0]; x < a1[0]; x++) {
@@ -539,7 +525,7 @@ static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physw
 static void grow_changed(const grid_t *g, const physwin_t *w, int32_t dlo[3], int32_t dhi[3])
 {
     int32_t a0[3], a1[3];
-    if (!clip_to_grid(g, w->slo, w->shi, a0, a1))
+    if (!grid_clip(g, w->slo, w->shi, a0, a1))
         return;
     const bool empty = dhi[0] <= dlo[0];
     for (int a = 0; a < 3; a++) {
@@ -753,7 +739,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
             shift_win(&gs->win, f->ratio, old_lo, new_lo);
             const argil_err_t e = reload_window(gs, dt_s, true);
             if (e != ARGIL_OK) {
-                close_window(gs);
+                gsolve_close_window(gs);
                 return e;
             }
             gs->stats.windows_moved++;
@@ -790,7 +776,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     memset(s->force_n, 0, s->nsamp * sizeof(float));
     bool forced = false;
     int32_t a0[3], a1[3];
-    if (clip_to_grid(g, w->slo, w->shi, a0, a1)) {
+    if (grid_clip(g, w->slo, w->shi, a0, a1)) {
         /* The grid holds every index the window can have: its box is the window's. */
         const int32_t ns[3] = {w->shi[0] - w->slo[0], w->shi[1] - w->slo[1],
                                w->shi[2] - w->slo[2]};
@@ -818,7 +804,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     argil_err_t e = solver_step_implicit(s);
     if (e != ARGIL_OK) {
         /* A non-finite step is not stored: the field keeps its last good state. */
-        close_window(gs);
+        gsolve_close_window(gs);
         return e;
     }
     gs->stats.steps++;
@@ -830,7 +816,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     float change = 0.0f;
     e = store_step(gs, g, w, NULL, dt_s, forced, GSOLVE_REST_DD, &change, &gs->resting);
     if (e != ARGIL_OK) {
-        close_window(gs);
+        gsolve_close_window(gs);
         return e;
     }
     if (change > 0.0f) {
@@ -911,7 +897,7 @@ argil_err_t gsolve_material_to_grid(const gsolve_t *gs, grid_t *g, const int32_t
                                     const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return ARGIL_OK;
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
@@ -1091,7 +1077,7 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
             paints ? colour_to_grid(gs, g, slo, shi) : view_to_grid(gs, g, slo, shi);
         if (change < 0.0f)
             return ARGIL_ERR_NOMEM;
-        if (change > 0.0f && clip_to_grid(g, slo, shi, clo, chi)) {
+        if (change > 0.0f && grid_clip(g, slo, shi, clo, chi)) {
             for (int a = 0; a < 3; a++) {
                 lo[a] = any && lo[a] < clo[a] ? lo[a] : clo[a];
                 hi[a] = any && hi[a] > chi[a] ? hi[a] : chi[a];
@@ -1117,7 +1103,7 @@ static uint8_t colour_byte(float v)
 static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return 0.0f;
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
@@ -1187,9 +1173,9 @@ argil_err_t gsolve_restored(gsolve_t *gs, grid_t *g, const int32_t lo[3], const 
     for (int a = 0; a < 3; a++)
         glo[a] = ghi[a] = 0;
     /* The window holds its own p and velocity: the next step reopens it from the field. */
-    close_window(gs);
+    gsolve_close_window(gs);
     int32_t a0[3], a1[3];
-    if (!clip_to_grid(g, lo, hi, a0, a1))
+    if (!grid_clip(g, lo, hi, a0, a1))
         return ARGIL_OK;
     if (view_to_grid(gs, g, a0, a1) < 0.0f)
         return ARGIL_ERR_NOMEM;
