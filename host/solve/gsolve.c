@@ -1,5 +1,6 @@
 /* The session's global solve on the B-spline model: field + physical window + grid view. */
 #include "host/solve/gsolve.h"
+#include "host/solve/gsolve_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,12 +11,7 @@
 #include "host/model/material.h"
 #include "host/model/tools.h"
 
-static float clamp01(float v)
-{
-    return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
-}
-
-static float *scratch(gsolve_t *gs, size_t n)
+float *gsolve_scratch(gsolve_t *gs, size_t n)
 {
     if (n > gs->buf_n) {
         float *b = realloc(gs->buf, n * sizeof(float));
@@ -31,7 +27,7 @@ static float *scratch(gsolve_t *gs, size_t n)
  * clamped to [0, 1], where they differ by more than GSOLVE_VIEW_EPS (so the round-off of a
  * field at rest neither re-sends windows nor fills the journal); returns the largest change
  * written, or -1 when out of memory. */
-static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const int32_t n[3])
+float gsolve_dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const int32_t n[3])
 {
     int32_t hi[3], a0[3], a1[3];
     for (int a = 0; a < 3; a++)
@@ -54,7 +50,7 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
                                                    (size_t)n[1] * (size_t)(z - lo[2])) -
                                lo[0];
             for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
-                const float v = clamp01(src[x]);
+                const float v = gsolve_clamp01(src[x]);
                 const float c = fabsf(v - cur[k]);
                 if (c > GSOLVE_VIEW_EPS) {
                     if (c > change)
@@ -69,18 +65,18 @@ static float dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
     return change;
 }
 
-static float view_to_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
+float gsolve_view_to_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
     if (!grid_clip(g, lo, hi, a0, a1))
         return 0.0f;
     for (int a = 0; a < 3; a++)
         n[a] = a1[a] - a0[a];
-    float *d = scratch(gs, (size_t)n[0] * n[1] * n[2]);
+    float *d = gsolve_scratch(gs, (size_t)n[0] * n[1] * n[2]);
     if (!d)
         return -1.0f;
     sparse_read_box(&gs->field.samp, FS_D, a0, n, d);
-    return dense_to_grid(g, d, a0, n);
+    return gsolve_dense_to_grid(g, d, a0, n);
 }
 
 void gsolve_set_material(gsolve_t *gs, const spring_material_t *m)
@@ -162,7 +158,7 @@ static float *win_scratch(gsolve_t *gs, const physwin_t *w, int32_t nc[3], int32
         nc[a] = w->chi[a] - w->clo[a];
         ns[a] = w->shi[a] - w->slo[a];
     }
-    float *d = scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
+    float *d = gsolve_scratch(gs, s->nsamp + (s->nsamp > s->ncoef ? s->nsamp : s->ncoef));
     if (d)
         *tmp = d + s->nsamp;
     return d;
@@ -173,7 +169,8 @@ static float *win_scratch(gsolve_t *gs, const physwin_t *w, int32_t nc[3], int32
  * after the window was shifted by whole knot spans, when the fixed flags and the material are
  * read too. The taps repeat every knot span, so they stay, and no array is reallocated (a
  * fresh physwin_open of a 32³ window faults in ~7 MB of new pages). */
-static argil_err_t reload_win(gsolve_t *gs, physwin_t *w, float dt_s, bool moved, bool *plain_io)
+argil_err_t gsolve_win_reload(gsolve_t *gs, physwin_t *w, float dt_s, bool moved,
+                              bool *plain_io)
 {
     solver_t *s = &w->solver;
     const field_t *f = &gs->field;
@@ -230,7 +227,7 @@ static argil_err_t reload_win(gsolve_t *gs, physwin_t *w, float dt_s, bool moved
 
 static argil_err_t reload_window(gsolve_t *gs, float dt_s, bool moved)
 {
-    const argil_err_t e = reload_win(gs, &gs->win, dt_s, moved, &gs->win_plain);
+    const argil_err_t e = gsolve_win_reload(gs, &gs->win, dt_s, moved, &gs->win_plain);
     if (e == ARGIL_OK) {
         gs->stale = false;
         gs->resting = false;
@@ -240,7 +237,8 @@ static argil_err_t reload_window(gsolve_t *gs, float dt_s, bool moved)
 
 /* Shifts an open window whose sample box was at old_lo to new_lo (same size, by whole knot
  * spans: the taps repeat every span, so only the boxes move). */
-static void shift_win(physwin_t *w, int32_t ratio, const int32_t old_lo[3], const int32_t new_lo[3])
+void gsolve_win_shift(physwin_t *w, int32_t ratio, const int32_t old_lo[3],
+                      const int32_t new_lo[3])
 {
     for (int a = 0; a < 3; a++) {
         const int32_t shift = new_lo[a] - old_lo[a];
@@ -253,7 +251,7 @@ static void shift_win(physwin_t *w, int32_t ratio, const int32_t old_lo[3], cons
 
 /* Coefficient box of the sample box [lo, hi): every coefficient centred in it, at least 4 per
  * axis. */
-static void coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
+void gsolve_coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
                      int32_t chi[3])
 {
     for (int a = 0; a < 3; a++) {
@@ -322,7 +320,7 @@ argil_err_t gsolve_refine(gsolve_t *gs, grid_t *g, float *max_dd, int32_t lo[3],
                 if (c > dd)
                     dd = c;
                 if (c > GSOLVE_VIEW_EPS) {
-                    if (grid_set(g, GRID_DENSITY, x, y, z, clamp01(after[i])) != ARGIL_OK) {
+                    if (grid_set(g, GRID_DENSITY, x, y, z, gsolve_clamp01(after[i])) != ARGIL_OK) {
                         free(before);
                         return ARGIL_ERR_NOMEM;
                     }
@@ -417,7 +415,7 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         ncoef *= (size_t)nc[a];
         nsamp *= (size_t)ns[a];
     }
-    float *p = scratch(gs, ncoef > nsamp ? ncoef : nsamp);
+    float *p = gsolve_scratch(gs, ncoef > nsamp ? ncoef : nsamp);
     if (!p)
         return ARGIL_ERR_NOMEM;
     /* Quasi-interpolation: coefficient c takes the density at its own sample R c. */
@@ -440,14 +438,14 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
         e = field_refresh(f, slo, shi);
     if (e != ARGIL_OK)
         return e;
-    p = scratch(gs, nsamp); /* field_refresh may not move it, but re-take it anyway */
+    p = gsolve_scratch(gs, nsamp); /* field_refresh may not move it, but re-take it anyway */
     if (!p)
         return ARGIL_ERR_NOMEM;
     sparse_read_box(&f->samp, FS_D, slo, ns, p);
     e = sparse_write_box(&f->samp, FS_REST, slo, ns, p);
     if (e != ARGIL_OK)
         return e;
-    if (view_to_grid(gs, g, slo, shi) < 0.0f)
+    if (gsolve_view_to_grid(gs, g, slo, shi) < 0.0f)
         return ARGIL_ERR_NOMEM;
     int32_t a0[3], a1[3];
     if (grid_clip(g, slo, shi, a0, a1))
@@ -468,9 +466,9 @@ argil_err_t gsolve_seed_from_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], 
  * Rest: no force acted and no sample of the view moved by rest_dd; the velocity is then
  * zeroed (CG's 8 iterations leave the B-spline's high-frequency modes, which barely show in
  * the samples, almost undamped: their round-off would otherwise drift on). */
-static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physwin_t *skip,
-                              float dt_s, bool forced, float rest_dd, float *change_out,
-                              bool *resting_out)
+argil_err_t gsolve_win_store(gsolve_t *gs, grid_t *g, physwin_t *w, const physwin_t *skip,
+                             float dt_s, bool forced, float rest_dd, float *change_out,
+                             bool *resting_out)
 {
     field_t *f = &gs->field;
     solver_t *s = &w->solver;
@@ -499,7 +497,7 @@ static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physw
                 }
         e = sparse_write_box(&f->samp, FS_REST, w->slo, ns, tmp);
     }
-    const float change = dense_to_grid(g, d, w->slo, ns);
+    const float change = gsolve_dense_to_grid(g, d, w->slo, ns);
     const bool resting = !forced && change < rest_dd;
     if (resting)
         memcpy(s->p_prev, s->p, s->ncoef * sizeof(float));
@@ -522,7 +520,7 @@ static argil_err_t store_step(gsolve_t *gs, grid_t *g, physwin_t *w, const physw
 }
 
 /* Grows the changed box [dlo, dhi) (empty when dlo = dhi) by w's samples clipped to the grid. */
-static void grow_changed(const grid_t *g, const physwin_t *w, int32_t dlo[3], int32_t dhi[3])
+void gsolve_grow_changed(const grid_t *g, const physwin_t *w, int32_t dlo[3], int32_t dhi[3])
 {
     int32_t a0[3], a1[3];
     if (!grid_clip(g, w->slo, w->shi, a0, a1))
@@ -537,7 +535,7 @@ static void grow_changed(const grid_t *g, const physwin_t *w, int32_t dlo[3], in
 /* The board's window moved away from the box [lo, hi) while the clay in it still moved: step
  * that box on as the settling region (replacing an older one, whose velocity stays in the
  * field and resumes when a window covers it again). */
-static void settle_take(gsolve_t *gs, const int32_t lo[3], const int32_t hi[3])
+void gsolve_settle_take(gsolve_t *gs, const int32_t lo[3], const int32_t hi[3])
 {
     gsolve_settle_t *st = &gs->settle;
     if (st->active)
@@ -587,15 +585,15 @@ static bool settle_clip_box(int32_t clo[3], int32_t chi[3], const int32_t wlo[3]
  * holds free is fixed here (block Gauss-Seidel: each coefficient moves once per period), the
  * rest of its box moves freely with no external force. Reloaded every step, since the main
  * window has just moved coefficients it reads. */
-static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[3], int32_t dhi[3],
-                               float *max_change)
+argil_err_t gsolve_settle_step(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[3],
+                               int32_t dhi[3], float *max_change)
 {
     gsolve_settle_t *st = &gs->settle;
     field_t *f = &gs->field;
     physwin_t *w = &st->win;
     argil_err_t e;
     int32_t clo[3], chi[3];
-    coef_box(f, st->box_lo, st->box_hi, clo, chi);
+    gsolve_coef_box(f, st->box_lo, st->box_hi, clo, chi);
     /* Every step, against where the main window is now (it may have moved on without taking a
      * newer region, when it rested): the region's free coefficients are the same either way. */
     if (gs->settle_clip && gs->win_open && !settle_clip_box(clo, chi, gs->win.clo, gs->win.chi)) {
@@ -613,7 +611,7 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
                 old_lo[a] = w->clo[a] * f->ratio;
                 new_lo[a] = clo[a] * f->ratio;
             }
-            shift_win(w, f->ratio, old_lo, new_lo);
+            gsolve_win_shift(w, f->ratio, old_lo, new_lo);
         } else {
             physwin_close(w);
             st->open = false;
@@ -637,7 +635,7 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
         st->open = true;
         st->plain = false;
     }
-    e = reload_win(gs, w, dt_s, true, &st->plain);
+    e = gsolve_win_reload(gs, w, dt_s, true, &st->plain);
     if (e != ARGIL_OK) {
         physwin_close(w);
         st->open = st->active = false;
@@ -687,7 +685,7 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
     bool quiet = false;
     st->quiet_steps++;
     /* Velocity zeroed only on the last of the quiet steps, when the region rests. */
-    e = store_step(gs, g, w, gs->win_open ? &gs->win : NULL, dt_s, false,
+    e = gsolve_win_store(gs, g, w, gs->win_open ? &gs->win : NULL, dt_s, false,
                    st->quiet_steps >= GSOLVE_SETTLE_QUIET_STEPS ? GSOLVE_SETTLE_DD : 0.0f, &change,
                    &quiet);
     if (e != ARGIL_OK) {
@@ -696,7 +694,7 @@ static argil_err_t step_settle(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
         return e;
     }
     if (change > 0.0f) {
-        grow_changed(g, w, dlo, dhi);
+        gsolve_grow_changed(g, w, dlo, dhi);
         if (change > *max_change)
             *max_change = change;
         /* The main window's fixed part (d of the coefficients outside it) changed. */
@@ -719,12 +717,12 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     field_t *f = &gs->field;
     /* The coefficients whose samples cover the box (at least 4 per axis). */
     int32_t clo[3], chi[3];
-    coef_box(f, lo, hi, clo, chi);
+    gsolve_coef_box(f, lo, hi, clo, chi);
     if (gs->win_open && (memcmp(clo, gs->win.clo, sizeof(clo)) != 0 ||
                          memcmp(chi, gs->win.chi, sizeof(chi)) != 0)) {
         /* The clay the window leaves behind may still be moving: keep stepping it. */
         if (!gs->resting && gs->settle_enabled)
-            settle_take(gs, gs->box_lo, gs->box_hi);
+            gsolve_settle_take(gs, gs->box_lo, gs->box_hi);
         /* Same size, shifted by whole knot spans (R samples each; a box that moved less stays
          * on the same coefficients): move the open window instead of reopening. */
         bool same = true;
@@ -736,7 +734,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
                 old_lo[a] = gs->win.clo[a] * f->ratio;
                 new_lo[a] = clo[a] * f->ratio;
             }
-            shift_win(&gs->win, f->ratio, old_lo, new_lo);
+            gsolve_win_shift(&gs->win, f->ratio, old_lo, new_lo);
             const argil_err_t e = reload_window(gs, dt_s, true);
             if (e != ARGIL_OK) {
                 gsolve_close_window(gs);
@@ -814,13 +812,13 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
     if (s->stats.residual > gs->stats.max_residual)
         gs->stats.max_residual = s->stats.residual;
     float change = 0.0f;
-    e = store_step(gs, g, w, NULL, dt_s, forced, GSOLVE_REST_DD, &change, &gs->resting);
+    e = gsolve_win_store(gs, g, w, NULL, dt_s, forced, GSOLVE_REST_DD, &change, &gs->resting);
     if (e != ARGIL_OK) {
         gsolve_close_window(gs);
         return e;
     }
     if (change > 0.0f) {
-        grow_changed(g, w, dlo, dhi);
+        gsolve_grow_changed(g, w, dlo, dhi);
         *max_change = change;
     }
     return ARGIL_OK;
@@ -836,7 +834,7 @@ argil_err_t gsolve_step(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int3
         return ARGIL_ERR_ARG;
     argil_err_t e = step_main(gs, g, lo, hi, dt_s, dlo, dhi, max_change);
     if (e == ARGIL_OK && gs->settle.active)
-        e = step_settle(gs, g, dt_s, dlo, dhi, max_change);
+        e = gsolve_settle_step(gs, g, dt_s, dlo, dhi, max_change);
     return e;
 }
 
@@ -945,8 +943,6 @@ argil_err_t gsolve_material_from_grid(gsolve_t *gs, const grid_t *g)
 }
 
 /* ---- the session's host tool (host/model/host_tool.h) ---- */
-
-static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3]);
 
 static const tool_action_t HOST_TO_TOOL_ACTION[HOST_ACT_COUNT] = {
     [HOST_ACT_CARVE] = TOOL_CARVE,       [HOST_ACT_ADD] = TOOL_ADD,
@@ -1073,8 +1069,8 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
             slo[a] = (int32_t)floorf((bmin[a] - org[a] - reach_m) / f->sample_spacing_m);
             shi[a] = (int32_t)ceilf((bmax[a] - org[a] + reach_m) / f->sample_spacing_m) + 1;
         }
-        const float change =
-            paints ? colour_to_grid(gs, g, slo, shi) : view_to_grid(gs, g, slo, shi);
+        const float change = paints ? gsolve_colour_box_to_grid(gs, g, slo, shi)
+                                    : gsolve_view_to_grid(gs, g, slo, shi);
         if (change < 0.0f)
             return ARGIL_ERR_NOMEM;
         if (change > 0.0f && grid_clip(g, slo, shi, clo, chi)) {
@@ -1093,14 +1089,15 @@ argil_err_t gsolve_apply_tool(gsolve_t *gs, grid_t *g, const host_tool_t *ht, fl
 /* A colour channel value (0..1) as the grid's byte. */
 static uint8_t colour_byte(float v)
 {
-    const float c = clamp01(v) * 255.0f;
+    const float c = gsolve_clamp01(v) * 255.0f;
     return (uint8_t)lrintf(isfinite(c) ? c : 0.0f);
 }
 
 /* Copies the model's FS_R/G/B in sample box [lo, hi) (clipped to the grid) into the grid's colour
  * as bytes (a block holds a colour array only once one of its samples differs from
  * GRID_RGB_DEFAULT); bumps g->rgb_writes when anything changed. Returns 1 when something changed, 0 when nothing did, -1 when out of memory. */
-static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
+float gsolve_colour_box_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3],
+                                const int32_t hi[3])
 {
     int32_t a0[3], a1[3], n[3];
     if (!grid_clip(g, lo, hi, a0, a1))
@@ -1139,7 +1136,7 @@ static float colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3], 
 argil_err_t gsolve_colour_to_grid(const gsolve_t *gs, grid_t *g, const int32_t lo[3],
                                   const int32_t hi[3])
 {
-    return colour_to_grid(gs, g, lo, hi) < 0.0f ? ARGIL_ERR_NOMEM : ARGIL_OK;
+    return gsolve_colour_box_to_grid(gs, g, lo, hi) < 0.0f ? ARGIL_ERR_NOMEM : ARGIL_OK;
 }
 
 argil_err_t gsolve_colour_from_grid(gsolve_t *gs, const grid_t *g)
@@ -1177,7 +1174,7 @@ argil_err_t gsolve_restored(gsolve_t *gs, grid_t *g, const int32_t lo[3], const 
     int32_t a0[3], a1[3];
     if (!grid_clip(g, lo, hi, a0, a1))
         return ARGIL_OK;
-    if (view_to_grid(gs, g, a0, a1) < 0.0f)
+    if (gsolve_view_to_grid(gs, g, a0, a1) < 0.0f)
         return ARGIL_ERR_NOMEM;
     int32_t an[3];
     for (int a = 0; a < 3; a++)
