@@ -1,12 +1,16 @@
-/* The session's global solve on the B-spline model: field + physical window + grid view. */
+/* The global solve's object (gsolve.h): its init from the grid, the scratch its parts share,
+ * closing its windows, its free. Each of its jobs has its own file: gsolve_step.c (one period),
+ * gsolve_window.c, gsolve_settle.c, gsolve_view.c, gsolve_seed.c, gsolve_refine.c,
+ * gsolve_material.c, gsolve_host_tool.c, gsolve_colour.c, gsolve_restore.c. */
 #include "host/solve/gsolve.h"
-#include "host/solve/gsolve_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/solve/gsolve_internal.h"
 
+/* gs->buf grown to at least n floats; NULL when out of memory. */
 float *gsolve_scratch(gsolve_t *gs, size_t n)
 {
     if (n > gs->buf_n) {
@@ -19,67 +23,13 @@ float *gsolve_scratch(gsolve_t *gs, size_t n)
     return gs->buf;
 }
 
-/* Copies the field's densities in sample box [lo, hi) (clipped to the grid) into the grid,
- * clamped to [0, 1], where they differ by more than GSOLVE_VIEW_EPS (so the round-off of a
- * field at rest neither re-sends windows nor fills the journal); returns the largest change
- * written, or -1 when out of memory. */
-float gsolve_dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const int32_t n[3])
-{
-    int32_t hi[3], a0[3], a1[3];
-    for (int a = 0; a < 3; a++)
-        hi[a] = lo[a] + n[a];
-    if (!grid_clip(g, lo, hi, a0, a1))
-        return 0.0f;
-    /* The grid's box, changed where the field moved it, stored back when anything changed. */
-    int32_t an[3];
-    for (int a = 0; a < 3; a++)
-        an[a] = a1[a] - a0[a];
-    float *cur = malloc((size_t)an[0] * (size_t)an[1] * (size_t)an[2] * sizeof(float));
-    if (cur == NULL)
-        return -1.0f;
-    grid_read_box(g, GRID_DENSITY, a0, an, cur);
-    float change = 0.0f;
-    size_t k = 0;
-    for (int32_t z = a0[2]; z < a1[2]; z++)
-        for (int32_t y = a0[1]; y < a1[1]; y++) {
-            const float *src = d + (size_t)n[0] * ((size_t)(y - lo[1]) +
-                                                   (size_t)n[1] * (size_t)(z - lo[2])) -
-                               lo[0];
-            for (int32_t x = a0[0]; x < a1[0]; x++, k++) {
-                const float v = gsolve_clamp01(src[x]);
-                const float c = fabsf(v - cur[k]);
-                if (c > GSOLVE_VIEW_EPS) {
-                    if (c > change)
-                        change = c;
-                    cur[k] = v;
-                }
-            }
-        }
-    if (change > 0.0f && grid_write_box(g, GRID_DENSITY, a0, an, cur) != ARGIL_OK)
-        change = -1.0f;
-    free(cur);
-    return change;
-}
-
-float gsolve_view_to_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3])
-{
-    int32_t a0[3], a1[3], n[3];
-    if (!grid_clip(g, lo, hi, a0, a1))
-        return 0.0f;
-    for (int a = 0; a < 3; a++)
-        n[a] = a1[a] - a0[a];
-    float *d = gsolve_scratch(gs, (size_t)n[0] * n[1] * n[2]);
-    if (!d)
-        return -1.0f;
-    sparse_read_box(&gs->field.samp, FS_D, a0, n, d);
-    return gsolve_dense_to_grid(g, d, a0, n);
-}
-
+/* gsolve_init_ratio at GSOLVE_RATIO_DEFAULT samples per knot span. */
 argil_err_t gsolve_init(gsolve_t *gs, grid_t *g)
 {
     return gsolve_init_ratio(gs, g, GSOLVE_RATIO_DEFAULT);
 }
 
+/* A field at ratio samples per knot span, seeded from the whole grid. */
 argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
 {
     memset(gs, 0, sizeof(*gs));
@@ -108,6 +58,7 @@ argil_err_t gsolve_init_ratio(gsolve_t *gs, grid_t *g, int32_t ratio)
     return e;
 }
 
+/* Frees the windows, the field and the scratch. */
 void gsolve_free(gsolve_t *gs)
 {
     gsolve_close_window(gs);
@@ -117,6 +68,7 @@ void gsolve_free(gsolve_t *gs)
     gs->buf_n = 0;
 }
 
+/* Closes the physical window and the settling region's; the field keeps their last step. */
 void gsolve_close_window(gsolve_t *gs)
 {
     if (gs->win_open)
@@ -132,6 +84,7 @@ void gsolve_close_window(gsolve_t *gs)
     gs->settle.active = false;
 }
 
+/* R, the field's samples per knot span. */
 int32_t gsolve_ratio(const gsolve_t *gs)
 {
     return gs->field.ratio;
