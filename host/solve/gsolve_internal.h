@@ -21,12 +21,12 @@ float gsolve_dense_to_grid(grid_t *g, const float *d, const int32_t lo[3], const
 /* The field's densities in sample box [lo, hi) into the grid, as gsolve_dense_to_grid. */
 float gsolve_view_to_grid(gsolve_t *gs, grid_t *g, const int32_t lo[3], const int32_t hi[3]);
 
-/* The physical window (gsolve_window.c): re-read from the field, shifted by whole knot spans,
- * its coefficient box, a step stored back, the changed box grown by it. */
+/* The physical window (gsolve_window.c): re-read from the field, moved onto a coefficient box
+ * of its size (false: another size), its coefficient box, a step stored back, the changed box
+ * grown by it. */
 argil_err_t gsolve_win_reload(gsolve_t *gs, physwin_t *w, float dt_s, bool moved,
                               bool *plain_io);
-void gsolve_win_shift(physwin_t *w, int32_t ratio, const int32_t old_lo[3],
-                      const int32_t new_lo[3]);
+bool gsolve_win_move(physwin_t *w, int32_t ratio, const int32_t clo[3], const int32_t chi[3]);
 void gsolve_coef_box(const field_t *f, const int32_t lo[3], const int32_t hi[3], int32_t clo[3],
                      int32_t chi[3]);
 argil_err_t gsolve_win_store(gsolve_t *gs, grid_t *g, physwin_t *w, const physwin_t *skip,

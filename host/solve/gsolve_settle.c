@@ -77,21 +77,9 @@ argil_err_t gsolve_settle_step(gsolve_t *gs, grid_t *g, float dt_s, int32_t dlo[
         st->active = false;
         return ARGIL_OK;
     }
-    if (st->open) {
-        bool same = true;
-        for (int a = 0; a < 3; a++)
-            same = same && chi[a] - clo[a] == w->chi[a] - w->clo[a];
-        if (same) {
-            int32_t old_lo[3], new_lo[3];
-            for (int a = 0; a < 3; a++) {
-                old_lo[a] = w->clo[a] * f->ratio;
-                new_lo[a] = clo[a] * f->ratio;
-            }
-            gsolve_win_shift(w, f->ratio, old_lo, new_lo);
-        } else {
-            physwin_close(w);
-            st->open = false;
-        }
+    if (st->open && !gsolve_win_move(w, f->ratio, clo, chi)) {
+        physwin_close(w);
+        st->open = false;
     }
     if (!st->open) {
         gs->cfg.dt_s = dt_s;

@@ -35,16 +35,7 @@ static argil_err_t step_main(gsolve_t *gs, grid_t *g, const int32_t lo[3], const
             gsolve_settle_take(gs, gs->box_lo, gs->box_hi);
         /* Same size, shifted by whole knot spans (R samples each; a box that moved less stays
          * on the same coefficients): move the open window instead of reopening. */
-        bool same = true;
-        for (int a = 0; a < 3; a++)
-            same = same && chi[a] - clo[a] == gs->win.chi[a] - gs->win.clo[a];
-        if (same) {
-            int32_t old_lo[3], new_lo[3];
-            for (int a = 0; a < 3; a++) {
-                old_lo[a] = gs->win.clo[a] * f->ratio;
-                new_lo[a] = clo[a] * f->ratio;
-            }
-            gsolve_win_shift(&gs->win, f->ratio, old_lo, new_lo);
+        if (gsolve_win_move(&gs->win, f->ratio, clo, chi)) {
             const argil_err_t e = reload_window(gs, dt_s, true);
             if (e != ARGIL_OK) {
                 gsolve_close_window(gs);

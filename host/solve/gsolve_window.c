@@ -100,7 +100,7 @@ argil_err_t gsolve_win_reload(gsolve_t *gs, physwin_t *w, float dt_s, bool moved
 
 /* Shifts an open window whose sample box was at old_lo to new_lo (same size, by whole knot
  * spans: the taps repeat every span, so only the boxes move). */
-void gsolve_win_shift(physwin_t *w, int32_t ratio, const int32_t old_lo[3],
+static void win_shift(physwin_t *w, int32_t ratio, const int32_t old_lo[3],
                       const int32_t new_lo[3])
 {
     for (int a = 0; a < 3; a++) {
@@ -110,6 +110,24 @@ void gsolve_win_shift(physwin_t *w, int32_t ratio, const int32_t old_lo[3],
         w->slo[a] += shift;
         w->shi[a] += shift;
     }
+}
+
+/* Moves open window w onto the coefficient box [clo, chi) and returns true when that box has
+ * w's size (a shift by whole knot spans); false, w as it was, when it has not. */
+bool gsolve_win_move(physwin_t *w, int32_t ratio, const int32_t clo[3], const int32_t chi[3])
+{
+    bool same = true;
+    for (int a = 0; a < 3; a++)
+        same = same && chi[a] - clo[a] == w->chi[a] - w->clo[a];
+    if (!same)
+        return false;
+    int32_t old_lo[3], new_lo[3];
+    for (int a = 0; a < 3; a++) {
+        old_lo[a] = w->clo[a] * ratio;
+        new_lo[a] = clo[a] * ratio;
+    }
+    win_shift(w, ratio, old_lo, new_lo);
+    return true;
 }
 
 /* After an implicit step of window w: d = A p + d_fixed once; plastic flow (the rest shape
