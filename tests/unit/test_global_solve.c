@@ -1,4 +1,4 @@
-/* The session's global solve on the B-spline model (host/solve/gsolve.c): the grid as the
+/* The session's global solve on the B-spline model (host/solve/gsolve*.c): the grid as the
  * model's view, impulses moving as much clay as the density springs do, carving through the
  * model's tools, painted material, a field at rest staying put, and the script's paint verb. */
 #include <stdarg.h>

@@ -1,4 +1,4 @@
-/* Knot insertion during a session (host/solve/gsolve.c, gsolve_refine): a field started at
+/* Knot insertion during a session (host/solve/gsolve_refine.c): a field started at
  * R = 2 or 4 grid samples per knot span is seeded close to the grid, solves, shifts its window
  * by whole knot spans and carves; a refinement halves R without changing a sample, the grid or
  * the mesh, and the clay still moves under a push afterwards, as much as at R = 1 from the

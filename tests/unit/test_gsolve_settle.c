@@ -1,4 +1,4 @@
-/* Clay the board's window leaves while it still moves keeps moving (host/solve/gsolve.c
+/* Clay the board's window leaves while it still moves keeps moving (host/solve/gsolve_settle.c
  * settling region): a dent pushed in and released springs back the same whether the window
  * stays over it or goes elsewhere; with settling off it freezes where the window left it. */
 #include <stdarg.h>

@@ -1,5 +1,5 @@
 /* The settling region is clipped to the layers the board's window left plus the coefficients
- * that reach their equations (host/solve/gsolve.c settle_clip_box): a window marching 2
+ * that reach their equations (host/solve/gsolve_settle.c settle_clip_box): a window marching 2
  * coefficients at a time along x leaves regions of at most a third of the old box, and the clay
  * ends where the whole old box's settling puts it. */
 #include <stdarg.h>
