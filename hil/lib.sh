@@ -140,9 +140,17 @@ CANDUMP_PID=
 # socket memory: 4 MiB held 0.7 s of a scenario's traffic, and a candump that far behind lost
 # frames, so SYNC counts and verdicts were wrong, CI 2026-12-02); -d reports any frame the
 # socket still drops (DROPCOUNT lines, moved to $CHECK.candump.drops by can_log_stop).
+# Returns once candump holds its CAN socket (up to 10 s), so the frames the check causes next
+# (a board's NMT start) are in the log however late a busy rig starts it; a fixed sleep was the
+# same bet that failed rig_watch once (see rig_watch_start).
 can_log_start() {
     hil-probe fifo "$CANDUMP_PRIO" candump -L -d -r 16777216 "$CAN_IF" >"$OUT/$CHECK.candump.log" 2>"$OUT/$CHECK.candump.err" &
-    CANDUMP_PID=$!; sleep 0.2
+    CANDUMP_PID=$!
+    cl_n=0
+    while ! ls -l "/proc/$CANDUMP_PID/fd" 2>/dev/null | grep -q 'socket:' && [ "$cl_n" -lt 1000 ]; do
+        sleep 0.01; cl_n=$((cl_n + 1))
+    done
+    sleep 0.05 # its bind follows the socket call
 }
 # candump runs under the rig's real-time work and may be far behind (0.7 s of frames were still
 # in its socket when a scenario's log was cut, 2026-12-02): before it is stopped it writes out
