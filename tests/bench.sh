@@ -143,7 +143,7 @@ for row in 16 32 "16 --paint-stiffness 4"; do
 done
 echo "  (goal: worst tick with a 16^3 window <= 150,000 instructions)"
 
-echo "== autosave journal (host/io/journal.c): the default session with and without it, $runs runs each"
+echo "== autosave journal (host/io/journal_*.c): the default session with and without it, $runs runs each"
 : >"$tmp/jon"; : >"$tmp/joff"; : >"$tmp/jms"
 for i in $(seq $runs); do
     for mode in on off; do

@@ -614,6 +614,51 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     return ARGIL_OK;
 }
 
+/* The 16-byte TOOL section at p (payload offset off in the file) into d->tool. */
+static argil_err_t af_tool(const af_rctx_t *c, const uint8_t *p, size_t off, argil_doc_t *d)
+{
+    d->tool.tool_kind = io_get_u32le(p);
+    d->tool.radius_m = io_get_f32le(p + 4);
+    d->tool.strength = io_get_f32le(p + 8);
+    memcpy(d->tool.paint_rgb, p + 12, 3);
+    if (!isfinite(d->tool.radius_m) || d->tool.radius_m < 0 || !isfinite(d->tool.strength) ||
+        d->tool.strength < 0 || d->tool.strength > 1)
+        return af_fail(c, off + 4, "TOOL radius or strength out of range");
+    return ARGIL_OK;
+}
+
+/* The RBF3 section (sl bytes at p; its head at file offset pos, payload at off) into d->rbf. */
+static argil_err_t af_rbf3(const af_rctx_t *c, const uint8_t *p, uint64_t sl, size_t pos,
+                           size_t off, argil_doc_t *d)
+{
+    if (d->has_rbf || sl < 28)
+        return af_fail(c, pos, "RBF3 section repeated or shorter than 28 bytes");
+    const uint32_t n = io_get_u32le(p);
+    if (n > RBF_CENTRES_MAX || sl != 28u + 16u * (uint64_t)n)
+        return af_fail(c, off, "RBF3 centre count out of range or not matching the "
+                               "section length");
+    if (rbf_alloc(&d->rbf, n) != ARGIL_OK) {
+        io_err(c->err, c->err_len, "%s: out of memory", c->path);
+        return ARGIL_ERR_NOMEM;
+    }
+    d->has_rbf = true;
+    float rf[6];
+    af_get_f32s(p + 4, rf, 6);
+    memcpy(d->rbf.poly, rf, sizeof(d->rbf.poly));
+    d->rbf.rms_err_m = rf[4];
+    d->rbf.max_err_m = rf[5];
+    for (uint32_t i = 0; i < n; i++) {
+        float cf[4];
+        af_get_f32s(p + 28 + 16 * (size_t)i, cf, 4);
+        memcpy(d->rbf.centre_m + 3 * (size_t)i, cf, 3 * sizeof(float));
+        d->rbf.weight[i] = cf[3];
+    }
+    if (!af_finite(rf, 6) || !af_finite(d->rbf.centre_m, 3 * (size_t)n) ||
+        !af_finite(d->rbf.weight, n))
+        return af_fail(c, off, "RBF3 holds NaN or Inf");
+    return ARGIL_OK;
+}
+
 static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, argil_doc_t *d)
 {
     if (len < ARGIL_FILE_HEADER_BYTES + 4)
@@ -677,13 +722,7 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
             if (seen_tool || sl != 16)
                 return af_fail(c, pos, "TOOL section repeated or not 16 bytes");
             seen_tool = true;
-            d->tool.tool_kind = io_get_u32le(p);
-            d->tool.radius_m = io_get_f32le(p + 4);
-            d->tool.strength = io_get_f32le(p + 8);
-            memcpy(d->tool.paint_rgb, p + 12, 3);
-            if (!isfinite(d->tool.radius_m) || d->tool.radius_m < 0 ||
-                !isfinite(d->tool.strength) || d->tool.strength < 0 || d->tool.strength > 1)
-                return af_fail(c, off + 4, "TOOL radius or strength out of range");
+            e = af_tool(c, p, off, d);
         } else if (strcmp(tag, "STAT") == 0) {
             if (seen_stat || sl != 20)
                 return af_fail(c, pos, "STAT section repeated or not 20 bytes");
@@ -710,31 +749,7 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
             colr_len = sl;
             colr_off = off;
         } else if (strcmp(tag, "RBF3") == 0) {
-            if (d->has_rbf || sl < 28)
-                return af_fail(c, pos, "RBF3 section repeated or shorter than 28 bytes");
-            const uint32_t n = io_get_u32le(p);
-            if (n > RBF_CENTRES_MAX || sl != 28u + 16u * (uint64_t)n)
-                return af_fail(c, off, "RBF3 centre count out of range or not matching the "
-                                       "section length");
-            if (rbf_alloc(&d->rbf, n) != ARGIL_OK) {
-                io_err(c->err, c->err_len, "%s: out of memory", c->path);
-                return ARGIL_ERR_NOMEM;
-            }
-            d->has_rbf = true;
-            float rf[6];
-            af_get_f32s(p + 4, rf, 6);
-            memcpy(d->rbf.poly, rf, sizeof(d->rbf.poly));
-            d->rbf.rms_err_m = rf[4];
-            d->rbf.max_err_m = rf[5];
-            for (uint32_t i = 0; i < n; i++) {
-                float cf[4];
-                af_get_f32s(p + 28 + 16 * (size_t)i, cf, 4);
-                memcpy(d->rbf.centre_m + 3 * (size_t)i, cf, 3 * sizeof(float));
-                d->rbf.weight[i] = cf[3];
-            }
-            if (!af_finite(rf, 6) || !af_finite(d->rbf.centre_m, 3 * (size_t)n) ||
-                !af_finite(d->rbf.weight, n))
-                return af_fail(c, off, "RBF3 holds NaN or Inf");
+            e = af_rbf3(c, p, sl, pos, off, d);
         } else if (strcmp(tag, "OCTB") == 0) {
             e = af_octb(c, p, sl, pos, off, d);
         } else if (strcmp(tag, "MTLS") == 0) {

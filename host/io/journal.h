@@ -45,8 +45,9 @@ typedef struct {
     uint64_t rgb_samples;     /* painted colour samples (3 bytes each) journaled */
 } journal_stats_t;
 
-/* One grid block of the writer's copy of the model as of the last record (host/io/journal.c):
- * only blocks the grid holds cost memory, and a block at one density holds no array. */
+/* One grid block of the writer's copy of the model as of the last record
+ * (host/io/journal_shadow.c): only blocks the grid holds cost memory, and a block at one density
+ * holds no array. */
 typedef struct {
     int32_t key[3];           /* block index, as the grid's; first: the table's key */
     float uniform;            /* the density of every sample when dens is NULL */

@@ -273,6 +273,55 @@ static bool obj_index(const char *s, size_t count, uint32_t *out)
     return true;
 }
 
+/* Adds the face statement tok[0, nt) ("f", then corners v, v/t, v//n or v/t/n) on line line_no
+ * to out as a fan of triangles, skipping degenerate ones; a corner's normal vn[n] is copied to
+ * its vertex, marked in *got_n (grown to out's vertex room *cap_got). ARGIL_ERR_PARSE with err
+ * naming the line, or ARGIL_ERR_NOMEM. */
+static argil_err_t obj_face(const char *path, size_t line_no, char **tok, int nt, mesh_t *out,
+                            const float *vn, size_t n_vn, uint8_t **got_n, size_t *cap_got,
+                            char *err, size_t err_len)
+{
+    if (nt < 4 || nt > 65) {
+        io_err(err, err_len, "%s: line %zu: 'f' needs 3 to 64 vertices", path, line_no);
+        return ARGIL_ERR_PARSE;
+    }
+    if (*cap_got < out->n_vert) {
+        uint8_t *g = realloc(*got_n, out->cap_vert);
+        if (g == NULL)
+            return ARGIL_ERR_NOMEM;
+        memset(g + *cap_got, 0, out->cap_vert - *cap_got);
+        *got_n = g;
+        *cap_got = out->cap_vert;
+    }
+    uint32_t idx[64];
+    for (int q = 1; q < nt; q++) {
+        char *s = tok[q];
+        char *sl1 = strchr(s, '/');
+        char *sl2 = sl1 != NULL ? strchr(sl1 + 1, '/') : NULL;
+        if (sl1 != NULL)
+            *sl1 = '\0';
+        if (sl2 != NULL)
+            *sl2 = '\0';
+        uint32_t ni = 0;
+        if (!obj_index(s, out->n_vert, &idx[q - 1]) ||
+            (sl2 != NULL && sl2[1] != '\0' && !obj_index(sl2 + 1, n_vn, &ni))) {
+            io_err(err, err_len, "%s: line %zu: face corner %d names a vertex or normal "
+                   "that does not exist (%zu vertices, %zu normals so far)",
+                   path, line_no, q, out->n_vert, n_vn);
+            return ARGIL_ERR_PARSE;
+        }
+        if (sl2 != NULL && sl2[1] != '\0') {
+            memcpy(out->normal + 3 * (size_t)idx[q - 1], vn + 3 * (size_t)ni, 3 * sizeof(float));
+            (*got_n)[idx[q - 1]] = 1;
+        }
+    }
+    for (int q = 2; q + 1 < nt; q++)
+        if (idx[0] != idx[q - 1] && idx[q - 1] != idx[q] && idx[0] != idx[q] &&
+            mesh_add_triangle(out, idx[0], idx[q - 1], idx[q]) != ARGIL_OK)
+            return ARGIL_ERR_NOMEM;
+    return ARGIL_OK;
+}
+
 argil_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *err, size_t err_len)
 {
     if (path == NULL || out == NULL) {
@@ -359,49 +408,8 @@ argil_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *err
                 n_vn++;
             }
         } else if (strcmp(k, "f") == 0) {
-            if (nt < 4 || nt > 65) {
-                io_err(err, err_len, "%s: line %zu: 'f' needs 3 to 64 vertices", path, it.line_no);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            if (cap_got < out->n_vert) {
-                uint8_t *g = realloc(got_n, out->cap_vert);
-                if (g == NULL) {
-                    e = ARGIL_ERR_NOMEM;
-                    break;
-                }
-                memset(g + cap_got, 0, out->cap_vert - cap_got);
-                got_n = g;
-                cap_got = out->cap_vert;
-            }
-            uint32_t idx[64];
-            for (int q = 1; q < nt && e == ARGIL_OK; q++) {
-                char *s = tok[q];
-                char *sl1 = strchr(s, '/');
-                char *sl2 = sl1 != NULL ? strchr(sl1 + 1, '/') : NULL;
-                if (sl1 != NULL)
-                    *sl1 = '\0';
-                if (sl2 != NULL)
-                    *sl2 = '\0';
-                uint32_t ni = 0;
-                if (!obj_index(s, out->n_vert, &idx[q - 1]) ||
-                    (sl2 != NULL && sl2[1] != '\0' && !obj_index(sl2 + 1, n_vn, &ni))) {
-                    io_err(err, err_len, "%s: line %zu: face corner %d names a vertex or normal "
-                           "that does not exist (%zu vertices, %zu normals so far)",
-                           path, it.line_no, q, out->n_vert, n_vn);
-                    e = ARGIL_ERR_PARSE;
-                    break;
-                }
-                if (sl2 != NULL && sl2[1] != '\0') {
-                    memcpy(out->normal + 3 * (size_t)idx[q - 1], vn + 3 * (size_t)ni,
-                           3 * sizeof(float));
-                    got_n[idx[q - 1]] = 1;
-                }
-            }
-            for (int q = 2; q + 1 < nt && e == ARGIL_OK; q++)
-                if (idx[0] != idx[q - 1] && idx[q - 1] != idx[q] && idx[0] != idx[q] &&
-                    mesh_add_triangle(out, idx[0], idx[q - 1], idx[q]) != ARGIL_OK)
-                    e = ARGIL_ERR_NOMEM;
+            e = obj_face(path, it.line_no, tok, nt, out, vn, n_vn, &got_n, &cap_got, err,
+                         err_len);
         } else if (strcmp(k, "vt") == 0 || strcmp(k, "vp") == 0 || strcmp(k, "o") == 0 ||
                    strcmp(k, "g") == 0 || strcmp(k, "s") == 0 || strcmp(k, "usemtl") == 0 ||
                    strcmp(k, "mtllib") == 0 || strcmp(k, "l") == 0) {

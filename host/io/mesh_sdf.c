@@ -103,6 +103,51 @@ static int cross_cmp(const void *x, const void *y)
     return a->x < b->x ? -1 : (a->x > b->x);
 }
 
+/* Face normals fn, angle-weighted vertex pseudo-normals vn (zero on entry) and the neighbour
+ * face nb across each edge of the watertight mesh m (ed: room for 3 n_tri edges); returns the
+ * number of zero-area faces. */
+static size_t sdf_normals(const mesh_t *m, dv_t *fn, dv_t *vn, uint32_t *nb, sdf_edge_t *ed)
+{
+    const size_t nt = m->n_tri;
+    size_t degenerate = 0;
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t *v = m->tri + 3 * t;
+        const dv_t p[3] = {vtx(m, v[0]), vtx(m, v[1]), vtx(m, v[2])};
+        const dv_t nrm = dcross(dsub(p[1], p[0]), dsub(p[2], p[0]));
+        fn[t] = dnorm(nrm);
+        if (!(ddot(nrm, nrm) > 0.0))
+            degenerate++;
+        for (int k = 0; k < 3; k++) {
+            const dv_t u = dnorm(dsub(p[(k + 1) % 3], p[k])), w = dnorm(dsub(p[(k + 2) % 3], p[k]));
+            const double cosang = fmax(-1.0, fmin(1.0, ddot(u, w)));
+            vn[v[k]] = dadd(vn[v[k]], dscale(fn[t], acos(cosang)));
+            const uint32_t a = v[k], b = v[(k + 1) % 3];
+            ed[3 * t + (size_t)k] = (sdf_edge_t){a < b ? a : b, a < b ? b : a, (uint32_t)t, (uint8_t)k};
+        }
+    }
+    qsort(ed, 3 * nt, sizeof(sdf_edge_t), edge_cmp);
+    for (size_t i = 0; i + 1 < 3 * nt; i += 2) { /* watertight: edges come in pairs */
+        nb[3 * (size_t)ed[i].tri + ed[i].edge] = ed[i + 1].tri;
+        nb[3 * (size_t)ed[i + 1].tri + ed[i + 1].edge] = ed[i].tri;
+    }
+    return degenerate;
+}
+
+/* Appends the crossing (row, x) to *cr, doubling its room *cap when full; false when out of
+ * memory (*cr is then unchanged). */
+static bool sdf_cross_push(sdf_cross_t **cr, size_t *n, size_t *cap, uint32_t row, float x)
+{
+    if (*n == *cap) {
+        sdf_cross_t *ncr = realloc(*cr, 2 * *cap * sizeof(sdf_cross_t));
+        if (ncr == NULL)
+            return false;
+        *cr = ncr;
+        *cap *= 2;
+    }
+    (*cr)[(*n)++] = (sdf_cross_t){row, x};
+    return true;
+}
+
 argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, vec3_t origin_m,
                      float band_m, float *sd, mesh_sdf_report_t *rep)
 {
@@ -143,27 +188,7 @@ argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, ve
         e = ARGIL_ERR_NOMEM;
         goto out;
     }
-    /* face normals, angle-weighted vertex pseudo-normals, edge neighbours */
-    for (size_t t = 0; t < nt; t++) {
-        const uint32_t *v = m->tri + 3 * t;
-        const dv_t p[3] = {vtx(m, v[0]), vtx(m, v[1]), vtx(m, v[2])};
-        const dv_t nrm = dcross(dsub(p[1], p[0]), dsub(p[2], p[0]));
-        fn[t] = dnorm(nrm);
-        if (!(ddot(nrm, nrm) > 0.0))
-            r.degenerate++;
-        for (int k = 0; k < 3; k++) {
-            const dv_t u = dnorm(dsub(p[(k + 1) % 3], p[k])), w = dnorm(dsub(p[(k + 2) % 3], p[k]));
-            const double cosang = fmax(-1.0, fmin(1.0, ddot(u, w)));
-            vn[v[k]] = dadd(vn[v[k]], dscale(fn[t], acos(cosang)));
-            const uint32_t a = v[k], b = v[(k + 1) % 3];
-            ed[3 * t + (size_t)k] = (sdf_edge_t){a < b ? a : b, a < b ? b : a, (uint32_t)t, (uint8_t)k};
-        }
-    }
-    qsort(ed, 3 * nt, sizeof(sdf_edge_t), edge_cmp);
-    for (size_t i = 0; i + 1 < 3 * nt; i += 2) { /* watertight: edges come in pairs */
-        nb[3 * (size_t)ed[i].tri + ed[i].edge] = ed[i + 1].tri;
-        nb[3 * (size_t)ed[i + 1].tri + ed[i + 1].edge] = ed[i].tri;
-    }
+    r.degenerate += sdf_normals(m, fn, vn, nb, ed);
     for (size_t i = 0; i < n; i++) {
         d2[i] = band_m * band_m;
         near[i] = UINT32_MAX;
@@ -213,16 +238,11 @@ argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, ve
                     continue;
                 const dv_t nrm = fn[t];
                 const double x = a.x - (nrm.y * (py - a.y) + nrm.z * (pz - a.z)) / nrm.x;
-                if (n_cross == cap_cross) {
-                    sdf_cross_t *ncr = realloc(cr, 2 * cap_cross * sizeof(sdf_cross_t));
-                    if (ncr == NULL) {
-                        e = ARGIL_ERR_NOMEM;
-                        goto out;
-                    }
-                    cr = ncr;
-                    cap_cross *= 2;
+                const uint32_t row = (uint32_t)(y + dims[1] * z);
+                if (!sdf_cross_push(&cr, &n_cross, &cap_cross, row, (float)x)) {
+                    e = ARGIL_ERR_NOMEM;
+                    goto out;
                 }
-                cr[n_cross++] = (sdf_cross_t){(uint32_t)(y + dims[1] * z), (float)x};
             }
     }
     qsort(cr, n_cross, sizeof(sdf_cross_t), cross_cmp);

@@ -279,11 +279,10 @@ static int ply_find(const ply_elem_t *e, const char *name)
     return -1;
 }
 
-/* Reads all elements into out. */
-static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out, bool *normals)
+/* Refuses element counts the bytes after the header cannot hold: every record takes at least
+ * min bytes (binary: its fixed parts; ASCII: two bytes a value), checked before any allocation. */
+static argil_err_t ply_check_counts(ply_in_t *in, const ply_elem_t *el, int n_el)
 {
-    /* Every element's records take at least min bytes (binary: fixed parts; ASCII: two bytes a
-     * value), so a count the file cannot hold is refused before any allocation. */
     uint64_t need = 0;
     for (int i = 0; i < n_el; i++) {
         uint64_t min = 0;
@@ -307,6 +306,15 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
             return ARGIL_ERR_PARSE;
         }
     }
+    return ARGIL_OK;
+}
+
+/* Reads all elements into out. */
+static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out, bool *normals)
+{
+    const argil_err_t ce = ply_check_counts(in, el, n_el);
+    if (ce != ARGIL_OK)
+        return ce;
     const ply_elem_t *ve = NULL;
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1;
     for (int i = 0; i < n_el; i++)

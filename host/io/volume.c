@@ -158,6 +158,107 @@ static int nrrd_numbers(const char *s, double *v, int n)
     return nt;
 }
 
+/* What a NRRD header has said so far (volume_read_nrrd). */
+typedef struct {
+    bool have_type, have_dim, have_sizes, have_enc, big, have_endian;
+    vol_type_t t;
+    int32_t dims[3];
+    char data_file[IMPORT_NUM_LINE];
+} nrrd_header_t;
+
+/* Applies the header field key: val on line ln to h and out (a field that does not change the
+ * samples is skipped); ARGIL_ERR_PARSE with err naming the line. */
+static argil_err_t nrrd_field(const char *path, size_t ln, const char *key, const char *val,
+                              nrrd_header_t *h, volume_t *out, char *err, size_t err_len)
+{
+    double v[9];
+    if (strcmp(key, "type") == 0) {
+        if (!vol_type_parse(val, &h->t)) {
+            io_err(err, err_len, "%s: line %zu: unknown type '%.40s'", path, ln, val);
+            return ARGIL_ERR_PARSE;
+        }
+        h->have_type = true;
+    } else if (strcmp(key, "dimension") == 0) {
+        if (strcmp(val, "3") != 0) {
+            io_err(err, err_len, "%s: line %zu: dimension must be 3, got '%.20s'", path, ln,
+                   val);
+            return ARGIL_ERR_PARSE;
+        }
+        h->have_dim = true;
+    } else if (strcmp(key, "sizes") == 0) {
+        if (nrrd_numbers(val, v, 3) != 3 || v[0] < 1 || v[1] < 1 || v[2] < 1 ||
+            v[0] > VOLUME_SAMPLES_MAX || v[1] > VOLUME_SAMPLES_MAX ||
+            v[2] > VOLUME_SAMPLES_MAX || v[0] != floor(v[0]) || v[1] != floor(v[1]) ||
+            v[2] != floor(v[2])) {
+            io_err(err, err_len, "%s: line %zu: sizes must be three whole numbers 1..2^30",
+                   path, ln);
+            return ARGIL_ERR_PARSE;
+        }
+        if (v[0] * v[1] * v[2] > (double)VOLUME_SAMPLES_MAX) {
+            io_err(err, err_len, "%s: line %zu: sizes give more than 2^30 samples", path, ln);
+            return ARGIL_ERR_PARSE;
+        }
+        for (int a = 0; a < 3; a++)
+            h->dims[a] = (int32_t)v[a];
+        h->have_sizes = true;
+    } else if (strcmp(key, "encoding") == 0) {
+        if (strcmp(val, "raw") != 0) {
+            io_err(err, err_len, "%s: line %zu: encoding '%.20s' is not supported (only raw)",
+                   path, ln, val);
+            return ARGIL_ERR_PARSE;
+        }
+        h->have_enc = true;
+    } else if (strcmp(key, "endian") == 0) {
+        if (strcmp(val, "little") != 0 && strcmp(val, "big") != 0) {
+            io_err(err, err_len, "%s: line %zu: endian must be little or big", path, ln);
+            return ARGIL_ERR_PARSE;
+        }
+        h->big = val[0] == 'b';
+        h->have_endian = true;
+    } else if (strcmp(key, "spacings") == 0) {
+        if (nrrd_numbers(val, v, 3) != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0)) {
+            io_err(err, err_len, "%s: line %zu: spacings must be three positive numbers", path,
+                   ln);
+            return ARGIL_ERR_PARSE;
+        }
+        for (int a = 0; a < 3; a++)
+            out->spacing_m[a] = (float)v[a];
+    } else if (strcmp(key, "space directions") == 0) {
+        if (nrrd_numbers(val, v, 9) != 9) {
+            io_err(err, err_len, "%s: line %zu: space directions must be three vectors (x,y,z)",
+                   path, ln);
+            return ARGIL_ERR_PARSE;
+        }
+        for (int a = 0; a < 3; a++) {
+            const double s = sqrt(v[3 * a] * v[3 * a] + v[3 * a + 1] * v[3 * a + 1] +
+                                  v[3 * a + 2] * v[3 * a + 2]);
+            if (!(s > 0) || s > 3e38) {
+                io_err(err, err_len, "%s: line %zu: a space direction has zero length", path, ln);
+                return ARGIL_ERR_PARSE;
+            }
+            out->spacing_m[a] = (float)s;
+        }
+    } else if (strcmp(key, "space origin") == 0) {
+        if (nrrd_numbers(val, v, 3) != 3 || fabs(v[0]) > 3e38 || fabs(v[1]) > 3e38 ||
+            fabs(v[2]) > 3e38) {
+            io_err(err, err_len, "%s: line %zu: space origin must be one vector (x,y,z)", path,
+                   ln);
+            return ARGIL_ERR_PARSE;
+        }
+        out->origin_m = vec3((float)v[0], (float)v[1], (float)v[2]);
+    } else if (strcmp(key, "data file") == 0 || strcmp(key, "datafile") == 0) {
+        if (strchr(val, '/') != NULL || strchr(val, '%') != NULL || strchr(val, ' ') != NULL ||
+            val[0] == '\0' || strcmp(val, "..") == 0 || strcmp(val, ".") == 0) {
+            io_err(err, err_len, "%s: line %zu: data file must be one plain file name beside "
+                   "the header", path, ln);
+            return ARGIL_ERR_PARSE;
+        }
+        snprintf(h->data_file, sizeof(h->data_file), "%s", val);
+    }
+    /* other fields (space, kinds, centers, content, ...) do not change the samples */
+    return ARGIL_OK;
+}
+
 argil_err_t volume_read_nrrd(const char *path, volume_t *out, char *err, size_t err_len)
 {
     if (path == NULL || out == NULL) {
@@ -172,11 +273,9 @@ argil_err_t volume_read_nrrd(const char *path, volume_t *out, char *err, size_t 
         return e;
     io_lines_t it = {(const char *)b, len, 0, 0, 0};
     char line[IMPORT_NUM_LINE];
-    bool have_type = false, have_dim = false, have_sizes = false, have_enc = false, big = false,
-         have_endian = false;
-    vol_type_t t = VOL_U8;
-    int32_t dims[3] = {0, 0, 0};
-    char data_file[IMPORT_NUM_LINE] = "";
+    nrrd_header_t h;
+    memset(&h, 0, sizeof(h));
+    h.t = VOL_U8;
     e = ARGIL_OK;
     for (;;) {
         const long n = io_next_line(&it, line, sizeof(line));
@@ -214,133 +313,39 @@ argil_err_t volume_read_nrrd(const char *path, volume_t *out, char *err, size_t 
             break;
         }
         *colon = '\0';
-        const char *key = line, *val = colon + 2;
-        double v[9];
-        if (strcmp(key, "type") == 0) {
-            if (!vol_type_parse(val, &t)) {
-                io_err(err, err_len, "%s: line %zu: unknown type '%.40s'", path, ln, val);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            have_type = true;
-        } else if (strcmp(key, "dimension") == 0) {
-            if (strcmp(val, "3") != 0) {
-                io_err(err, err_len, "%s: line %zu: dimension must be 3, got '%.20s'", path, ln,
-                       val);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            have_dim = true;
-        } else if (strcmp(key, "sizes") == 0) {
-            if (nrrd_numbers(val, v, 3) != 3 || v[0] < 1 || v[1] < 1 || v[2] < 1 ||
-                v[0] > VOLUME_SAMPLES_MAX || v[1] > VOLUME_SAMPLES_MAX ||
-                v[2] > VOLUME_SAMPLES_MAX || v[0] != floor(v[0]) || v[1] != floor(v[1]) ||
-                v[2] != floor(v[2])) {
-                io_err(err, err_len, "%s: line %zu: sizes must be three whole numbers 1..2^30",
-                       path, ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            if (v[0] * v[1] * v[2] > (double)VOLUME_SAMPLES_MAX) {
-                io_err(err, err_len, "%s: line %zu: sizes give more than 2^30 samples", path, ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            for (int a = 0; a < 3; a++)
-                dims[a] = (int32_t)v[a];
-            have_sizes = true;
-        } else if (strcmp(key, "encoding") == 0) {
-            if (strcmp(val, "raw") != 0) {
-                io_err(err, err_len, "%s: line %zu: encoding '%.20s' is not supported (only raw)",
-                       path, ln, val);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            have_enc = true;
-        } else if (strcmp(key, "endian") == 0) {
-            if (strcmp(val, "little") != 0 && strcmp(val, "big") != 0) {
-                io_err(err, err_len, "%s: line %zu: endian must be little or big", path, ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            big = val[0] == 'b';
-            have_endian = true;
-        } else if (strcmp(key, "spacings") == 0) {
-            if (nrrd_numbers(val, v, 3) != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0)) {
-                io_err(err, err_len, "%s: line %zu: spacings must be three positive numbers", path,
-                       ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            for (int a = 0; a < 3; a++)
-                out->spacing_m[a] = (float)v[a];
-        } else if (strcmp(key, "space directions") == 0) {
-            if (nrrd_numbers(val, v, 9) != 9) {
-                io_err(err, err_len, "%s: line %zu: space directions must be three vectors (x,y,z)",
-                       path, ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            for (int a = 0; a < 3; a++) {
-                const double s = sqrt(v[3 * a] * v[3 * a] + v[3 * a + 1] * v[3 * a + 1] +
-                                      v[3 * a + 2] * v[3 * a + 2]);
-                if (!(s > 0) || s > 3e38) {
-                    io_err(err, err_len, "%s: line %zu: a space direction has zero length", path, ln);
-                    e = ARGIL_ERR_PARSE;
-                    break;
-                }
-                out->spacing_m[a] = (float)s;
-            }
-            if (e != ARGIL_OK)
-                break;
-        } else if (strcmp(key, "space origin") == 0) {
-            if (nrrd_numbers(val, v, 3) != 3 || fabs(v[0]) > 3e38 || fabs(v[1]) > 3e38 ||
-                fabs(v[2]) > 3e38) {
-                io_err(err, err_len, "%s: line %zu: space origin must be one vector (x,y,z)", path,
-                       ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            out->origin_m = vec3((float)v[0], (float)v[1], (float)v[2]);
-        } else if (strcmp(key, "data file") == 0 || strcmp(key, "datafile") == 0) {
-            if (strchr(val, '/') != NULL || strchr(val, '%') != NULL || strchr(val, ' ') != NULL ||
-                val[0] == '\0' || strcmp(val, "..") == 0 || strcmp(val, ".") == 0) {
-                io_err(err, err_len, "%s: line %zu: data file must be one plain file name beside "
-                       "the header", path, ln);
-                e = ARGIL_ERR_PARSE;
-                break;
-            }
-            snprintf(data_file, sizeof(data_file), "%s", val);
-        }
-        /* other fields (space, kinds, centers, content, ...) do not change the samples */
+        e = nrrd_field(path, ln, line, colon + 2, &h, out, err, err_len);
+        if (e != ARGIL_OK)
+            break;
     }
-    if (e == ARGIL_OK && (!have_type || !have_dim || !have_sizes || !have_enc)) {
-        io_err(err, err_len, "%s: line %zu: header lacks the required field '%s'", path,
-               it.line_no, !have_type ? "type" : !have_dim ? "dimension" : !have_sizes ? "sizes"
-                                                                                    : "encoding");
+    if (e == ARGIL_OK && (!h.have_type || !h.have_dim || !h.have_sizes || !h.have_enc)) {
+        io_err(err, err_len, "%s: line %zu: header lacks the required field '%s'", path, it.line_no,
+               !h.have_type    ? "type"
+               : !h.have_dim   ? "dimension"
+               : !h.have_sizes ? "sizes"
+                               : "encoding");
         e = ARGIL_ERR_PARSE;
     }
-    if (e == ARGIL_OK && vol_size(t) > 1 && !have_endian) {
+    if (e == ARGIL_OK && vol_size(h.t) > 1 && !h.have_endian) {
         io_err(err, err_len, "%s: line %zu: header lacks 'endian' for a %zu-byte type", path,
-               it.line_no, vol_size(t));
+               it.line_no, vol_size(h.t));
         e = ARGIL_ERR_PARSE;
     }
     if (e == ARGIL_OK) {
-        if (data_file[0] != '\0') {
+        if (h.data_file[0] != '\0') {
             const char *slash = strrchr(path, '/');
             const size_t dl = slash != NULL ? (size_t)(slash - path) + 1 : 0;
-            char *dp = malloc(dl + strlen(data_file) + 1);
+            char *dp = malloc(dl + strlen(h.data_file) + 1);
             if (dp == NULL) {
                 e = ARGIL_ERR_NOMEM;
             } else {
                 memcpy(dp, path, dl);
-                strcpy(dp + dl, data_file);
+                strcpy(dp + dl, h.data_file);
                 uint8_t *db;
                 size_t dlen;
                 char inner[384] = "";
                 e = io_slurp(dp, IO_FILE_MAX_BYTES, &db, &dlen, inner, sizeof(inner));
                 if (e == ARGIL_OK) {
-                    e = vol_decode(dp, db, dlen, 0, dims, t, big, out, inner, sizeof(inner));
+                    e = vol_decode(dp, db, dlen, 0, h.dims, h.t, h.big, out, inner, sizeof(inner));
                     free(db);
                 }
                 if (e != ARGIL_OK)
@@ -348,7 +353,8 @@ argil_err_t volume_read_nrrd(const char *path, volume_t *out, char *err, size_t 
                 free(dp);
             }
         } else {
-            e = vol_decode(path, b + it.pos, len - it.pos, it.pos, dims, t, big, out, err, err_len);
+            e = vol_decode(path, b + it.pos, len - it.pos, it.pos, h.dims, h.t, h.big, out, err,
+                           err_len);
         }
     }
     free(b);

@@ -1,0 +1,442 @@
+/* The journal reader: decodes and checks the header, then walks the records (CRC, head, runs,
+ * painted material and colour, each rule checked before anything is applied) and replays them
+ * onto dense arrays or a grid. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "host/io/journal_internal.h"
+#include "shared/crc32c.h"
+
+/* ARGIL_ERR_PARSE, with err "name: byte N: why". */
+static argil_err_t fail(char *err, size_t err_len, const char *name, size_t byte, const char *why)
+{
+    io_err(err, err_len, "%s: byte %zu: %s", name, byte, why);
+    return ARGIL_ERR_PARSE;
+}
+
+/* Checks the 160-byte header field by field into info (journal.h). */
+argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *name,
+                                  journal_info_t *info, char *err, size_t err_len)
+{
+    memset(info, 0, sizeof(*info));
+    if (len < JOURNAL_HEADER_BYTES)
+        return fail(err, err_len, name, len, "file shorter than the journal header");
+    if (memcmp(data, JOURNAL_MAGIC, 8) != 0)
+        return fail(err, err_len, name, 0, "not an argil journal");
+    if (io_get_u32le(data + JOURNAL_HEADER_BYTES - 4) !=
+        crc32c(0, data, JOURNAL_HEADER_BYTES - 4))
+        return fail(err, err_len, name, JOURNAL_HEADER_BYTES - 4, "header checksum mismatch");
+    info->version = io_get_u32le(data + 8);
+    if (info->version < 1 || info->version > JOURNAL_VERSION)
+        return fail(err, err_len, name, 8, "journal version (this argil reads 1..2)");
+    if (io_get_u32le(data + 12) != JOURNAL_HEADER_BYTES)
+        return fail(err, err_len, name, 12, "header size");
+    int64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        const int32_t d = (int32_t)io_get_u32le(data + 16 + 4 * a);
+        if (d < 1 || (n *= d) > GRID_SAMPLES_MAX)
+            return fail(err, err_len, name, 16 + 4 * (size_t)a, "grid dimension below 1 or "
+                                                               "more than 2^30 samples");
+        info->dims[a] = d;
+    }
+    info->spacing_m = io_get_f32le(data + 28);
+    info->origin_m = vec3(io_get_f32le(data + 32), io_get_f32le(data + 36),
+                          io_get_f32le(data + 40));
+    info->iso = io_get_f32le(data + 44);
+    info->band_m = io_get_f32le(data + 48);
+    if (!isfinite(info->spacing_m) || !(info->spacing_m > 0.0f) || !vec3_isfinite(info->origin_m) ||
+        !isfinite(info->iso) || !isfinite(info->band_m))
+        return fail(err, err_len, name, 28, "grid spacing, origin, iso or band not finite");
+    journal_get_material(data + 52, &info->material);
+    if (!spring_material_valid(&info->material))
+        return fail(err, err_len, name, 52, "material out of range");
+    info->checkpoint = io_get_u32le(data + 72);
+    info->first_seq = io_get_u32le(data + 76);
+    if (info->first_seq == 0)
+        return fail(err, err_len, name, 76, "first record number 0");
+    info->last_seq = info->first_seq - 1u;
+    info->base_len = journal_get_u64(data + 80);
+    info->base_crc = io_get_u32le(data + 88);
+    info->edits = io_get_u32le(data + 92);
+    const uint8_t *bn = data + 96;
+    size_t bl = 0;
+    while (bl < JOURNAL_BASE_NAME_MAX && bn[bl] != 0)
+        bl++;
+    for (size_t i = bl; i < JOURNAL_BASE_NAME_MAX; i++)
+        if (bn[i] != 0)
+            return fail(err, err_len, name, 96 + i, "base name not NUL-padded");
+    if (bl == 0 || memchr(bn, '/', bl) != NULL || (bl <= 2 && bn[0] == '.'))
+        return fail(err, err_len, name, 96, "base name empty or not a plain file name");
+    for (size_t i = 0; i < bl; i++)
+        if (bn[i] < 0x20 || bn[i] > 0x7e)
+            return fail(err, err_len, name, 96 + i, "base name not printable ASCII");
+    memcpy(info->base_name, bn, bl);
+    info->base_name[bl] = '\0';
+    info->good_bytes = JOURNAL_HEADER_BYTES;
+    return ARGIL_OK;
+}
+
+/* Checks the painted-material blocks of a type-2 record (type 3: min_blocks 0) from payload
+ * offset *off against n samples; advances *off past them and adds their values to *samples. */
+static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *off, size_t at,
+                                    const char *name, size_t n, uint32_t rec, uint32_t min_blocks,
+                                    uint64_t *samples, char *err, size_t err_len)
+{
+    char why[200];
+    size_t o = *off;
+    if (payload - o < 4) {
+        snprintf(why, sizeof(why), "record %u: material block count runs past the record", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    const uint32_t blocks = io_get_u32le(p + o);
+    if (blocks < min_blocks || blocks > GRID_MAT_N) {
+        snprintf(why, sizeof(why), "record %u: material block count %u not in %u..4", rec, blocks,
+                 min_blocks);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    o += 4;
+    int64_t prev = -1;
+    for (uint32_t k = 0; k < blocks; k++) {
+        if (payload - o < 8) {
+            snprintf(why, sizeof(why), "record %u: material block %u head runs past the record",
+                     rec, k);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        if (ch >= GRID_MAT_N || (int64_t)ch <= prev || runs < 1) {
+            snprintf(why, sizeof(why), "record %u: material block %u: channel %u not 0..3 in "
+                     "increasing order, or no runs", rec, k, ch);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        prev = (int64_t)ch;
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++) {
+            if (payload - o < 8) {
+                snprintf(why, sizeof(why), "record %u: material run %u head runs past the record",
+                         rec, r);
+                return fail(err, err_len, name, at + 4 + o, why);
+            }
+            const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            if (count == 0 || start + count > (uint64_t)n || count > (payload - o - 8) / 4) {
+                snprintf(why, sizeof(why), "record %u: material run %u (%llu samples from %llu) "
+                         "empty, beyond the grid or past the record", rec, r,
+                         (unsigned long long)count, (unsigned long long)start);
+                return fail(err, err_len, name, at + 4 + o, why);
+            }
+            for (uint64_t i = 0; i < count; i++)
+                if (!grid_mat_valid((grid_mat_t)ch, io_get_f32le(p + o + 8 + 4 * i))) {
+                    snprintf(why, sizeof(why), "record %u: painted material value out of range "
+                             "(finite; mass scale > 0, stiffness and damping scales >= 0)", rec);
+                    return fail(err, err_len, name, at + 4 + o + 8 + 4 * (size_t)i, why);
+                }
+            o += 8 + 4 * (size_t)count;
+            *samples += count;
+        }
+    }
+    *off = o;
+    return ARGIL_OK;
+}
+
+/* Checks the painted colour of a type-3 record (from payload offset *off: uint32 run count >= 1,
+ * runs of uint32 first sample, uint32 count >= 1, 3 count bytes) against n samples; advances *off
+ * past it and adds its samples to *samples. */
+static argil_err_t check_rgb_runs(const uint8_t *p, size_t payload, size_t *off, size_t at,
+                                  const char *name, size_t n, uint32_t rec, uint64_t *samples,
+                                  char *err, size_t err_len)
+{
+    char why[200];
+    size_t o = *off;
+    if (payload - o < 4) {
+        snprintf(why, sizeof(why), "record %u: colour run count runs past the record", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    const uint32_t runs = io_get_u32le(p + o);
+    if (runs < 1) {
+        snprintf(why, sizeof(why), "record %u: colour run count 0", rec);
+        return fail(err, err_len, name, at + 4 + o, why);
+    }
+    o += 4;
+    uint64_t next = 0; /* runs are in sample order and do not overlap */
+    for (uint32_t r = 0; r < runs; r++) {
+        if (payload - o < 8) {
+            snprintf(why, sizeof(why), "record %u: colour run %u head runs past the record", rec,
+                     r);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        if (count == 0 || start < next || start + count > (uint64_t)n ||
+            count > (payload - o - 8) / 3) {
+            snprintf(why, sizeof(why), "record %u: colour run %u (%llu samples from %llu) empty, "
+                     "out of order, beyond the grid or past the record", rec, r,
+                     (unsigned long long)count, (unsigned long long)start);
+            return fail(err, err_len, name, at + 4 + o, why);
+        }
+        next = start + count;
+        o += 8 + 3 * (size_t)count;
+        *samples += count;
+    }
+    *off = o;
+    return ARGIL_OK;
+}
+
+/* Applies the checked colour runs at payload offset off to the n-sample colour *rgb (made, every
+ * sample GRID_RGB_DEFAULT, when absent). */
+static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, uint8_t **rgb, size_t n,
+                                  const char *name, char *err, size_t err_len)
+{
+    if (*rgb == NULL) {
+        *rgb = malloc(3 * n);
+        if (*rgb == NULL) {
+            io_err(err, err_len, "%s: out of memory for the painted colour", name);
+            return ARGIL_ERR_NOMEM;
+        }
+        memset(*rgb, (int)GRID_RGB_DEFAULT, 3 * n);
+    }
+    const uint32_t runs = io_get_u32le(p + off);
+    size_t o = off + 4;
+    for (uint32_t r = 0; r < runs; r++) {
+        const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        memcpy(*rgb + 3 * start, p + o + 8, 3 * count);
+        o += 8 + 3 * count;
+    }
+    return ARGIL_OK;
+}
+
+/* Applies the checked material blocks at payload offset off to the n-sample channels mat (an
+ * absent one is made, every sample the default, before it is written). */
+static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, float *mat[GRID_MAT_N],
+                                    size_t n, const char *name, char *err, size_t err_len)
+{
+    const uint32_t blocks = io_get_u32le(p + off);
+    size_t o = off + 4;
+    /* Every channel the record touches exists before anything is written. */
+    for (uint32_t k = 0; k < blocks; k++) {
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        if (mat[ch] == NULL) {
+            mat[ch] = malloc(n * sizeof(float));
+            if (mat[ch] == NULL) {
+                io_err(err, err_len, "%s: out of memory for a painted material channel", name);
+                return ARGIL_ERR_NOMEM;
+            }
+            const float def = grid_mat_default((grid_mat_t)ch);
+            for (size_t i = 0; i < n; i++)
+                mat[ch][i] = def;
+        }
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++)
+            o += 8 + 4 * (size_t)io_get_u32le(p + o + 4);
+    }
+    o = off + 4;
+    for (uint32_t k = 0; k < blocks; k++) {
+        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        float *m = mat[ch];
+        o += 8;
+        for (uint32_t r = 0; r < runs; r++) {
+            const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            for (size_t i = 0; i < count; i++)
+                m[start + i] = io_get_f32le(p + o + 8 + 4 * i);
+            o += 8 + 4 * count;
+        }
+    }
+    return ARGIL_OK;
+}
+
+/* Checks one record's payload (CRC already good) and, with density (and g), applies it. */
+static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, const char *name,
+                                float *density, float **mat, uint8_t **rgb, size_t n,
+                                journal_info_t *info, char *err, size_t err_len)
+{
+    char why[160];
+    const uint32_t rec = info->records + 1u;
+    if (payload < JOURNAL_RECORD_HEAD_BYTES) {
+        snprintf(why, sizeof(why), "record %u: shorter than a record head", rec);
+        return fail(err, err_len, name, at, why);
+    }
+    const uint32_t type = io_get_u32le(p);
+    if (type != 1u && ((type != 2u && type != 3u) || info->version < 2u)) {
+        snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, type);
+        return fail(err, err_len, name, at + 4, why);
+    }
+    const uint32_t seq = io_get_u32le(p + 4);
+    if (seq != info->last_seq + 1u) {
+        snprintf(why, sizeof(why), "record %u: number %u, expected %u", rec, seq,
+                 info->last_seq + 1u);
+        return fail(err, err_len, name, at + 8, why);
+    }
+    spring_material_t m;
+    journal_get_material(p + 28, &m);
+    if (!spring_material_valid(&m)) {
+        snprintf(why, sizeof(why), "record %u: material out of range", rec);
+        return fail(err, err_len, name, at + 32, why);
+    }
+    const uint32_t runs = io_get_u32le(p + 48);
+    /* Check every run before changing anything. */
+    size_t off = JOURNAL_RECORD_HEAD_BYTES;
+    uint64_t samples = 0, mat_samples = 0;
+    for (uint32_t r = 0; r < runs; r++) {
+        if (payload - off < 8) {
+            snprintf(why, sizeof(why), "record %u: run %u head runs past the record", rec, r);
+            return fail(err, err_len, name, at + 4 + off, why);
+        }
+        const uint64_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+        if (count == 0 || start + count > (uint64_t)n || count > (payload - off - 8) / 4) {
+            snprintf(why, sizeof(why),
+                     "record %u: run %u (%llu samples from %llu) empty, beyond the grid or "
+                     "past the record",
+                     rec, r, (unsigned long long)count, (unsigned long long)start);
+            return fail(err, err_len, name, at + 4 + off, why);
+        }
+        for (uint64_t i = 0; i < count; i++) {
+            const float v = io_get_f32le(p + off + 8 + 4 * i);
+            if (!isfinite(v) || v < 0.0f || v > 1.0f) {
+                snprintf(why, sizeof(why), "record %u: density not a finite number in [0, 1]",
+                         rec);
+                return fail(err, err_len, name, at + 4 + off + 8 + 4 * (size_t)i, why);
+            }
+        }
+        off += 8 + 4 * (size_t)count;
+        samples += count;
+    }
+    const size_t mat_off = off;
+    uint64_t rgb_samples = 0;
+    size_t rgb_off = 0;
+    if (type >= 2u) {
+        argil_err_t e = check_mat_blocks(p, payload, &off, at, name, n, rec, type == 3u ? 0u : 1u,
+                                         &mat_samples, err, err_len);
+        rgb_off = off;
+        if (e == ARGIL_OK && type == 3u)
+            e = check_rgb_runs(p, payload, &off, at, name, n, rec, &rgb_samples, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    if (off != payload) {
+        snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
+        return fail(err, err_len, name, at + 4 + off, why);
+    }
+    if (type >= 2u && mat != NULL && io_get_u32le(p + mat_off) > 0) {
+        const argil_err_t e = apply_mat_blocks(p, mat_off, mat, n, name, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    if (type == 3u && rgb != NULL) {
+        const argil_err_t e = apply_rgb_runs(p, rgb_off, rgb, n, name, err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+    }
+    if (density != NULL) {
+        off = JOURNAL_RECORD_HEAD_BYTES;
+        for (uint32_t r = 0; r < runs; r++) {
+            const size_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+            for (size_t i = 0; i < count; i++)
+                density[start + i] = io_get_f32le(p + off + 8 + 4 * i);
+            off += 8 + 4 * count;
+        }
+    }
+    info->records++;
+    info->last_seq = seq;
+    info->last_sim_s = (double)journal_get_u64(p + 8) * 1e-6;
+    info->last_wall_ms = journal_get_u64(p + 16);
+    info->edits = io_get_u32le(p + 24);
+    info->material = m;
+    info->samples += samples;
+    info->mat_samples += mat_samples;
+    info->rgb_samples += rgb_samples;
+    return ARGIL_OK;
+}
+
+/* journal_replay with optional painted channels (mat[GRID_MAT_N], n samples each) and colour
+ * (*rgb, 3 n bytes, made when a record paints and it is NULL). */
+argil_err_t journal_replay_channels(const uint8_t *data, size_t len, const char *name,
+                                    float *density, size_t n, float **mat, uint8_t **rgb,
+                                    journal_info_t *info, char *err, size_t err_len)
+{
+    argil_err_t e = journal_header_decode(data, len, name, info, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    const size_t want = (size_t)info->dims[0] * (size_t)info->dims[1] * (size_t)info->dims[2];
+    if (density != NULL && n != want) {
+        io_err(err, err_len, "%s: the journal's grid (%zu samples) is not the model's (%zu)", name,
+               want, n);
+        return ARGIL_ERR_ARG;
+    }
+    size_t at = JOURNAL_HEADER_BYTES;
+    while (at < len) {
+        const size_t left = len - at;
+        if (left < 8) {
+            info->torn_bytes = left;
+            break;
+        }
+        const uint64_t payload = io_get_u32le(data + at);
+        if (payload + 8 > left) {
+            info->torn_bytes = left; /* declared length runs past the end: a cut-short write */
+            break;
+        }
+        const uint32_t crc = io_get_u32le(data + at + 4 + payload);
+        if (crc != crc32c(0, data + at, 4 + (size_t)payload)) {
+            if (payload + 8 == left) {
+                info->torn_bytes = left; /* the very last record, partly written */
+                break;
+            }
+            char why[96];
+            snprintf(why, sizeof(why), "record %u: checksum mismatch (recovery stops before it)",
+                     info->records + 1u);
+            return fail(err, err_len, name, at, why);
+        }
+        e = apply_record(data + at + 4, (size_t)payload, at, name, density, mat, rgb, want, info,
+                         err, err_len);
+        if (e != ARGIL_OK)
+            return e;
+        at += 8 + (size_t)payload;
+        info->good_bytes = at;
+    }
+    return ARGIL_OK;
+}
+
+/* Replays densities only (journal.h). */
+argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
+                           size_t n, journal_info_t *info, char *err, size_t err_len)
+{
+    return journal_replay_channels(data, len, name, density, n, NULL, NULL, info, err, err_len);
+}
+
+/* Replays onto g through dense copies of its bounds, written back even after a bad record. */
+argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
+                                journal_info_t *info, char *err, size_t err_len)
+{
+    int32_t lo[3], hi[3], dims[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        dims[a] = hi[a] - lo[a];
+    const size_t n = grid_count(g);
+    float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
+    uint8_t *rgb = NULL;
+    argil_err_t e = journal_grid_dense(g, lo, dims, &dens, mat, &rgb);
+    if (e != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return e;
+    }
+    e = journal_replay_channels(data, len, name, dens, n, mat, &rgb, info, err, err_len);
+    /* Even after a bad record (PARSE) the grid takes the model as of the record before it. */
+    argil_err_t we = grid_write_box(g, GRID_DENSITY, lo, dims, dens);
+    bool painted = false;
+    for (int ch = 0; ch < GRID_MAT_N && we == ARGIL_OK; ch++)
+        if (mat[ch] != NULL) {
+            we = grid_mat_write_box(g, (grid_mat_t)ch, lo, dims, mat[ch]);
+            painted = true;
+        }
+    if (painted)
+        g->mat_writes++;
+    if (we == ARGIL_OK && rgb != NULL) {
+        we = grid_rgb_write_box(g, lo, dims, rgb);
+        if (info->rgb_samples > 0)
+            g->rgb_writes++;
+    }
+    journal_dense_free(&dens, mat, &rgb);
+    if (we != ARGIL_OK) {
+        io_err(err, err_len, "%s: out of memory for the model", name);
+        return we;
+    }
+    return e;
+}
