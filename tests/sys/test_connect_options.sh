@@ -63,6 +63,22 @@ expect_error "^argil connect: --knot-ratio needs the B-spline model" --global-so
 expect_error "^argil connect: --autosave-s needs seconds in 0.001..3600" --autosave-s 0
 
 number_after() { sed -n "s/.*$1 \([0-9][0-9]*\).*/\1/p" "$2" | head -n 1; }
+# kill_with_journal DIR BYTES TRIES: waits until DIR holds a journal base and a journal.log of at
+# least BYTES (at most TRIES x 0.1 s), then SIGKILLs the session $cpid (whose stderr is DIR.err);
+# fails if it had already ended or left no journal.
+kill_with_journal() {
+    kj_n=0
+    while { [ ! -s "$1/journal-base-0.argil" ] ||
+            [ "$(stat -c %s "$1/journal.log" 2>/dev/null || echo 0)" -lt "$2" ]; } && [ "$kj_n" -lt "$3" ]; do
+        sleep 0.1
+        kj_n=$((kj_n + 1))
+    done
+    sleep 0.3
+    kill -9 "$cpid" 2>/dev/null || fail "the session in $1 ended before it could be killed: $(cat "$1.err")"
+    wait "$cpid" 2>/dev/null || true
+    cpid=
+    [ -s "$1/journal.log" ] && [ -s "$1/journal-base-0.argil" ] || fail "no journal after SIGKILL: $(ls "$1")"
+}
 
 # 2. The settings reach the peer and the board, and the summary says so.
 st=0
@@ -115,18 +131,7 @@ cpid=
 cpid=$!
 # Kill once the journal is started (its base written and its header durable, 160 bytes; the
 # still hand adds no record), at most 20 s.
-n=0
-while { [ ! -s "$tmp/k/journal-base-0.argil" ] ||
-        [ "$(stat -c %s "$tmp/k/journal.log" 2>/dev/null || echo 0)" -lt 160 ]; } && [ "$n" -lt 200 ]; do
-    sleep 0.1
-    n=$((n + 1))
-done
-sleep 0.3
-kill -9 "$cpid" 2>/dev/null || fail "the session ended before it could be killed: $(cat "$tmp/k.err")"
-wait "$cpid" 2>/dev/null || true
-cpid=
-[ -s "$tmp/k/journal.log" ] && [ -s "$tmp/k/journal-base-0.argil" ] ||
-    fail "no journal after SIGKILL: $(ls "$tmp/k")"
+kill_with_journal "$tmp/k" 160 200
 st=0
 "$bin" connect --device sim --seconds 1 --out "$tmp/k" </dev/null >"$tmp/k2.out" 2>"$tmp/k2.err" || st=$?
 [ "$st" = 1 ] || fail "connect over an unfinished journal: exit $st, want 1"
@@ -147,17 +152,7 @@ cmp "$tmp/c/model.argil" "$tmp/k/recovered.argil" ||
 "$bin" connect --device sim:press --seconds 60 --arm --action carve --autosave-s 0.05 --quiet \
     --out "$tmp/p" >"$tmp/p.out" 2>"$tmp/p.err" &
 cpid=$!
-n=0
-while [ "$(stat -c %s "$tmp/p/journal.log" 2>/dev/null || echo 0)" -le 4096 ] && [ "$n" -lt 300 ]; do
-    sleep 0.1
-    n=$((n + 1))
-done
-sleep 0.3
-kill -9 "$cpid" 2>/dev/null || fail "the pressing session ended before it could be killed: $(cat "$tmp/p.err")"
-wait "$cpid" 2>/dev/null || true
-cpid=
-[ -s "$tmp/p/journal.log" ] && [ -s "$tmp/p/journal-base-0.argil" ] ||
-    fail "no journal after SIGKILL of the pressing session: $(ls "$tmp/p")"
+kill_with_journal "$tmp/p" 4097 300
 "$bin" recover "$tmp/p" >"$tmp/pr.out" 2>&1 || fail "recover: $(cat "$tmp/pr.out")"
 cat "$tmp/pr.out"
 precs=$(number_after "journal records    " "$tmp/pr.out")

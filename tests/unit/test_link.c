@@ -574,12 +574,11 @@ static void test_host_numbers_its_frames_in_one_sequence(void **state)
     link_close(&l);
 }
 
-static void test_sim_board_answers(void **state)
+/* Opens the sim board on device and says HELLO to it as its host. */
+static void open_sim_and_hello(link_t *l, const char *device)
 {
-    (void)state;
-    link_t l;
     char err[256];
-    assert_int_equal(link_open(&l, "sim", err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(link_open(l, device, err, sizeof(err)), ARGIL_OK);
     proto_msg_t m;
     memset(&m, 0, sizeof(m));
     m.type = MSG_HELLO;
@@ -587,7 +586,16 @@ static void test_sim_board_answers(void **state)
     uint8_t f[PROTO_FRAME_MAX];
     size_t fl = 0;
     assert_int_equal(proto_encode(&m, 0, f, sizeof(f), &fl), PROTO_OK);
-    assert_int_equal(link_send(&l, f, fl), ARGIL_OK);
+    assert_int_equal(link_send(l, f, fl), ARGIL_OK);
+}
+
+static void test_sim_board_answers(void **state)
+{
+    (void)state;
+    link_t l;
+    open_sim_and_hello(&l, "sim");
+    proto_msg_t m;
+    uint8_t f[PROTO_FRAME_MAX];
     /* 200 ms of virtual time (no sleeping: wait 0): the board answers HELLO, telemetry every
      * tick. */
     uint32_t hellos = 0, telemetry = 0, last_tick = 0;
@@ -620,16 +628,9 @@ static void test_sim_board_answers(void **state)
 static void sim_hand_buttons(const char *device, uint32_t *b1_rows, uint32_t *rows)
 {
     link_t l;
-    char err[256];
-    assert_int_equal(link_open(&l, device, err, sizeof(err)), ARGIL_OK);
+    open_sim_and_hello(&l, device);
     proto_msg_t m;
-    memset(&m, 0, sizeof(m));
-    m.type = MSG_HELLO;
-    m.u.hello.role = PROTO_ROLE_HOST;
     uint8_t f[PROTO_FRAME_MAX];
-    size_t fl = 0;
-    assert_int_equal(proto_encode(&m, 0, f, sizeof(f), &fl), PROTO_OK);
-    assert_int_equal(link_send(&l, f, fl), ARGIL_OK);
     *b1_rows = *rows = 0;
     uint64_t t = 1000u;
     for (int ms = 0; ms < 2000; ms++) {
