@@ -48,6 +48,7 @@ rig_input() {
         if [ "$2" = 1 ]; then echo pull-up >"$(sim_attr "$1" pull)"; else echo pull-down >"$(sim_attr "$1" pull)"; fi ;;
     loopback)
         eval "off=\${LOOP_$1:?LOOP_$1 not set in the rig config}"
+        [ -n "${HIL_WATCH_READY:-}" ] && : >"$HIL_WATCH_READY" # gpiomon says nothing sooner
         eval "old=\${LOOP_PID_$1:-}"
         [ -n "$old" ] && kill "$old" 2>/dev/null
         gpioset --mode=signal "$LOOP_CHIP" "$off=$2" &
@@ -65,6 +66,24 @@ rig_watch() {
         v=$(gpioget "$LOOP_CHIP" "$off")
         echo "samples=0 high=$v edges=$n first_edge=0 last_edge=0 final=$v" ;;
     esac
+}
+# rig_watch_start LINE MS FILE: rig_watch LINE MS into FILE in the background (WATCH_PID), and
+# return once the watch has taken its first sample (up to 10 s; status 1 if it never did), so a
+# stimulus applied after it is inside the watch however late a busy rig started the process.
+# A fixed sleep did not hold: once, under TCG on a loaded machine, the watcher's first sample
+# came 1.2 s after it was launched and it saw DRIVE_ENABLE only after it had fallen.
+WATCH_PID=
+rig_watch_start() {
+    ready="$3.ready"
+    rm -f "$ready"
+    HIL_WATCH_READY=$ready
+    export HIL_WATCH_READY
+    rig_watch "$1" "$2" >"$3" &
+    WATCH_PID=$!
+    unset HIL_WATCH_READY
+    n=0
+    while [ ! -e "$ready" ] && [ "$n" -lt 1000 ]; do sleep 0.01; n=$((n + 1)); done
+    [ -e "$ready" ]
 }
 field() { echo "$2" | tr ' ' '\n' | sed -n "s/^$1=//p"; } # field NAME "k=v k=v"
 # Edge times on the CAN log's clock: gpio-sim samples do; gpiomon's (loopback) are
@@ -121,9 +140,17 @@ CANDUMP_PID=
 # socket memory: 4 MiB held 0.7 s of a scenario's traffic, and a candump that far behind lost
 # frames, so SYNC counts and verdicts were wrong, CI 2026-12-02); -d reports any frame the
 # socket still drops (DROPCOUNT lines, moved to $CHECK.candump.drops by can_log_stop).
+# Returns once candump holds its CAN socket (up to 10 s), so the frames the check causes next
+# (a board's NMT start) are in the log however late a busy rig starts it; a fixed sleep was the
+# same bet that failed rig_watch once (see rig_watch_start).
 can_log_start() {
     hil-probe fifo "$CANDUMP_PRIO" candump -L -d -r 16777216 "$CAN_IF" >"$OUT/$CHECK.candump.log" 2>"$OUT/$CHECK.candump.err" &
-    CANDUMP_PID=$!; sleep 0.2
+    CANDUMP_PID=$!
+    cl_n=0
+    while ! ls -l "/proc/$CANDUMP_PID/fd" 2>/dev/null | grep -q 'socket:' && [ "$cl_n" -lt 1000 ]; do
+        sleep 0.01; cl_n=$((cl_n + 1))
+    done
+    sleep 0.05 # its bind follows the socket call
 }
 # candump runs under the rig's real-time work and may be far behind (0.7 s of frames were still
 # in its socket when a scenario's log was cut, 2026-12-02): before it is stopped it writes out
@@ -316,8 +343,9 @@ check_estop() {
     host_start 8
     host_wait_state ARMED 4 >/dev/null || { fail "host could not arm the board: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
     sleep 0.2
-    rig_watch "$LINE_DRIVE_ENABLE" 1000 >"$OUT/$CHECK.enable" &
-    wp=$!
+    rig_watch_start "$LINE_DRIVE_ENABLE" 1000 "$OUT/$CHECK.enable" ||
+        { fail "the DRIVE_ENABLE watch did not start within 10 s: rig too busy"; return; }
+    wp=$WATCH_PID
     sleep 0.4
     if [ "$STIM" = gpio-sim ]; then
         tw=$(hil-probe set "$(sim_attr "$LINE_ESTOP" pull)" pull-down)
@@ -365,8 +393,9 @@ check_drive_heartbeat() {
     host_wait_state ARMED 4 >/dev/null || { fail "host could not arm the board: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
     sleep 0.5
     grep -q "state FAULT" "$OUT/$CHECK.board.log" && { fail "FAULT while heartbeats flow: $(board_tail)"; return; }
-    rig_watch "$LINE_DRIVE_ENABLE" 3000 >"$OUT/$CHECK.enable" &
-    wp=$!
+    rig_watch_start "$LINE_DRIVE_ENABLE" 3000 "$OUT/$CHECK.enable" ||
+        { fail "the DRIVE_ENABLE watch did not start within 10 s: rig too busy"; return; }
+    wp=$WATCH_PID
     sleep 0.3
     heartbeats_stop
     wait "$wp"
@@ -394,8 +423,9 @@ check_host_loss() {
     rig_has_edge_times || { skip "needs GPIO edge times on the CAN log's clock (STIM=gpio-sim)"; return; }
     can_log_start
     board_start --can "$CAN_IF" --link "udp:127.0.0.1:$UDP_PORT" || { fail "did not start: $(board_tail)"; return; }
-    rig_watch "$LINE_DRIVE_ENABLE" 6500 >"$OUT/$CHECK.enable" &
-    wp=$!
+    rig_watch_start "$LINE_DRIVE_ENABLE" 6500 "$OUT/$CHECK.enable" ||
+        { fail "the DRIVE_ENABLE watch did not start within 10 s: rig too busy"; return; }
+    wp=$WATCH_PID
     sleep 0.5
     host_start 4
     host_wait_state ARMED 4 >/dev/null || { fail "host could not arm the board: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }

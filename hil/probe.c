@@ -10,7 +10,9 @@
  *       "samples=N high=N edges=N first_edge=T last_edge=T final=V start=T end=T
  *        first_edge_lo=T last_edge_lo=T": an edge happened after its _lo time (the sample
  *       before) and no later than its time (the sample that saw it); start/end: the first and
- *       last sample, so a caller can count board ticks in between
+ *       last sample, so a caller can count board ticks in between; with HIL_WATCH_READY=PATH
+ *       in the environment it creates PATH once the first sample is taken, so a caller can
+ *       apply its stimulus after the watch has begun however late a busy rig started it
  *   hil-probe fifo PRIO CMD [ARG...]    run CMD under SCHED_FIFO at PRIO (busybox has no chrt):
  *                                      the rig's CAN logger must not lose frames to a busy CPU
  *   hil-probe chrt PRIO PID            set a running task SCHED_FIFO at PRIO (the VM raises
@@ -97,6 +99,21 @@ static int read_level(int fd)
     return c == '1' ? 1 : c == '0' ? 0 : -1;
 }
 
+/* Creates $HIL_WATCH_READY (if set) holding the first sample's time. */
+static void signal_ready(double t)
+{
+    const char *ready = getenv("HIL_WATCH_READY");
+    if (!ready || !*ready)
+        return;
+    FILE *f = fopen(ready, "w");
+    if (!f) {
+        fprintf(stderr, "hil-probe: cannot create '%s': %s\n", ready, strerror(errno));
+        return;
+    }
+    fprintf(f, "%.6f\n", t);
+    fclose(f);
+}
+
 static int watch(const char *path, long ms, long period_us)
 {
     const int fd = open(path, O_RDONLY);
@@ -120,8 +137,10 @@ static int watch(const char *path, long ms, long period_us)
             close(fd);
             return 1;
         }
-        if (samples == 0)
+        if (samples == 0) {
             t_first = t;
+            signal_ready(t);
+        }
         t_last = t;
         samples++;
         high += v;
