@@ -10,6 +10,7 @@
 #   make bench        figures for the 1 kHz path and the host
 #   make cross        aarch64 and Cortex-M builds, run under qemu (docs/board.md)
 #   make hil          the HIL VM rig: real argil-board on vcan/gpio-sim/FunctionFS (hil/README.md)
+#   make hil-repeat N=20  the HIL plan N times: each check's passes of N (hil/repeat.sh)
 #   make clean
 
 BUILD ?= build
@@ -65,7 +66,7 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all check-compile-deps check-layers run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all check-compile-deps check-layers run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil hil-repeat clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
 all: $(REL)/argil $(REL)/argil-board check-freestanding check-layers
@@ -333,6 +334,11 @@ HIL_BINS := $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/h
 hil: deps-hil
 	@$(MAKE) --no-print-directory $(HIL_BINS)
 	@$(RUN_TESTS) hil
+
+# The whole HIL plan N times over and each check's passes of N (hil/repeat.sh; not in make test).
+N ?= 20
+hil-repeat: deps-hil
+	@sh hil/repeat.sh $(N) $(BUILD)
 
 clean:
 	rm -rf $(BUILD) $(OUT)

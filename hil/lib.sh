@@ -67,9 +67,11 @@ rig_watch() {
         echo "samples=0 high=$v edges=$n first_edge=0 last_edge=0 final=$v" ;;
     esac
 }
-# rig_watch_start LINE MS FILE: rig_watch LINE MS into FILE in the background (WATCH_PID), and
-# return once the watch has taken its first sample (up to 10 s; status 1 if it never did), so a
-# stimulus applied after it is inside the watch however late a busy rig started the process.
+# rig_watch_start LINE MS FILE [AFTER_EDGE_MS]: rig_watch LINE MS into FILE in the background
+# (WATCH_PID), and return once the watch has taken its first sample (up to 10 s; status 1 if it
+# never did), so a stimulus applied after it is inside the watch however late a busy rig started
+# the process. With AFTER_EDGE_MS the watch ends that long after its first edge, and MS is only
+# the most it waits for one (a stimulus process can start late too).
 # A fixed sleep did not hold: once, under TCG on a loaded machine, the watcher's first sample
 # came 1.2 s after it was launched and it saw DRIVE_ENABLE only after it had fallen.
 WATCH_PID=
@@ -77,10 +79,11 @@ rig_watch_start() {
     ready="$3.ready"
     rm -f "$ready"
     HIL_WATCH_READY=$ready
-    export HIL_WATCH_READY
+    HIL_WATCH_AFTER_EDGE_MS=${4:-}
+    export HIL_WATCH_READY HIL_WATCH_AFTER_EDGE_MS
     rig_watch "$1" "$2" >"$3" &
     WATCH_PID=$!
-    unset HIL_WATCH_READY
+    unset HIL_WATCH_READY HIL_WATCH_AFTER_EDGE_MS
     n=0
     while [ ! -e "$ready" ] && [ "$n" -lt 1000 ]; do sleep 0.01; n=$((n + 1)); done
     [ -e "$ready" ]
@@ -343,7 +346,7 @@ check_estop() {
     host_start 8
     host_wait_state ARMED 4 >/dev/null || { fail "host could not arm the board: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
     sleep 0.2
-    rig_watch_start "$LINE_DRIVE_ENABLE" 1000 "$OUT/$CHECK.enable" ||
+    rig_watch_start "$LINE_DRIVE_ENABLE" 5000 "$OUT/$CHECK.enable" 300 ||
         { fail "the DRIVE_ENABLE watch did not start within 10 s: rig too busy"; return; }
     wp=$WATCH_PID
     sleep 0.4
@@ -393,7 +396,7 @@ check_drive_heartbeat() {
     host_wait_state ARMED 4 >/dev/null || { fail "host could not arm the board: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
     sleep 0.5
     grep -q "state FAULT" "$OUT/$CHECK.board.log" && { fail "FAULT while heartbeats flow: $(board_tail)"; return; }
-    rig_watch_start "$LINE_DRIVE_ENABLE" 3000 "$OUT/$CHECK.enable" ||
+    rig_watch_start "$LINE_DRIVE_ENABLE" 8000 "$OUT/$CHECK.enable" 300 ||
         { fail "the DRIVE_ENABLE watch did not start within 10 s: rig too busy"; return; }
     wp=$WATCH_PID
     sleep 0.3

@@ -12,7 +12,9 @@
  *       before) and no later than its time (the sample that saw it); start/end: the first and
  *       last sample, so a caller can count board ticks in between; with HIL_WATCH_READY=PATH
  *       in the environment it creates PATH once the first sample is taken, so a caller can
- *       apply its stimulus after the watch has begun however late a busy rig started it
+ *       apply its stimulus after the watch has begun however late a busy rig started it; with
+ *       HIL_WATCH_AFTER_EDGE_MS=M it ends M ms after the first edge (MS is then the most it waits
+ *       for one)
  *   hil-probe fifo PRIO CMD [ARG...]    run CMD under SCHED_FIFO at PRIO (busybox has no chrt):
  *                                      the rig's CAN logger must not lose frames to a busy CPU
  *   hil-probe chrt PRIO PID            set a running task SCHED_FIFO at PRIO (the VM raises
@@ -121,7 +123,9 @@ static int watch(const char *path, long ms, long period_us)
         fprintf(stderr, "hil-probe: cannot open '%s': %s\n", path, strerror(errno));
         return 1;
     }
-    const double end = now_s() + (double)ms / 1e3;
+    double end = now_s() + (double)ms / 1e3;
+    const char *ae = getenv("HIL_WATCH_AFTER_EDGE_MS");
+    const double after_edge_s = ae && *ae ? strtod(ae, NULL) / 1e3 : -1.0;
     long samples = 0, high = 0, edges = 0;
     double first = 0.0, last = 0.0, t_first = 0.0, t_last = 0.0;
     int prev = -1, v = -1;
@@ -148,6 +152,8 @@ static int watch(const char *path, long ms, long period_us)
             if (edges == 0) {
                 first = t;
                 first_lo = t_prev;
+                if (after_edge_s >= 0.0 && t + after_edge_s < end)
+                    end = t + after_edge_s;
             }
             last = t;
             last_lo = t_prev;

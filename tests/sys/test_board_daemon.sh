@@ -53,7 +53,8 @@ expect_error 2 "needs no key" --bus sim --link "ffs:$tmp/ffs" --key "$tmp/link.k
 # The real daemon (simulated arm behind it) and a host over UDP. 2000 Hz must work too.
 port=$((20000 + $$ % 20000))
 for rate in 1000 2000; do
-    "$bin" --bus sim --link "udp:127.0.0.1:$port" --rate-hz "$rate" --duration-s 6 \
+    # --duration-s only a backstop: SIGTERM below ends it (a loaded machine must not win a race)
+    "$bin" --bus sim --link "udp:127.0.0.1:$port" --rate-hz "$rate" --duration-s 60 \
         --stats-period-s 0 --overrun-streak 0 --key "$tmp/link.key" \
         >"$tmp/daemon.out" 2>"$tmp/daemon.err" &
     pid=$!

@@ -23,8 +23,10 @@ board_key="--insecure"; host_key=""; stranger_key=""
 [ "$keyed" = 1 ] && { board_key="--key $tmp/board.key"; host_key="--key $tmp/board.key"; stranger_key="$tmp/stranger.key"; }
 rm -rf "$tmp/s"
 # shellcheck disable=SC2086
+# --duration-s is only a backstop (SIGTERM below ends it): at 12 s it ran out first on a loaded
+# machine, where the host took seconds to go ACTIVE, and the kill found no daemon.
 "$REL/argil-board" --bus sim --link "udp:127.0.0.1:$port" --rt-priority 0 --overrun-streak 0 \
-    --stats-period-s 0 --duration-s 12 $board_key >"$tmp/board.out" 2>"$tmp/board.err" &
+    --stats-period-s 0 --duration-s 60 $board_key >"$tmp/board.out" 2>"$tmp/board.err" &
 bpid=$!
 sleep 0.3
 # shellcheck disable=SC2086
