@@ -385,7 +385,11 @@ check_estop() {
 
 # drive_heartbeat: three drives send heartbeats, a host arms the board, then the drives fall
 # silent: FAULT (drive heartbeat lost) after the 250 ms consumer timeout, i.e. 250 board ticks:
-# counted as SYNC frames from the oldest last heartbeat to the DRIVE_ENABLE falling edge.
+# counted as SYNC frames from the oldest last heartbeat to the DRIVE_ENABLE falling edge. The
+# first tick that begins after the heartbeat reads it: the one that ends with the first SYNC
+# after it, or the second when the heartbeat came while a tick was computing. The board faults
+# when the heartbeat's age passes 250 ticks, in the 251st tick after the one that read it, and
+# writes DRIVE_ENABLE after that tick's SYNC: the edge follows SYNC 252 or 253.
 check_drive_heartbeat() {
     rig_has_edge_times || { skip "needs GPIO edge times on the CAN log's clock (STIM=gpio-sim)"; return; }
     can_log_start
@@ -409,11 +413,11 @@ check_drive_heartbeat() {
     [ "$(field edges "$en")" = 1 ] && [ "$(field final "$en")" = 0 ] || { fail "DRIVE_ENABLE did not fall once: $en"; return; }
     # The first drive to time out is the one whose last heartbeat is oldest.
     hb=$(for n in 1 2 3; do can_last "70$n#05"; done | sort -n | head -n 1)
-    # The fall lies in (lo, hi]: fail when it was surely before tick 249 or surely after 252.
+    # The fall lies in (lo, hi]: fail when it was surely before SYNC 252 or surely after 253.
     lo=$(field first_edge_lo "$en"); hi=$(field first_edge "$en")
     t_lo=$(ticks_between "$hb" "$lo"); t_hi=$(ticks_between "$hb" "$hi")
     ms="$(ms_between "$hb" "$lo")..$(ms_between "$hb" "$hi")"
-    [ "$t_hi" -ge 249 ] && [ "$t_lo" -le 252 ] || { fail "DRIVE_ENABLE fell between $t_lo and $t_hi ticks ($ms ms) after the last heartbeat, want 250..252"; return; }
+    [ "$t_hi" -ge 252 ] && [ "$t_lo" -le 253 ] || { fail "DRIVE_ENABLE fell between $t_lo and $t_hi ticks ($ms ms) after the last heartbeat, want 252..253"; return; }
     pass "FAULT (drive heartbeat lost): DRIVE_ENABLE fell between $t_lo and $t_hi ticks ($ms ms) after the last heartbeat (timeout 250 ms = 250 ticks), logged +$(ms_between "$hb" "$t1") ms"
 }
 
