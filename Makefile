@@ -49,8 +49,8 @@ LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
 # HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
-BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/can_socket.c firmware/hal/gpio_port.c \
-                 firmware/hal/gpio_gpiod.c firmware/hal/link_udp.c \
+BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/hal_sim_bus.c firmware/hal/can_socket.c \
+                 firmware/hal/gpio_port.c firmware/hal/gpio_gpiod.c firmware/hal/link_udp.c \
                  firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)

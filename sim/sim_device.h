@@ -23,7 +23,7 @@ typedef struct {
     uint32_t quick_stop_ms;         /* drives' quick stop duration before SWITCH_ON_DISABLED */
 } sim_params_t;
 
-typedef struct {
+typedef struct sim_device {
     sim_params_t p;
     arm_sim_t arm;
     drive_t drive[ARGIL_DRIVES];    /* joint j is node j + 1 */

@@ -10,7 +10,7 @@
 # layer of a file         may include
 #   shared/               shared/
 #   firmware/core/        firmware/core/, shared/, and the HAL interface firmware/hal/hal.h
-#   firmware/hal/         firmware/hal/, shared/  (hal_sim.* also sim/)
+#   firmware/hal/         firmware/hal/, shared/  (the sim backends hal_sim.*, hal_sim_bus.* also sim/)
 #   firmware/board/,      firmware/core/, firmware/hal/, shared/  (the daemon's and the MCU
 #   firmware/cortexm/     image's mains compose the core and a HAL)
 #   sim/rig/              firmware/, sim/, shared/, host/link/link.h
@@ -29,7 +29,7 @@ awk -v known="$known" '
 function layer(p) {
     if (p ~ /^shared\//) return "shared"
     if (p ~ /^firmware\/core\//) return "core"
-    if (p ~ /^firmware\/hal\/hal_sim\.[ch]$/) return "hal_sim"
+    if (p ~ /^firmware\/hal\/hal_sim(_bus)?\.[ch]$/) return "hal_sim"
     if (p ~ /^firmware\/hal\//) return "hal"
     if (p ~ /^firmware\/(board|cortexm)\//) return "main"
     if (p ~ /^sim\/rig\//) return "rig"
@@ -46,7 +46,7 @@ function broken(l, p,    t) {
     if (l == "core") return (t == "core" || t == "shared" || p == "firmware/hal/hal.h") ? "" : \
         "firmware/core includes only firmware/core, shared/ and firmware/hal/hal.h"
     if (l == "hal") return (t == "hal" || t == "hal_sim" || t == "shared") ? "" : \
-        "firmware/hal includes only firmware/hal and shared/ (sim/ only from hal_sim.*)"
+        "firmware/hal includes only firmware/hal and shared/ (sim/ only from hal_sim.*, hal_sim_bus.*)"
     if (l == "hal_sim") return (t == "hal" || t == "hal_sim" || t == "shared" || t == "sim") ? "" : \
         "the sim HAL includes only firmware/hal, sim/ and shared/"
     if (l == "main") return (t == "core" || t == "hal" || t == "hal_sim" || t == "shared" || t == "main") ? "" : \

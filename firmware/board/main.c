@@ -20,6 +20,7 @@
 #include "firmware/core/board_hal.h"
 #include "firmware/core/rt_stats.h"
 #include "firmware/hal/hal_linux.h"
+#include "firmware/hal/hal_sim_bus.h"
 #include "firmware/hal/link_io.h"
 #include "firmware/hal/link_key.h"
 

@@ -1,5 +1,5 @@
 /* HAL backend for the Linux board: SocketCAN, libgpiod (through gpio_port), SPSC link rings,
- * CLOCK_MONOTONIC; or the simulated arm in place of CAN and GPIO. */
+ * CLOCK_MONOTONIC; or the simulated arm in place of CAN and GPIO (hal_sim_bus.c). */
 #define _POSIX_C_SOURCE 200809L
 #include "hal_linux.h"
 
@@ -9,10 +9,13 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "shared/gpio_lines.h"
+#include "hal_sim_bus.h"
 
-static argil_err_t rings_init(hal_t *h)
+argil_err_t hal_linux_reset(hal_t *h, hal_bus_t bus)
 {
+    memset(h, 0, offsetof(hal_t, link_rx_mem));
+    h->bus = bus;
+    h->can_fd = -1;
     if (spsc_init(&h->link_rx, h->link_rx_mem, HAL_LINUX_RX_RING_BYTES) != ARGIL_OK ||
         spsc_init(&h->link_tx, h->link_tx_mem, HAL_LINUX_TX_RING_BYTES) != ARGIL_OK)
         return ARGIL_ERR_ARG;
@@ -22,10 +25,7 @@ static argil_err_t rings_init(hal_t *h)
 argil_err_t hal_linux_open(hal_t *h, const char *can_if, const gpio_names_t *names, char *err,
                            size_t err_len)
 {
-    memset(h, 0, offsetof(hal_t, link_rx_mem));
-    h->bus = HAL_BUS_SOCKETCAN;
-    h->can_fd = -1;
-    argil_err_t rc = rings_init(h);
+    argil_err_t rc = hal_linux_reset(h, HAL_BUS_SOCKETCAN);
     if (rc != ARGIL_OK)
         return rc;
     rc = can_socket_open(can_if, &h->can_fd, err, err_len);
@@ -39,117 +39,13 @@ argil_err_t hal_linux_open(hal_t *h, const char *can_if, const gpio_names_t *nam
     return rc;
 }
 
-/* ---- the simulated arm as a GPIO chip with the default line names ---- */
-
-typedef struct {
-    const char *name;
-    uint32_t bit;
-    bool output;
-} sim_line_t;
-
-static const sim_line_t sim_lines[] = {
-    {"ESTOP_N", GPIO_IN_ESTOP_N, false},         {"DRIVE_FAULT_N", GPIO_IN_DRIVE_FAULT_N, false},
-    {"STYLUS_BTN1", GPIO_IN_STYLUS_BTN1, false}, {"STYLUS_BTN2", GPIO_IN_STYLUS_BTN2, false},
-    {"DRIVE_ENABLE", GPIO_OUT_DRIVE_ENABLE, true}, {"STATUS_LED", GPIO_OUT_STATUS_LED, true},
-    {"WDOG_KICK", GPIO_OUT_WDOG_KICK, true},
-};
-#define SIM_CHIP "argil-sim"
-
-static void *sim_chip_open(void *ctx, const char *chip)
-{
-    return strcmp(chip, SIM_CHIP) == 0 || strcmp(chip, "gpiochip0") == 0 ? ctx : NULL;
-}
-
-static void sim_chip_close(void *ctx, void *chip)
-{
-    (void)ctx;
-    (void)chip;
-}
-
-static void *sim_line_find(void *ctx, void *chip, const char *name)
-{
-    (void)ctx;
-    (void)chip;
-    for (size_t i = 0; i < sizeof(sim_lines) / sizeof(sim_lines[0]); i++)
-        if (strcmp(sim_lines[i].name, name) == 0)
-            return (void *)&sim_lines[i];
-    return NULL;
-}
-
-static int sim_request_in(void *ctx, void *line, const char *consumer)
-{
-    (void)ctx;
-    (void)consumer;
-    return ((const sim_line_t *)line)->output ? -1 : 0;
-}
-
-static int sim_request_out(void *ctx, void *line, const char *consumer, int level)
-{
-    (void)consumer;
-    const sim_line_t *l = line;
-    if (!l->output)
-        return -1;
-    hal_t *h = ctx;
-    h->sim_gpio_out = level ? (h->sim_gpio_out | l->bit) : (h->sim_gpio_out & ~l->bit);
-    return 0;
-}
-
-static int sim_get(void *ctx, void *line)
-{
-    hal_t *h = ctx;
-    return (sim_device_gpio_in(h->sim) & ((const sim_line_t *)line)->bit) ? 1 : 0;
-}
-
-static int sim_set(void *ctx, void *line, int level)
-{
-    return sim_request_out(ctx, line, NULL, level);
-}
-
-static void sim_release(void *ctx, void *line)
-{
-    (void)ctx;
-    (void)line;
-}
-
-static const gpio_ops_t sim_gpio_ops = {sim_chip_open, sim_chip_close, sim_line_find,
-                                        sim_request_in, sim_request_out, sim_get,
-                                        sim_set, sim_release};
-
-argil_err_t hal_linux_open_sim(hal_t *h, const gpio_names_t *names, uint32_t tick_us, char *err,
-                               size_t err_len)
-{
-    memset(h, 0, offsetof(hal_t, link_rx_mem));
-    h->bus = HAL_BUS_SIM;
-    h->can_fd = -1;
-    h->tick_us = tick_us;
-    argil_err_t rc = rings_init(h);
-    if (rc != ARGIL_OK)
-        return rc;
-    h->sim = calloc(1, sizeof(*h->sim));
-    if (h->sim == NULL) {
-        snprintf(err, err_len, "simulated arm: out of memory");
-        return ARGIL_ERR_NOMEM;
-    }
-    sim_params_t sp;
-    sim_params_default(&sp);
-    sim_device_init(h->sim, &sp);
-    sim_device_release_hand(h->sim);
-    rc = gpio_port_open(&h->gpio, &sim_gpio_ops, h, names, err, err_len);
-    if (rc != ARGIL_OK) {
-        free(h->sim);
-        h->sim = NULL;
-    }
-    return rc;
-}
-
 void hal_linux_close(hal_t *h)
 {
     gpio_port_close(&h->gpio);
     if (h->can_fd >= 0)
         close(h->can_fd);
     h->can_fd = -1;
-    free(h->sim);
-    h->sim = NULL;
+    hal_sim_bus_close(h);
 }
 
 argil_err_t hal_linux_can_flush(hal_t *h, const can_batch_t *tx)
@@ -162,9 +58,7 @@ argil_err_t hal_linux_can_flush(hal_t *h, const can_batch_t *tx)
 argil_err_t hal_can_receive(hal_t *h, can_batch_t *rx)
 {
     if (h->bus == HAL_BUS_SIM) {
-        /* One step of the simulated arm under last tick's frames and lines. */
-        sim_device_step(h->sim, &h->sim_from_board, h->sim_gpio_out, rx, h->tick_us);
-        h->sim_from_board.n = 0;
+        hal_sim_bus_step(h, rx);
         return ARGIL_OK;
     }
     return can_socket_receive_queued(h->can_fd, &h->can_rx, rx, &h->can);

@@ -1,7 +1,8 @@
 /* The Linux board backend of the HAL: SocketCAN for the drives, libgpiod lines, and the host
  * link handed over through two lock-free SPSC rings that the link thread serves (the fast loop
  * never makes a link system call). A "sim" bus replaces CAN and GPIO with the in-process
- * simulated arm (sim/), so the real daemon runs and is tested on a machine with neither. */
+ * simulated arm (hal_sim_bus.h: the only part that includes sim/), so the real daemon runs and
+ * is tested on a machine with neither. */
 #ifndef ARGIL_HAL_LINUX_H
 #define ARGIL_HAL_LINUX_H
 
@@ -13,12 +14,13 @@
 #include "gpio_port.h"
 #include "hal.h"
 #include "shared/spsc_ring.h"
-#include "sim/sim_device.h"
 
 #define HAL_LINUX_RX_RING_BYTES (1u << 17)   /* host → board frames waiting for the tick */
 #define HAL_LINUX_TX_RING_BYTES (1u << 19)   /* board → host, about 50 ticks of output */
 
 typedef enum { HAL_BUS_SOCKETCAN = 0, HAL_BUS_SIM = 1 } hal_bus_t;
+
+struct sim_device; /* the simulated arm of the sim bus (hal_sim_bus.c) */
 
 struct hal {
     hal_bus_t bus;
@@ -27,7 +29,7 @@ struct hal {
     can_rx_queue_t can_rx;
     gpio_port_t gpio;
     /* sim bus */
-    sim_device_t *sim;
+    struct sim_device *sim;
     can_batch_t sim_from_board;    /* frames the board sent, delivered at the next step */
     uint32_t sim_gpio_out;
     uint32_t tick_us;
@@ -44,14 +46,13 @@ struct hal {
     uint32_t link_rx_too_big;      /* records larger than the tick's buffer (dropped) */
 };
 
-/* Opens the SocketCAN interface and the GPIO lines. One line into err on failure. */
+/* Opens the SocketCAN interface and the GPIO lines (the sim bus: hal_linux_open_sim in
+ * hal_sim_bus.h). One line into err on failure. */
 argil_err_t hal_linux_open(hal_t *h, const char *can_if, const gpio_names_t *names,
                            char *err, size_t err_len);
 
-/* Uses the simulated arm (sim_params_default) for CAN and GPIO; the lines still go through
- * gpio_port with the default names, so a wrong line name fails as on a real chip. */
-argil_err_t hal_linux_open_sim(hal_t *h, const gpio_names_t *names, uint32_t tick_us,
-                               char *err, size_t err_len);
+/* Clears h for a backend on bus and sets up its link rings (both opens start here). */
+argil_err_t hal_linux_reset(hal_t *h, hal_bus_t bus);
 
 void hal_linux_close(hal_t *h);
 
