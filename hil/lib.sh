@@ -681,20 +681,21 @@ check_scenario() {
         return
     fi
     # How long the board took to get ready, and how far behind the board the arm stand-in fell
-    # at least (the most SYNCs it took in one read of at most 32 frames): the figures to look
-    # at when a bound is near.
+    # (the most SYNCs waiting for it when it woke): the figures to look at when a bound is near.
     pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\).*/ready after \1 board ticks (\2 ms)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
-    lag=$(sed -n 's/.* end .*max_syncs_per_read=\([0-9]*\).*/, arm stand-in >= \1 ticks behind at worst (8: a full read)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
+    lag=$(sed -n 's/.* end .*max_backlog_syncs=\([0-9]*\).*/, arm stand-in up to \1 ticks behind/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     # How late the bus delivered a frame: in the raw log (delivery order) the most a frame's
     # stamp lies behind the latest stamp before it (vcan0's frames wait in the sender CPU's
     # backlog until the network softirq runs; see vm/init).
+    # How long the rig held hil-host's real-time thread (its heartbeats) back at worst.
+    hgap=$(sed -n 's/.* rt_max_gap_ms=\([0-9.]*\).*/, host thread held up to \1 ms/p' "$OUT/$CHECK.host.log" | tail -n 1)
     late=$(awk '{ t = substr($1, 2, length($1) - 2) + 0; if (t > m) m = t; else if (m - t > d) d = m - t }
                 END { printf ", frames delivered up to %.1f ms late", d * 1000 }' "$OUT/$CHECK.candump.log")
     # The board's states as it logged them, for a failure: "ACTIVE FAULT(drive heartbeat lost)".
     states=$(sed -n 's/^[0-9.]* argil-board: state \([A-Z]*\)\( — \(.*\)\)*$/\1(\3)/p' "$OUT/$CHECK.board.log" | sed 's/()//' | tr '\n' ' ')
     # and its last word (a daemon that gave up says why: "CAN bus-off not recovered ...").
     last=$(tail -n 1 "$OUT/$CHECK.board.log" | cut -d' ' -f2-)
-    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag$late; board: $states; last: $last]"; return; }
+    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag$late$hgap; board: $states; last: $last]"; return; }
     # A stranger on the network (`stranger KIND for D`): the board refused its frames by reason,
     # as its RT_STATS told hil-host, and served one host session throughout.
     if grep -q '^at .* stranger ' "$scn"; then
@@ -714,7 +715,7 @@ check_scenario() {
             { fail "$res, but the board's refusals do not show the stranger: $(echo "$sl" | cut -d' ' -f2-)"; return; }
         res="$res; stranger refused: wrong source $ws, replayed $dup, bad tag ${mac:-0}, one session"
     fi
-    pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag$late)"
+    pass "$res ($(grep -c . "$OUT/$CHECK.candump.log") CAN frames logged; $pre$lag$late$hgap)"
 }
 
 # can_controller NAME: scenario NAME on real CAN controller drivers instead of vcan, as a user

@@ -558,7 +558,10 @@ int main(int argc, char **argv)
     }
     const int64_t preroll_t0_us = mono_us();
     bool gate_seen = false;
-    uint32_t max_syncs_per_read = 0;
+    /* How far behind the board this stand-in fell: the SYNCs waiting when it woke, read one
+     * batch after another until the socket came back short (one read holds at most
+     * CAN_BATCH_MAX frames, about 8 ticks' worth, so a count per read saturates there). */
+    uint32_t backlog_syncs = 0, max_backlog_syncs = 0;
 
     can_socket_stats_t st;
     memset(&st, 0, sizeof(st));
@@ -633,6 +636,12 @@ int main(int argc, char **argv)
             rc = EXIT_RUN;
             break;
         }
+        for (uint8_t i = 0; i < rx.n; i++)
+            backlog_syncs += rx.f[i].id == CANOPEN_COB_SYNC && rx.f[i].len <= 1u;
+        if (backlog_syncs > max_backlog_syncs)
+            max_backlog_syncs = backlog_syncs;
+        if (rx.n < CAN_BATCH_MAX)
+            backlog_syncs = 0; /* the socket is empty: caught up */
         struct timespec t_read;
         clock_gettime(CLOCK_REALTIME, &t_read);
         if (preroll && gate_seen && rx.n == 0) {
@@ -647,24 +656,21 @@ int main(int argc, char **argv)
             write_event(&t_before_read, 0, line);
             fflush(event_log);
             scn_clock_init(&clk, clock_ticks, mono_us());
-            max_syncs_per_read = 0; /* the backlog of the scenario, not of the start-up */
+            max_backlog_syncs = 0; /* the backlog of the scenario, not of the start-up */
             sim_runner_hold(&run, false);
             run.have_gpio_out = false; /* the next tick logs DRIVE_ENABLE's level */
             continue;
         }
         /* One device step per SYNC (with the frames the board sent before it), or one on the
          * wall clock when the bus has been silent; frames after the last SYNC wait for it. */
-        uint32_t steps_this_read = 0, syncs_this_read = 0;
+        uint32_t steps_this_read = 0;
         for (uint32_t i = 0; i <= rx.n && rc == 0; i++) {
             uint32_t dt_us = 0;
             if (i < rx.n) {
                 const can_frame_t *f = &rx.f[i];
                 (void)can_batch_push(&held, f);
-                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u) {
+                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
                     dt_us = scn_clock_sync(&clk, mono_us());
-                    if (++syncs_this_read > max_syncs_per_read)
-                        max_syncs_per_read = syncs_this_read;
-                }
                 else if (held.n < CAN_BATCH_MAX)
                     continue;
                 /* a full batch without SYNC is handed over with a step of 0 */
@@ -738,11 +744,11 @@ int main(int argc, char **argv)
     snprintf(line, sizeof(line),
              "end frames_rx=%u frames_tx=%u tx_busy=%u tx_errors=%u error_frames_retried=%u "
              "error_frames_unsent=%u late_ticks=%u dropped=%u/%u silenced=%u "
-             "clock %s syncs=%u wall_steps=%u max_syncs_per_read=%u cpu_ms=%.0f",
+             "clock %s syncs=%u wall_steps=%u max_backlog_syncs=%u cpu_ms=%.0f",
              st.rx_frames, st.tx_frames, st.tx_busy, st.tx_errors, err_frames_retried,
              err_pending_n, late_ticks, run.faults.dropped_to_board,
              run.faults.dropped_from_board, run.faults.silenced, clock_ticks ? "ticks" : "wall",
-             clk.syncs, clk.wall_steps, max_syncs_per_read, cpu_ms());
+             clk.syncs, clk.wall_steps, max_backlog_syncs, cpu_ms());
     log_event(NULL, run.now_us, line);
     if (event_log != stdout)
         fclose(event_log);
