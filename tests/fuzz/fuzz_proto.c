@@ -1,6 +1,7 @@
 /* libFuzzer target for the wire protocol: arbitrary bytes as one frame and as a stream,
  * with and without a repaired CRC; every decoded message must re-encode to the same bytes
  * and decode back to the same fields; WINDOW chunks go through a real window assembly. */
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -148,9 +149,9 @@ static void check_ranges(const proto_msg_t *m)
         check(w->sample_count <= PROTO_WINDOW_CHUNK_SAMPLES);
         check(w->first_sample + w->sample_count <= nodes * w->channels);
         for (uint32_t k = 0; k < w->sample_count; k++) {
-            check(w->samples[k] == w->samples[k]); /* not NaN */
+            check(isfinite(w->samples[k])); /* no NaN, no infinity */
             if (w->first_sample + k >= nodes)
-                check(w->samples[k] >= 0.0f && w->samples[k] <= 3.5e38f); /* a stiffness */
+                check(w->samples[k] >= 0.0f); /* a stiffness */
         }
     } else if (m->type == MSG_TOOL) {
         const msg_tool_t *t = &m->u.tool;
