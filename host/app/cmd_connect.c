@@ -257,10 +257,6 @@ static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t r
     }
 }
 
-/* The link's authentication says the session cannot go on (one line on stderr, true): a keyed
- * host that hears only datagrams with no valid tag (the board has another key, or none) for
- * 1 s, or an --arm session on a board that refuses to arm without a key. A keyless host that
- * hears nothing from a UDP board for 2 s is told once what a keyed board needs. */
 /* ---- undo and redo: command lines on standard input ---- */
 
 /* Reads what standard input has (never waits), queues its undo and redo lines, then works on the
@@ -704,6 +700,10 @@ static const char *link_auth_summary(const connect_opts_t *o, conn_t *c)
     return text;
 }
 
+/* The link's authentication says the session cannot go on (one line on stderr, true): a keyed
+ * host that hears only datagrams with no valid tag (the board has another key, or none) for
+ * 1 s, or an --arm session on a board that refuses to arm without a key. A keyless host that
+ * hears nothing from a UDP board for 2 s is told once what a keyed board needs. */
 static bool link_refusal_ends(conn_solver_t *s, const connect_opts_t *o, double elapsed_s,
                               bool *udp_hinted, bool tty)
 {
@@ -730,60 +730,74 @@ static bool link_refusal_ends(conn_solver_t *s, const connect_opts_t *o, double 
     return false;
 }
 
-int cmd_connect(int argc, char **argv)
-{
+/* One connect session from its options to its summary: what the steps below share. */
+typedef struct {
     connect_opts_t o;
-    const int st = parse_opts(argc, argv, &o);
-    if (st >= 0)
-        return st;
-    if (o.journal) {
-        const int offer = recover_offer(o.out_dir, o.discard_journal, isatty(STDIN_FILENO) != 0);
-        if (offer >= 0)
-            return offer;
-    }
-    const bool tty = isatty(STDERR_FILENO);
-    char err[1024] = "";
-    int exit_code = 0;
+    bool tty;                       /* stderr is a terminal: the status line redraws in place */
+    conn_t *c;
+    conn_solver_t *s;
+    msg_tool_t board_tool;          /* the tool the board was sent */
+    char csv_path[4096], csv_tmp[4200];
+    bool interrupted;               /* Ctrl-C or SIGTERM ended the session */
+    char journal_err[1024];         /* why the autosave journal stopped ("": it did not) */
+    double ran_s;                   /* from the solver loop's start to the link thread's end */
+    uint32_t frames_rx;             /* frames the link took in over the whole session */
+    size_t triangles;               /* in the final.ply written */
+} connect_session_t;
 
-    conn_t *c = calloc(1, sizeof(*c));
-    conn_solver_t *s = calloc(1, sizeof(*s));
-    if (!c || !s) {
-        free(c);
-        free(s);
-        fprintf(stderr, "argil connect: out of memory\n");
-        return 1;
-    }
-    s->c = c;
+/* The solver loop's own state: its clock, when to say HELLO and arm again, the last status. */
+typedef struct {
+    uint64_t last_us, next_us, status_at_us;
+    uint64_t last_hello_us, last_rearm_us;
+    bool hello_wanted, rearm_pending;
+    uint32_t hello_period_us;
+    uint32_t seen_resyncs, restarts_seen, rx_at_status, tx_at_status;
+    uint32_t windows_at_last;
+    /* What the host knew when the link was lost (for the re-arm rule). */
+    uint32_t faults_at_loss, faults_seen;
+    bool loss_by_transport, bad_before_loss;
+    bool udp_hinted;
+} conn_loop_t;
+
+/* Sets up the rings and opens the link (keyed with --key); 0, else the exit status (one line
+ * said why). */
+static int connect_open_link(connect_session_t *cs)
+{
+    conn_t *c = cs->c;
+    const connect_opts_t *o = &cs->o;
+    char err[1024] = "";
     c->rx_store = malloc(CONNECT_RX_RING_BYTES);
     c->tx_store = malloc(CONNECT_TX_RING_BYTES);
     if (!c->rx_store || !c->tx_store ||
         spsc_init(&c->rx, c->rx_store, CONNECT_RX_RING_BYTES) != ARGIL_OK ||
         spsc_init(&c->tx, c->tx_store, CONNECT_TX_RING_BYTES) != ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory\n");
-        exit_code = 1;
-        goto free_conn;
+        return 1;
     }
     link_key_t key;
-    if (o.key_file && !link_auth_init()) {
+    if (o->key_file && !link_auth_init()) {
         fprintf(stderr, "argil connect: libsodium cannot start (no random source?)\n");
-        exit_code = 1;
-        goto free_conn;
+        return 1;
     }
-    if (o.key_file && link_key_load(o.key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
+    if (o->key_file && link_key_load(o->key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        exit_code = 2;
-        goto free_conn;
+        return 2;
     }
     const argil_err_t lo =
-        link_open_keyed(&c->link, o.device, o.key_file ? key.k : NULL, err, sizeof(err));
+        link_open_keyed(&c->link, o->device, o->key_file ? key.k : NULL, err, sizeof(err));
     memset(&key, 0, sizeof(key));
     if (lo != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        exit_code = lo == ARGIL_ERR_PARSE || lo == ARGIL_ERR_ARG ? 2 : 1;
-        goto free_conn;
+        return lo == ARGIL_ERR_PARSE || lo == ARGIL_ERR_ARG ? 2 : 1;
     }
+    return 0;
+}
 
-    /* The host's clay: a sphere just below the arm's workspace centre (device = model). */
+/* The host's clay, a sphere just below the arm's workspace centre (device = model), and the
+ * peer on it; 0, else the exit status (one line said why, nothing left to free). */
+static int connect_clay_open(connect_session_t *cs)
+{
+    conn_solver_t *s = cs->s;
     arm_desc_t arm_desc;
     arm_desc_default(&arm_desc);
     const vec3_t centre = arm_workspace_centre(&arm_desc);
@@ -792,215 +806,280 @@ int cmd_connect(int argc, char **argv)
     peer_cfg_t pc;
     peer_cfg_default(&pc);
     pc.adaptive_region = true; /* real time: a slow solve narrows its region, never the board */
-    pc.global_solve = o.global_solve;
-    pc.knot_ratio = o.knot_ratio;
+    pc.global_solve = cs->o.global_solve;
+    pc.knot_ratio = cs->o.knot_ratio;
     /* The sphere is in the grid before the peer starts: the B-spline model is fitted to the
      * grid as peer_init finds it (an empty grid gave an empty model, whose solve then emptied
      * the clay inside every window it stepped). */
     if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
         ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory for the clay\n");
-        exit_code = 1;
-        goto close_link;
+        return 1;
     }
     grid_fill_sphere(&s->grid, vec3_sub(centre, vec3(0, 0, CONNECT_CLAY_BELOW_M)),
                      CONNECT_CLAY_RADIUS_M);
     if (peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory for the clay\n");
-        exit_code = 1;
         grid_free(&s->grid);
-        goto close_link;
+        return 1;
     }
-    if (peer_set_host_tool(&s->peer, &o.host_tool) != ARGIL_OK) {
+    return 0;
+}
+
+/* Frees the clay, its peer and its undo; a journal still open keeps its files (the end was not
+ * clean). */
+static void connect_clay_close(conn_solver_t *s)
+{
+    if (s->journaling)
+        journal_close(&s->journal); /* keeps its files: the end was not clean */
+    session_undo_free(&s->undo);
+    peer_free(&s->peer);
+    grid_free(&s->grid);
+}
+
+/* Gives the peer the host tool and the board's tool, asks it to arm the board with --arm and
+ * sets up undo; 0, else the exit status (one line said why). */
+static int connect_tools_init(connect_session_t *cs)
+{
+    conn_solver_t *s = cs->s;
+    const connect_opts_t *o = &cs->o;
+    if (peer_set_host_tool(&s->peer, &o->host_tool) != ARGIL_OK) {
         fprintf(stderr, "argil connect: the host tool was refused (needs the B-spline model)\n");
-        exit_code = 1;
-        goto free_clay;
+        return 1;
     }
-    msg_tool_t tool;
-    default_tool(&tool);
-    if (o.host_tool_set)
-        tool.kind = TOOL_CARVE; /* the host tool acts while the board's carve is held */
-    peer_set_tool(&s->peer, &tool);
-    if (o.arm)
+    default_tool(&cs->board_tool);
+    if (o->host_tool_set)
+        cs->board_tool.kind = TOOL_CARVE; /* the host tool acts while the board's carve is held */
+    peer_set_tool(&s->peer, &cs->board_tool);
+    if (o->arm)
         peer_request_arm(&s->peer);
     /* Undo: off with the springs (their grid keeps no history) or --undo-mb 0 (the summary
      * says so; a request is refused with that reason). */
     (void)session_undo_init(&s->undo, s->peer.gs ? &s->peer.gs->field : NULL,
-                            (size_t)o.undo_mb << 20);
+                            (size_t)o->undo_mb << 20);
     s->stdin_open = true;
+    return 0;
+}
 
-    char csv_path[4096], csv_tmp[4200];
-    if (make_dir(o.out_dir) != 0) {
-        fprintf(stderr, "argil connect: %s: cannot create directory: %s\n", o.out_dir,
+/* Closes the telemetry CSV of a session that did not run and removes it. */
+static void connect_csv_discard(connect_session_t *cs)
+{
+    fclose(cs->s->csv);
+    unlink(cs->csv_tmp);
+}
+
+/* Creates the output directory, the telemetry CSV and (unless --no-journal) the autosave
+ * journal; 0, else the exit status (one line said why, no CSV left open). */
+static int connect_files_open(connect_session_t *cs)
+{
+    conn_solver_t *s = cs->s;
+    const connect_opts_t *o = &cs->o;
+    char err[1024] = "";
+    if (make_dir(o->out_dir) != 0) {
+        fprintf(stderr, "argil connect: %s: cannot create directory: %s\n", o->out_dir,
                 strerror(errno));
-        exit_code = 1;
-        goto free_clay;
+        return 1;
     }
-    if (o.telemetry)
-        snprintf(csv_path, sizeof(csv_path), "%s", o.telemetry);
+    if (o->telemetry)
+        snprintf(cs->csv_path, sizeof(cs->csv_path), "%s", o->telemetry);
     else
-        snprintf(csv_path, sizeof(csv_path), "%s/telemetry.csv", o.out_dir);
-    if (open_csv(s, csv_path, csv_tmp, sizeof(csv_tmp), err, sizeof(err)) != ARGIL_OK) {
+        snprintf(cs->csv_path, sizeof(cs->csv_path), "%s/telemetry.csv", o->out_dir);
+    if (open_csv(s, cs->csv_path, cs->csv_tmp, sizeof(cs->csv_tmp), err, sizeof(err)) !=
+        ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        exit_code = 1;
-        goto free_clay;
+        return 1;
     }
-    if (o.journal) {
-        if (peer_journal_open(&s->journal, o.out_dir, &s->grid, o.autosave_s,
+    if (o->journal) {
+        if (peer_journal_open(&s->journal, o->out_dir, &s->grid, o->autosave_s,
                               CONNECT_CHECKPOINT_S, err, sizeof(err)) != ARGIL_OK) {
             fprintf(stderr, "argil connect: %s\n", err);
-            exit_code = 1;
-            goto close_csv;
+            connect_csv_discard(cs);
+            return 1;
         }
         s->journaling = true;
     }
+    return 0;
+}
 
+/* From here on Ctrl-C and SIGTERM end the session at the solver's next step, not the process. */
+static void connect_catch_signals(void)
+{
     g_connect_stop = 0;
     struct sigaction sa;
     memset(&sa, 0, sizeof(sa));
     sa.sa_handler = on_stop_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+}
 
-    pthread_t lt;
-    if (pthread_create(&lt, NULL, link_thread, c) != 0) {
-        fprintf(stderr, "argil connect: cannot start the link thread\n");
-        exit_code = 1;
-        goto close_csv;
-    }
-
-    /* The solver loop, 1 ms period. */
+/* Takes in what the link thread received: a loss marker asks for HELLO again (and notes what
+ * the host knew for the re-arm rule), a board HELLO ends the asking, every frame goes to the
+ * peer. */
+static void solver_take_frames(conn_solver_t *s, conn_loop_t *loop)
+{
     static uint8_t frame[PROTO_FRAME_MAX];
+    size_t n;
+    while (spsc_pop(&s->c->rx, frame, sizeof(frame), &n) == ARGIL_OK) {
+        if (n == 1) { /* the link thread's loss marker */
+            loop->loss_by_transport = frame[0] != 0;
+            loop->faults_at_loss = s->peer.stats.faults;
+            loop->bad_before_loss = s->have_tm && (s->last_state == SAFETY_FAULT ||
+                                                   s->last_state == SAFETY_ESTOP);
+            /* Say HELLO until the board answers: a restarted board, or one whose session
+             * ended, serves no host until one does (it is silent to us until then). */
+            loop->hello_wanted = true;
+            loop->last_hello_us = 0;
+            loop->hello_period_us = CONNECT_HELLO_PERIOD_US;
+            continue;
+        }
+        if (n > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO && frame[12] == PROTO_ROLE_BOARD) {
+            s->board_hellos++;
+            loop->hello_wanted = false;
+        }
+        peer_receive(&s->peer, frame, n);
+    }
+}
+
+/* Keeps the board in session with this host: HELLO again (backing off) after a reconnection
+ * or a restarted board, and with --arm (arm) arm it again after it lost the host. */
+static void solver_keep_session(conn_solver_t *s, conn_loop_t *loop, bool arm)
+{
+    /* Resynchronise after a reconnection or a restarted board (its tick went back). */
+    const uint32_t r = atomic_load_explicit(&s->c->pub.resyncs, memory_order_relaxed);
+    if (r != loop->seen_resyncs || s->board_restarts != loop->restarts_seen) {
+        loop->seen_resyncs = r;
+        loop->restarts_seen = s->board_restarts;
+        loop->hello_wanted = true;
+        loop->last_hello_us = 0;
+        loop->hello_period_us = CONNECT_HELLO_PERIOD_US;
+        loop->rearm_pending = arm;
+    }
+    /* The board says it lost the host (this host stalled, or the link dropped and came
+     * back before our silence timeout): as after a reconnection, arm again. */
+    if (s->peer.stats.faults != loop->faults_seen) {
+        loop->faults_seen = s->peer.stats.faults;
+        if (s->peer.stats.last_fault_code == FAULT_HOST_LOST)
+            loop->rearm_pending = arm;
+    }
+    if (loop->hello_wanted && s->now_us - loop->last_hello_us >= loop->hello_period_us) {
+        (void)peer_send_hello(&s->peer, "argil connect");
+        loop->last_hello_us = s->now_us;
+        if (loop->hello_period_us < CONNECT_HELLO_PERIOD_MAX_US)
+            loop->hello_period_us *= 2u;
+    }
+    /* A link loss faulted the board (host lost): the person asked for --arm, so arm again
+     * once the board has its new window. Any other fault stays latched. The board reports
+     * a fault once, and over USB that FAULT frame is dropped while unplugged: when none
+     * arrived since the loss, the loss was the transport's own (both directions dead for
+     * longer than the board's host timeout) and the board was not faulted before it, the
+     * fault can only be host lost. */
+    if (loop->rearm_pending && s->have_tm) {
+        const uint8_t bs = s->peer.last_tm.state;
+        const bool heard = s->peer.stats.faults != loop->faults_at_loss;
+        const bool host_lost = heard ? s->peer.stats.last_fault_code == FAULT_HOST_LOST
+                                     : loop->loss_by_transport && !loop->bad_before_loss;
+        if (bs == SAFETY_ACTIVE || bs == SAFETY_ARMED) {
+            loop->rearm_pending = false; /* armed again (an IDLE board is armed by the peer) */
+        } else if (bs == SAFETY_FAULT && host_lost && s->peer.have_current &&
+                   !loop->hello_wanted &&
+                   s->now_us - loop->last_rearm_us >= CONNECT_REARM_PERIOD_US) {
+            (void)peer_send_command(&s->peer, PROTO_CMD_ARM);
+            loop->last_rearm_us = s->now_us;
+        }
+    }
+}
+
+/* Advances the host model by the time since the last step (at most 50 ms), works on undo and
+ * redo requests, journals the edits and starts timing a window that went out. */
+static void solver_step(connect_session_t *cs, conn_loop_t *loop, double elapsed_s)
+{
+    conn_solver_t *s = cs->s;
+    uint64_t dt_us = s->now_us - loop->last_us;
+    if (dt_us > 50000u)
+        dt_us = 50000u; /* after a stall, do not replay time */
+    if (dt_us > 0) {
+        /* a press starts a stroke; the last one's diff goes a slice a tick */
+        session_undo_observe(&s->undo, &s->peer, (uint32_t)dt_us);
+        peer_tick(&s->peer, (uint32_t)dt_us);
+        loop->last_us = s->now_us;
+    }
+    undo_commands(s, cs->tty);
+    if (s->journaling) {
+        char err[1024] = "";
+        bool stop_now = false;
+        if (peer_journal_step(&s->journal, &s->journal_steps, &s->peer, elapsed_s, &stop_now,
+                              err, sizeof(err)) != ARGIL_OK) {
+            /* The person keeps sculpting; the end says the journal broke (exit 1). */
+            fprintf(stderr, "%sargil connect: autosave journal stopped: %s\n",
+                    cs->tty ? "\n" : "", err);
+            snprintf(cs->journal_err, sizeof(cs->journal_err), "%s", err);
+            journal_close(&s->journal);
+            s->journaling = false;
+        }
+    }
+    if (s->peer.stats.windows_sent != loop->windows_at_last) {
+        loop->windows_at_last = s->peer.stats.windows_sent;
+        s->rtt_version = s->peer.current.version;
+        s->rtt_t0_us = s->now_us;
+        s->rtt_pending = true;
+    }
+}
+
+/* Runs the solver every 1 ms until --seconds (0), Ctrl-C or SIGTERM (0, cs->interrupted) or
+ * until the link's authentication ends the session (1, one line said why). */
+static int connect_loop(connect_session_t *cs)
+{
+    conn_solver_t *s = cs->s;
+    conn_t *c = cs->c;
+    const connect_opts_t *o = &cs->o;
     s->t0_us = mono_us();
-    uint64_t last_us = s->t0_us, next_us = s->t0_us, status_at_us = s->t0_us + 1000000u;
-    uint64_t last_hello_us = 0, last_rearm_us = 0;
-    bool hello_wanted = true, rearm_pending = false;
-    uint32_t hello_period_us = CONNECT_HELLO_PERIOD_US;
-    uint32_t seen_resyncs = 0, restarts_seen = 0, rx_at_status = 0, tx_at_status = 0;
-    uint32_t windows_at_last = 0;
-    bool interrupted = false;
-    char journal_err[1024] = "";
-    /* What the host knew when the link was lost (for the re-arm rule below). */
-    uint32_t faults_at_loss = 0, faults_seen = 0;
-    bool loss_by_transport = false, bad_before_loss = false;
-    bool udp_hinted = false;
+    conn_loop_t loop;
+    memset(&loop, 0, sizeof(loop));
+    loop.last_us = s->t0_us;
+    loop.next_us = s->t0_us;
+    loop.status_at_us = s->t0_us + 1000000u;
+    loop.hello_wanted = true;
+    loop.hello_period_us = CONNECT_HELLO_PERIOD_US;
     for (;;) {
         s->now_us = mono_us();
         const double elapsed_s = (double)(s->now_us - s->t0_us) * 1e-6;
         if (g_connect_stop) {
-            interrupted = true;
-            break;
+            cs->interrupted = true;
+            return 0;
         }
-        if (o.seconds > 0 && elapsed_s >= o.seconds)
-            break;
-        size_t n;
-        while (spsc_pop(&c->rx, frame, sizeof(frame), &n) == ARGIL_OK) {
-            if (n == 1) { /* the link thread's loss marker */
-                loss_by_transport = frame[0] != 0;
-                faults_at_loss = s->peer.stats.faults;
-                bad_before_loss = s->have_tm && (s->last_state == SAFETY_FAULT ||
-                                                 s->last_state == SAFETY_ESTOP);
-                /* Say HELLO until the board answers: a restarted board, or one whose session
-                 * ended, serves no host until one does (it is silent to us until then). */
-                hello_wanted = true;
-                last_hello_us = 0;
-                hello_period_us = CONNECT_HELLO_PERIOD_US;
-                continue;
-            }
-            if (n > PROTO_HEADER_SIZE && frame[5] == MSG_HELLO && frame[12] == PROTO_ROLE_BOARD) {
-                s->board_hellos++;
-                hello_wanted = false;
-            }
-            peer_receive(&s->peer, frame, n);
+        if (o->seconds > 0 && elapsed_s >= o->seconds)
+            return 0;
+        solver_take_frames(s, &loop);
+        solver_keep_session(s, &loop, o->arm);
+        solver_step(cs, &loop, elapsed_s);
+        if (link_refusal_ends(s, o, elapsed_s, &loop.udp_hinted, cs->tty))
+            return 1;
+        if (s->now_us >= loop.status_at_us) {
+            const uint32_t rx = atomic_load(&c->pub.frames_rx);
+            const uint32_t tx = atomic_load(&c->pub.frames_tx);
+            if (!o->quiet)
+                status_line(s, cs->tty, elapsed_s, rx - loop.rx_at_status,
+                            tx - loop.tx_at_status);
+            loop.rx_at_status = rx;
+            loop.tx_at_status = tx;
+            loop.status_at_us += 1000000u;
         }
-        /* Resynchronise after a reconnection or a restarted board (its tick went back). */
-        const uint32_t r = atomic_load_explicit(&c->pub.resyncs, memory_order_relaxed);
-        if (r != seen_resyncs || s->board_restarts != restarts_seen) {
-            seen_resyncs = r;
-            restarts_seen = s->board_restarts;
-            hello_wanted = true;
-            last_hello_us = 0;
-            hello_period_us = CONNECT_HELLO_PERIOD_US;
-            rearm_pending = o.arm;
-        }
-        /* The board says it lost the host (this host stalled, or the link dropped and came
-         * back before our silence timeout): as after a reconnection, arm again. */
-        if (s->peer.stats.faults != faults_seen) {
-            faults_seen = s->peer.stats.faults;
-            if (s->peer.stats.last_fault_code == FAULT_HOST_LOST)
-                rearm_pending = o.arm;
-        }
-        if (hello_wanted && s->now_us - last_hello_us >= hello_period_us) {
-            (void)peer_send_hello(&s->peer, "argil connect");
-            last_hello_us = s->now_us;
-            if (hello_period_us < CONNECT_HELLO_PERIOD_MAX_US)
-                hello_period_us *= 2u;
-        }
-        /* A link loss faulted the board (host lost): the person asked for --arm, so arm again
-         * once the board has its new window. Any other fault stays latched. The board reports
-         * a fault once, and over USB that FAULT frame is dropped while unplugged: when none
-         * arrived since the loss, the loss was the transport's own (both directions dead for
-         * longer than the board's host timeout) and the board was not faulted before it, the
-         * fault can only be host lost. */
-        if (rearm_pending && s->have_tm) {
-            const uint8_t bs = s->peer.last_tm.state;
-            const bool heard = s->peer.stats.faults != faults_at_loss;
-            const bool host_lost = heard ? s->peer.stats.last_fault_code == FAULT_HOST_LOST
-                                         : loss_by_transport && !bad_before_loss;
-            if (bs == SAFETY_ACTIVE || bs == SAFETY_ARMED) {
-                rearm_pending = false; /* armed again (an IDLE board is armed by the peer) */
-            } else if (bs == SAFETY_FAULT && host_lost && s->peer.have_current && !hello_wanted &&
-                       s->now_us - last_rearm_us >= CONNECT_REARM_PERIOD_US) {
-                (void)peer_send_command(&s->peer, PROTO_CMD_ARM);
-                last_rearm_us = s->now_us;
-            }
-        }
-        uint64_t dt_us = s->now_us - last_us;
-        if (dt_us > 50000u)
-            dt_us = 50000u; /* after a stall, do not replay time */
-        if (dt_us > 0) {
-            /* a press starts a stroke; the last one's diff goes a slice a tick */
-            session_undo_observe(&s->undo, &s->peer, (uint32_t)dt_us);
-            peer_tick(&s->peer, (uint32_t)dt_us);
-            last_us = s->now_us;
-        }
-        undo_commands(s, tty);
-        if (s->journaling) {
-            bool stop_now = false;
-            if (peer_journal_step(&s->journal, &s->journal_steps, &s->peer, elapsed_s,
-                                  &stop_now, err, sizeof(err)) != ARGIL_OK) {
-                /* The person keeps sculpting; the end says the journal broke (exit 1). */
-                fprintf(stderr, "%sargil connect: autosave journal stopped: %s\n",
-                        tty ? "\n" : "", err);
-                snprintf(journal_err, sizeof(journal_err), "%s", err);
-                journal_close(&s->journal);
-                s->journaling = false;
-            }
-        }
-        if (s->peer.stats.windows_sent != windows_at_last) {
-            windows_at_last = s->peer.stats.windows_sent;
-            s->rtt_version = s->peer.current.version;
-            s->rtt_t0_us = s->now_us;
-            s->rtt_pending = true;
-        }
-        if (link_refusal_ends(s, &o, elapsed_s, &udp_hinted, tty)) {
-            exit_code = 1;
-            break;
-        }
-        if (s->now_us >= status_at_us) {
-            const uint32_t rx = atomic_load(&c->pub.frames_rx), tx = atomic_load(&c->pub.frames_tx);
-            if (!o.quiet)
-                status_line(s, tty, elapsed_s, rx - rx_at_status, tx - tx_at_status);
-            rx_at_status = rx;
-            tx_at_status = tx;
-            status_at_us += 1000000u;
-        }
-        next_us += 1000u;
-        if (next_us + 20000u < s->now_us)
-            next_us = s->now_us; /* fell far behind: do not try to catch up */
-        const struct timespec ts = {(time_t)(next_us / 1000000u), (long)(next_us % 1000000u) * 1000L};
+        loop.next_us += 1000u;
+        if (loop.next_us + 20000u < s->now_us)
+            loop.next_us = s->now_us; /* fell far behind: do not try to catch up */
+        const struct timespec ts = {(time_t)(loop.next_us / 1000000u),
+                                    (long)(loop.next_us % 1000000u) * 1000L};
         clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
     }
+}
+
+/* Tells the board we are going, stops the link thread (lt) and takes in its last frames; notes
+ * how long the session ran and how many frames came in. */
+static void connect_stop(connect_session_t *cs, pthread_t lt)
+{
+    conn_solver_t *s = cs->s;
+    conn_t *c = cs->c;
+    static uint8_t frame[PROTO_FRAME_MAX];
     /* Tell the board we are going: END disarms (forces off at once, not after the host-lost
      * fade) and ends our session, so the next host need not wait for it to lapse. */
     if (s->have_tm)
@@ -1008,155 +1087,203 @@ int cmd_connect(int argc, char **argv)
     atomic_store_explicit(&c->stop, true, memory_order_release);
     pthread_join(lt, NULL);
     /* Frames the link thread took in after the solver stopped reading. */
-    {
-        size_t n;
-        while (spsc_pop(&c->rx, frame, sizeof(frame), &n) == ARGIL_OK)
-            if (n > 1) /* not a loss marker */
-                peer_receive(&s->peer, frame, n);
-    }
-    if (tty && !o.quiet)
+    size_t n;
+    while (spsc_pop(&c->rx, frame, sizeof(frame), &n) == ARGIL_OK)
+        if (n > 1) /* not a loss marker */
+            peer_receive(&s->peer, frame, n);
+    if (cs->tty && !cs->o.quiet)
         fputc('\n', stderr);
+    cs->ran_s = (double)(mono_us() - s->t0_us) * 1e-6;
+    cs->frames_rx = atomic_load(&c->pub.frames_rx);
+}
 
-    const double ran_s = (double)(mono_us() - s->t0_us) * 1e-6;
-    const uint32_t frames_rx = atomic_load(&c->pub.frames_rx);
-    size_t triangles = 0;
-    /* Files: the telemetry, the clay's surface and the model. */
-    {
-        int bad = fflush(s->csv) != 0 || fsync(fileno(s->csv)) != 0;
-        bad |= fclose(s->csv) != 0;
-        s->csv = NULL;
-        if (bad || rename(csv_tmp, csv_path) != 0) {
-            fprintf(stderr, "argil connect: %s: cannot write: %s\n", csv_path, strerror(errno));
-            exit_code = 1;
-        }
-        if (write_model(&s->grid, &s->peer.host_tool, o.out_dir,
-                        s->journaling ? s->journal.seq : 0u, &triangles, err,
-                        sizeof(err)) != ARGIL_OK) {
+/* Writes the telemetry, the clay's surface and the model; a clean end removes the journal.
+ * Returns exit_code, or 1 when a file could not be written or the journal had stopped. */
+static int connect_write_files(connect_session_t *cs, int exit_code)
+{
+    conn_solver_t *s = cs->s;
+    char err[1024] = "";
+    int bad = fflush(s->csv) != 0 || fsync(fileno(s->csv)) != 0;
+    bad |= fclose(s->csv) != 0;
+    s->csv = NULL;
+    if (bad || rename(cs->csv_tmp, cs->csv_path) != 0) {
+        fprintf(stderr, "argil connect: %s: cannot write: %s\n", cs->csv_path, strerror(errno));
+        exit_code = 1;
+    }
+    if (write_model(&s->grid, &s->peer.host_tool, cs->o.out_dir,
+                    s->journaling ? s->journal.seq : 0u, &cs->triangles, err,
+                    sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil connect: %s\n", err);
+        exit_code = 1;
+    }
+    /* A clean end: the files are whole, so the journal is no longer needed. */
+    if (s->journaling && exit_code == 0) {
+        s->journaling = false;
+        if (journal_finish(&s->journal, err, sizeof(err)) != ARGIL_OK) {
             fprintf(stderr, "argil connect: %s\n", err);
             exit_code = 1;
         }
-        /* A clean end: the files are whole, so the journal is no longer needed. */
-        if (s->journaling && exit_code == 0) {
-            s->journaling = false;
-            if (journal_finish(&s->journal, err, sizeof(err)) != ARGIL_OK) {
-                fprintf(stderr, "argil connect: %s\n", err);
-                exit_code = 1;
-            }
-        }
-        if (journal_err[0] != '\0')
-            exit_code = 1;
     }
-    if (!o.quiet) {
-        const uint32_t rx_drop = atomic_load(&c->rx.dropped);
-        printf("argil connect: %s for %.1f s%s\n", o.device, ran_s,
-               interrupted ? " (interrupted)" : "");
-        printf("  link                %s; frames in %u, out %u; receive errors %u, send errors "
-               "%u, reconnects %u, frames dropped %u; %s\n",
-               link_state_name((link_state_t)atomic_load(&c->pub.state)), frames_rx,
-               atomic_load(&c->pub.frames_tx), atomic_load(&c->pub.errors_rx),
-               atomic_load(&c->pub.errors_tx), atomic_load(&c->pub.reconnects),
-               rx_drop + atomic_load(&c->pub.tx_dropped), link_auth_summary(&o, c));
-        printf("  board               %s; ACTIVE entered %u times; board HELLOs %u; restarts "
-               "seen %u; deadline misses %u; peak force %.3f N\n",
-               s->have_tm ? safety_state_name((safety_state_t)s->last_state) : "never heard",
-               s->active_entries, s->board_hellos, s->board_restarts, s->deadline_misses,
-               (double)s->peak_force_n);
-        {
-            const proto_link_counts_t *l = &s->peer.last_rt.link;
-            if (s->peer.stats.rt_stats_frames > 0)
-                printf("  board link          host sessions %u; host frames refused: wrong source "
-                       "%u, no session %u, duplicate %u, stale %u, decode errors %u, bad tag %u, "
-                       "bad nonce %u; ARM refused %u\n",
-                       l->sessions, l->wrong_source, l->no_session, l->duplicate, l->stale,
-                       l->decode_errors, l->bad_mac, l->bad_nonce, l->arm_refused);
-            else
-                printf("  board link          no RT_STATS report from the board\n");
-        }
-        printf("  protocol            telemetry rows %u (%.0f per s); decode errors %u; windows "
-               "sent %u; impulse frames %u; faults %u%s%s%s\n",
-               s->csv_rows, ran_s > 0 ? s->csv_rows / ran_s : 0.0,
-               s->peer.stats.decode_errors, s->peer.stats.windows_sent,
-               s->peer.stats.impulse_frames, s->peer.stats.faults,
-               s->peer.stats.faults ? " (last: " : "",
-               s->peer.stats.faults
-                   ? safety_fault_name((fault_code_t)s->peer.stats.last_fault_code)
-                   : "",
-               s->peer.stats.faults ? ")" : "");
-        {
-            double med = 0, p99 = 0, mx = 0;
-            peer_solve_times_ms(&s->peer, &med, &p99, &mx);
-            printf("  global solve        %s, %u steps, CPU time per step median %.2f ms, 99th "
-                   "percentile %.2f ms, max %.2f ms; region narrowed %u times (margin %d..%d "
-                   "samples)\n",
-                   cli_global_solve_text(o.global_solve), s->peer.stats.solves, med, p99, mx,
-                   s->peer.sched.shrinks, (int)s->peer.sched.margin_min, SOLVE_MARGIN_MAX);
-        }
-        if (o.global_solve == PEER_SOLVE_BSPLINE)
-            printf("  knots               %d sample%s per knot span\n", o.knot_ratio,
-                   o.knot_ratio == 1 ? "" : "s");
-        {
-            char mirror[8], strength[48] = "";
-            const host_tool_t *t = &s->peer.host_tool;
-            host_mirror_name(t->mirror, mirror);
-            if (host_action_has_strength(t->action))
-                snprintf(strength, sizeof(strength), ", strength %g per s", (double)t->strength);
-            printf("  tool                board %s; host action %s, shape %s, mirror %s%s%s\n",
-                   tool.kind == TOOL_CARVE ? "carve" : "touch", host_action_name(t->action),
-                   host_shape_name(t->shape), mirror, strength,
-                   tool.kind == TOOL_CARVE ? " (while stylus button 1 is held)" : " (idle)");
-        }
-        if (s->rtt_samples > 0)
-            printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
-                   s->rtt_worst_ms, s->rtt_samples);
-        if (s->undo.on)
-            printf("  undo                %u stroke%s recorded (%u undone, %u redone, %u refused), "
-                   "%.1f KiB held of %u MiB; recording CPU time per tick median %.2f ms, max "
-                   "%.2f ms\n",
-                   s->undo.stats.steps, s->undo.stats.steps == 1 ? "" : "s",
-                   s->undo.stats.undos, s->undo.stats.redos, s->undo.stats.refused,
-                   (double)session_undo_bytes(&s->undo) / 1024.0, o.undo_mb,
-                   session_undo_work_median_ms(&s->undo), s->undo.stats.max_work_ms);
-        else
-            printf("  undo                %s\n", s->undo.off_reason);
-        printf("  files               %s (%u rows), %s/final.ply (%zu triangles), "
-               "%s/model.argil\n",
-               csv_path, s->csv_rows, o.out_dir, triangles, o.out_dir);
-        const journal_stats_t *js = &s->journal.stats;
-        if (journal_err[0] != '\0')
-            printf("  autosave journal    STOPPED: %s\n", journal_err);
-        else if (o.journal)
-            printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u "
-                   "checkpoints, %.1f ms of work; %s\n",
-                   js->records, (double)js->bytes / 1024.0, js->syncs, js->checkpoints,
-                   s->journal_steps.real_s * 1e3,
-                   s->journaling ? "KEPT (the end was not clean): 'argil recover' restores"
-                                 : "removed at this clean end");
-    }
-    if (frames_rx == 0 && exit_code == 0) {
-        fprintf(stderr, "argil connect: the board never answered on %s%s\n", o.device,
-                udp_key_hint(&o));
+    if (cs->journal_err[0] != '\0')
         exit_code = 1;
-    } else if (exit_code == 0 && interrupted) {
+    return exit_code;
+}
+
+/* Prints the session's summary on stdout: link, board, protocol, solve, tool, undo, files and
+ * journal. */
+static void connect_summary(const connect_session_t *cs)
+{
+    const connect_opts_t *o = &cs->o;
+    conn_t *c = cs->c;
+    const conn_solver_t *s = cs->s;
+    const uint32_t rx_drop = atomic_load(&c->rx.dropped);
+    printf("argil connect: %s for %.1f s%s\n", o->device, cs->ran_s,
+           cs->interrupted ? " (interrupted)" : "");
+    printf("  link                %s; frames in %u, out %u; receive errors %u, send errors "
+           "%u, reconnects %u, frames dropped %u; %s\n",
+           link_state_name((link_state_t)atomic_load(&c->pub.state)), cs->frames_rx,
+           atomic_load(&c->pub.frames_tx), atomic_load(&c->pub.errors_rx),
+           atomic_load(&c->pub.errors_tx), atomic_load(&c->pub.reconnects),
+           rx_drop + atomic_load(&c->pub.tx_dropped), link_auth_summary(o, c));
+    printf("  board               %s; ACTIVE entered %u times; board HELLOs %u; restarts "
+           "seen %u; deadline misses %u; peak force %.3f N\n",
+           s->have_tm ? safety_state_name((safety_state_t)s->last_state) : "never heard",
+           s->active_entries, s->board_hellos, s->board_restarts, s->deadline_misses,
+           (double)s->peak_force_n);
+    const proto_link_counts_t *l = &s->peer.last_rt.link;
+    if (s->peer.stats.rt_stats_frames > 0)
+        printf("  board link          host sessions %u; host frames refused: wrong source "
+               "%u, no session %u, duplicate %u, stale %u, decode errors %u, bad tag %u, "
+               "bad nonce %u; ARM refused %u\n",
+               l->sessions, l->wrong_source, l->no_session, l->duplicate, l->stale,
+               l->decode_errors, l->bad_mac, l->bad_nonce, l->arm_refused);
+    else
+        printf("  board link          no RT_STATS report from the board\n");
+    printf("  protocol            telemetry rows %u (%.0f per s); decode errors %u; windows "
+           "sent %u; impulse frames %u; faults %u%s%s%s\n",
+           s->csv_rows, cs->ran_s > 0 ? s->csv_rows / cs->ran_s : 0.0,
+           s->peer.stats.decode_errors, s->peer.stats.windows_sent,
+           s->peer.stats.impulse_frames, s->peer.stats.faults,
+           s->peer.stats.faults ? " (last: " : "",
+           s->peer.stats.faults
+               ? safety_fault_name((fault_code_t)s->peer.stats.last_fault_code)
+               : "",
+           s->peer.stats.faults ? ")" : "");
+    double med = 0, p99 = 0, mx = 0;
+    peer_solve_times_ms(&s->peer, &med, &p99, &mx);
+    printf("  global solve        %s, %u steps, CPU time per step median %.2f ms, 99th "
+           "percentile %.2f ms, max %.2f ms; region narrowed %u times (margin %d..%d "
+           "samples)\n",
+           cli_global_solve_text(o->global_solve), s->peer.stats.solves, med, p99, mx,
+           s->peer.sched.shrinks, (int)s->peer.sched.margin_min, SOLVE_MARGIN_MAX);
+    if (o->global_solve == PEER_SOLVE_BSPLINE)
+        printf("  knots               %d sample%s per knot span\n", o->knot_ratio,
+               o->knot_ratio == 1 ? "" : "s");
+    char mirror[8], strength[48] = "";
+    const host_tool_t *t = &s->peer.host_tool;
+    const bool carve = cs->board_tool.kind == TOOL_CARVE;
+    host_mirror_name(t->mirror, mirror);
+    if (host_action_has_strength(t->action))
+        snprintf(strength, sizeof(strength), ", strength %g per s", (double)t->strength);
+    printf("  tool                board %s; host action %s, shape %s, mirror %s%s%s\n",
+           carve ? "carve" : "touch", host_action_name(t->action), host_shape_name(t->shape),
+           mirror, strength, carve ? " (while stylus button 1 is held)" : " (idle)");
+    if (s->rtt_samples > 0)
+        printf("  window round trip   last %.1f ms, worst %.1f ms (%u windows)\n", s->rtt_ms,
+               s->rtt_worst_ms, s->rtt_samples);
+    if (s->undo.on)
+        printf("  undo                %u stroke%s recorded (%u undone, %u redone, %u refused), "
+               "%.1f KiB held of %u MiB; recording CPU time per tick median %.2f ms, max "
+               "%.2f ms\n",
+               s->undo.stats.steps, s->undo.stats.steps == 1 ? "" : "s", s->undo.stats.undos,
+               s->undo.stats.redos, s->undo.stats.refused,
+               (double)session_undo_bytes(&s->undo) / 1024.0, o->undo_mb,
+               session_undo_work_median_ms(&s->undo), s->undo.stats.max_work_ms);
+    else
+        printf("  undo                %s\n", s->undo.off_reason);
+    printf("  files               %s (%u rows), %s/final.ply (%zu triangles), %s/model.argil\n",
+           cs->csv_path, s->csv_rows, o->out_dir, cs->triangles, o->out_dir);
+    const journal_stats_t *js = &s->journal.stats;
+    if (cs->journal_err[0] != '\0')
+        printf("  autosave journal    STOPPED: %s\n", cs->journal_err);
+    else if (o->journal)
+        printf("  autosave journal    %u edits journaled, %.1f KiB, %u fsyncs, %u "
+               "checkpoints, %.1f ms of work; %s\n",
+               js->records, (double)js->bytes / 1024.0, js->syncs, js->checkpoints,
+               s->journal_steps.real_s * 1e3,
+               s->journaling ? "KEPT (the end was not clean): 'argil recover' restores"
+                             : "removed at this clean end");
+}
+
+/* The session on the clay: the tools, the files, the link thread and the solver loop, then the
+ * files written and the summary; the exit status. */
+static int connect_run(connect_session_t *cs)
+{
+    const connect_opts_t *o = &cs->o;
+    int exit_code = connect_tools_init(cs);
+    if (exit_code == 0)
+        exit_code = connect_files_open(cs);
+    if (exit_code != 0)
+        return exit_code;
+    connect_catch_signals();
+    pthread_t lt;
+    if (pthread_create(&lt, NULL, link_thread, cs->c) != 0) {
+        fprintf(stderr, "argil connect: cannot start the link thread\n");
+        connect_csv_discard(cs);
+        return 1;
+    }
+    exit_code = connect_loop(cs);
+    connect_stop(cs, lt);
+    exit_code = connect_write_files(cs, exit_code);
+    if (!o->quiet)
+        connect_summary(cs);
+    if (cs->frames_rx == 0 && exit_code == 0) {
+        fprintf(stderr, "argil connect: the board never answered on %s%s\n", o->device,
+                udp_key_hint(o));
+        exit_code = 1;
+    } else if (exit_code == 0 && cs->interrupted) {
         exit_code = 130;
     }
-    goto free_clay;
+    return exit_code;
+}
 
-close_csv:
-    fclose(s->csv);
-    unlink(csv_tmp);
-free_clay:
-    if (s->journaling)
-        journal_close(&s->journal); /* keeps its files: the end was not clean */
-    session_undo_free(&s->undo);
-    peer_free(&s->peer);
-    grid_free(&s->grid);
-close_link:
-    link_close(&c->link);
-free_conn:
-    free(c->rx_store);
-    free(c->tx_store);
-    free(c);
-    free(s);
+/* argil connect: a live session with a board until --seconds or Ctrl-C; the exit status. */
+int cmd_connect(int argc, char **argv)
+{
+    connect_session_t cs;
+    memset(&cs, 0, sizeof(cs));
+    const int st = parse_opts(argc, argv, &cs.o);
+    if (st >= 0)
+        return st;
+    if (cs.o.journal) {
+        const int offer =
+            recover_offer(cs.o.out_dir, cs.o.discard_journal, isatty(STDIN_FILENO) != 0);
+        if (offer >= 0)
+            return offer;
+    }
+    cs.tty = isatty(STDERR_FILENO);
+    cs.c = calloc(1, sizeof(*cs.c));
+    cs.s = calloc(1, sizeof(*cs.s));
+    if (!cs.c || !cs.s) {
+        free(cs.c);
+        free(cs.s);
+        fprintf(stderr, "argil connect: out of memory\n");
+        return 1;
+    }
+    cs.s->c = cs.c;
+    int exit_code = connect_open_link(&cs);
+    if (exit_code == 0) {
+        exit_code = connect_clay_open(&cs);
+        if (exit_code == 0) {
+            exit_code = connect_run(&cs);
+            connect_clay_close(cs.s);
+        }
+        link_close(&cs.c->link);
+    }
+    free(cs.c->rx_store);
+    free(cs.c->tx_store);
+    free(cs.c);
+    free(cs.s);
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     return exit_code;

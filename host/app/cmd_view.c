@@ -245,15 +245,60 @@ static int run_window(const mesh_t *m, const mesh_t *wire, render_scene_t *s, ca
     return 0;
 }
 
-int cmd_view(int argc, char **argv)
+/* What argil view's command line asks for. */
+typedef struct {
+    const char *model, *png, *csv;  /* the model, --screenshot and --telemetry (NULL: none) */
+    int w, h;                       /* image or window size, pixels */
+    render_backend_t backend;
+    render_scene_t scene;           /* --mode, --key, --fill and --box's switch so far */
+    float tool[4];                  /* --tool X Y Z R, mm */
+    float force[3];                 /* --force, N */
+    float box[6];                   /* --box corners, mm */
+    float yaw_deg, pitch_deg, iso2;
+    int have_tool, have_force;
+} view_opts_t;
+
+/* Takes the value v of --screenshot, --telemetry, --mode or --backend (a); 0, else prints and
+ * returns 2. */
+static int take_word(const char *a, const char *v, view_opts_t *o)
 {
-    const char *model = NULL, *png = NULL, *csv = NULL;
-    int w = 1024, h = 768;
-    render_backend_t backend = RENDER_BACKEND_AUTO;
-    render_scene_t s;
-    render_scene_default(&s);
-    float tool[4] = {0}, force[3] = {0}, box[6] = {0}, yaw = 0.0f, pitch = 0.0f, iso2 = 0.0f;
-    int have_tool = 0, have_force = 0;
+    if (strcmp(a, "--screenshot") == 0) {
+        o->png = v;
+    } else if (strcmp(a, "--telemetry") == 0) {
+        o->csv = v;
+    } else if (strcmp(a, "--mode") == 0) {
+        if (strcmp(v, "plain") == 0)
+            o->scene.mode = RENDER_MODE_PLAIN;
+        else if (strcmp(v, "clearcoat") == 0)
+            o->scene.mode = RENDER_MODE_CLEARCOAT;
+        else {
+            fprintf(stderr, "argil view: unknown mode '%s' (plain, clearcoat)\n", v);
+            return 2;
+        }
+    } else {
+        if (strcmp(v, "auto") == 0)
+            o->backend = RENDER_BACKEND_AUTO;
+        else if (strcmp(v, "egl") == 0)
+            o->backend = RENDER_BACKEND_EGL;
+        else if (strcmp(v, "glfw") == 0)
+            o->backend = RENDER_BACKEND_GLFW;
+        else {
+            fprintf(stderr, "argil view: unknown backend '%s' (auto, egl, glfw)\n", v);
+            return 2;
+        }
+    }
+    return 0;
+}
+
+/* Parses the options into o; returns -1 to go on, else the exit status (--help: 0; a bad
+ * option: 2, one line said why). */
+static int parse_view_opts(int argc, char **argv, view_opts_t *o)
+{
+    memset(o, 0, sizeof(*o));
+    o->w = 1024;
+    o->h = 768;
+    o->backend = RENDER_BACKEND_AUTO;
+    render_scene_default(&o->scene);
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int rc = 0;
@@ -266,49 +311,24 @@ int cmd_view(int argc, char **argv)
                 fprintf(stderr, "argil view: %s needs a value (see --help)\n", a);
                 return 2;
             }
-            const char *v = argv[++i];
-            if (strcmp(a, "--screenshot") == 0) {
-                png = v;
-            } else if (strcmp(a, "--telemetry") == 0) {
-                csv = v;
-            } else if (strcmp(a, "--mode") == 0) {
-                if (strcmp(v, "plain") == 0)
-                    s.mode = RENDER_MODE_PLAIN;
-                else if (strcmp(v, "clearcoat") == 0)
-                    s.mode = RENDER_MODE_CLEARCOAT;
-                else {
-                    fprintf(stderr, "argil view: unknown mode '%s' (plain, clearcoat)\n", v);
-                    return 2;
-                }
-            } else {
-                if (strcmp(v, "auto") == 0)
-                    backend = RENDER_BACKEND_AUTO;
-                else if (strcmp(v, "egl") == 0)
-                    backend = RENDER_BACKEND_EGL;
-                else if (strcmp(v, "glfw") == 0)
-                    backend = RENDER_BACKEND_GLFW;
-                else {
-                    fprintf(stderr, "argil view: unknown backend '%s' (auto, egl, glfw)\n", v);
-                    return 2;
-                }
-            }
+            rc = take_word(a, argv[++i], o);
         } else if (strcmp(a, "--width") == 0) {
-            rc = take_int(argc, argv, &i, 16, 8192, &w);
+            rc = take_int(argc, argv, &i, 16, 8192, &o->w);
         } else if (strcmp(a, "--height") == 0) {
-            rc = take_int(argc, argv, &i, 16, 8192, &h);
+            rc = take_int(argc, argv, &i, 16, 8192, &o->h);
         } else if (strcmp(a, "--tool") == 0) {
-            rc = take_floats(argc, argv, &i, 4, tool);
-            have_tool = 1;
-            if (rc == 0 && !(tool[3] > 0.0f)) {
+            rc = take_floats(argc, argv, &i, 4, o->tool);
+            o->have_tool = 1;
+            if (rc == 0 && !(o->tool[3] > 0.0f)) {
                 fprintf(stderr, "argil view: --tool radius must be > 0 mm\n");
                 return 2;
             }
         } else if (strcmp(a, "--force") == 0) {
-            rc = take_floats(argc, argv, &i, 3, force);
-            have_force = 1;
+            rc = take_floats(argc, argv, &i, 3, o->force);
+            o->have_force = 1;
         } else if (strcmp(a, "--box") == 0) {
-            rc = take_floats(argc, argv, &i, 6, box);
-            s.show_box = true;
+            rc = take_floats(argc, argv, &i, 6, o->box);
+            o->scene.show_box = true;
         } else if (strcmp(a, "--key") == 0 || strcmp(a, "--fill") == 0) {
             float d[3];
             rc = take_floats(argc, argv, &i, 3, d);
@@ -317,16 +337,16 @@ int cmd_view(int argc, char **argv)
                 return 2;
             }
             if (a[2] == 'k')
-                s.key.dir = vec3(d[0], d[1], d[2]);
+                o->scene.key.dir = vec3(d[0], d[1], d[2]);
             else
-                s.fill.dir = vec3(d[0], d[1], d[2]);
+                o->scene.fill.dir = vec3(d[0], d[1], d[2]);
         } else if (strcmp(a, "--yaw") == 0) {
-            rc = take_floats(argc, argv, &i, 1, &yaw);
+            rc = take_floats(argc, argv, &i, 1, &o->yaw_deg);
         } else if (strcmp(a, "--pitch") == 0) {
-            rc = take_floats(argc, argv, &i, 1, &pitch);
+            rc = take_floats(argc, argv, &i, 1, &o->pitch_deg);
         } else if (strcmp(a, "--iso2") == 0) {
-            rc = take_floats(argc, argv, &i, 1, &iso2);
-            if (rc == 0 && !(iso2 >= 0.05f && iso2 <= 0.95f)) {
+            rc = take_floats(argc, argv, &i, 1, &o->iso2);
+            if (rc == 0 && !(o->iso2 >= 0.05f && o->iso2 <= 0.95f)) {
                 fprintf(stderr, "argil view: --iso2 needs a density level 0.05..0.95 (the "
                                 "surface is 0.5)\n");
                 return 2;
@@ -334,83 +354,121 @@ int cmd_view(int argc, char **argv)
         } else if (a[0] == '-' && a[1] != '\0') {
             fprintf(stderr, "argil view: unknown option '%s' (see --help)\n", a);
             return 2;
-        } else if (model == NULL) {
-            model = a;
+        } else if (o->model == NULL) {
+            o->model = a;
         } else {
-            fprintf(stderr, "argil view: one model at a time ('%s' and '%s')\n", model, a);
+            fprintf(stderr, "argil view: one model at a time ('%s' and '%s')\n", o->model, a);
             return 2;
         }
         if (rc != 0)
             return rc;
     }
-    if (model == NULL) {
+    if (o->model == NULL) {
         usage_view(stderr);
         return 2;
     }
-    char err[1024] = "";
-    if (csv != NULL) {
-        telemetry_log_t log;
-        if (telemetry_log_read(csv, &log, err, sizeof(err)) != ARGIL_OK) {
-            fprintf(stderr, "argil view: %s\n", err);
-            return 1;
-        }
-        const size_t last = log.n - 1;
-        if (!have_tool) {
-            memcpy(tool, log.pos_mm + 3 * last, 3 * sizeof(float));
-            tool[3] = 4.0f;
-            have_tool = 1;
-        }
-        if (!have_force) {
-            memcpy(force, log.force_n + 3 * last, 3 * sizeof(float));
-            have_force = 1;
-        }
-        telemetry_log_free(&log);
-    }
-    s.show_tool = have_tool;
-    s.tool_pos_m = vec3(tool[0] * 1e-3f, tool[1] * 1e-3f, tool[2] * 1e-3f);
-    s.tool_radius_m = tool[3] * 1e-3f;
-    s.show_force = have_force;
-    s.force_n = vec3(force[0], force[1], force[2]);
-    s.box_lo_m = vec3(fminf(box[0], box[3]) * 1e-3f, fminf(box[1], box[4]) * 1e-3f,
-                      fminf(box[2], box[5]) * 1e-3f);
-    s.box_hi_m = vec3(fmaxf(box[0], box[3]) * 1e-3f, fmaxf(box[1], box[4]) * 1e-3f,
-                      fmaxf(box[2], box[5]) * 1e-3f);
+    return -1;
+}
 
-    mesh_t m, wire;
-    mesh_init(&m);
-    mesh_init(&wire);
-    bool has_normals = false;
-    const size_t len = strlen(model);
-    if (len > 6 && strcmp(model + len - 6, ".argil") == 0) {
-        if (load_model(model, iso2, &m, &wire, &s, err, sizeof(err)) != ARGIL_OK) {
-            fprintf(stderr, "argil view: %s\n", err);
-            mesh_free(&m);
-            mesh_free(&wire);
-            return 1;
-        }
-        has_normals = true;
-    } else if (iso2 > 0.0f) {
-        fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
-                        "model, or use 'argil sculpt --iso2')\n", model);
-        return 2;
-    } else if (mesh_import(model, &m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+/* With --telemetry, the tool (radius 4 mm) and the force not given default to the log's last
+ * row; 0, else prints and returns 1. */
+static int take_telemetry(view_opts_t *o)
+{
+    char err[1024] = "";
+    telemetry_log_t log;
+    if (telemetry_log_read(o->csv, &log, err, sizeof(err)) != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return 1;
     }
-    if (m.n_tri == 0) {
+    const size_t last = log.n - 1;
+    if (!o->have_tool) {
+        memcpy(o->tool, log.pos_mm + 3 * last, 3 * sizeof(float));
+        o->tool[3] = 4.0f;
+        o->have_tool = 1;
+    }
+    if (!o->have_force) {
+        memcpy(o->force, log.force_n + 3 * last, 3 * sizeof(float));
+        o->have_force = 1;
+    }
+    telemetry_log_free(&log);
+    return 0;
+}
+
+/* Puts the tool, the force and the box the options give into the scene, in metres. */
+static void place_in_scene(view_opts_t *o)
+{
+    render_scene_t *s = &o->scene;
+    const float *tool = o->tool, *force = o->force, *box = o->box;
+    s->show_tool = o->have_tool;
+    s->tool_pos_m = vec3(tool[0] * 1e-3f, tool[1] * 1e-3f, tool[2] * 1e-3f);
+    s->tool_radius_m = tool[3] * 1e-3f;
+    s->show_force = o->have_force;
+    s->force_n = vec3(force[0], force[1], force[2]);
+    s->box_lo_m = vec3(fminf(box[0], box[3]) * 1e-3f, fminf(box[1], box[4]) * 1e-3f,
+                       fminf(box[2], box[5]) * 1e-3f);
+    s->box_hi_m = vec3(fmaxf(box[0], box[3]) * 1e-3f, fmaxf(box[1], box[4]) * 1e-3f,
+                       fmaxf(box[2], box[5]) * 1e-3f);
+}
+
+/* Reads the model into m with vertex normals (a .argil meshed at its surface level, and at
+ * --iso2 into wire; else a mesh file); 0, else prints and returns the exit status with nothing
+ * left to free. */
+static int load_view_mesh(view_opts_t *o, mesh_t *m, mesh_t *wire)
+{
+    char err[1024] = "";
+    const char *model = o->model;
+    bool has_normals = false;
+    const size_t len = strlen(model);
+    if (len > 6 && strcmp(model + len - 6, ".argil") == 0) {
+        if (load_model(model, o->iso2, m, wire, &o->scene, err, sizeof(err)) != ARGIL_OK) {
+            fprintf(stderr, "argil view: %s\n", err);
+            mesh_free(m);
+            mesh_free(wire);
+            return 1;
+        }
+        has_normals = true;
+    } else if (o->iso2 > 0.0f) {
+        fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
+                        "model, or use 'argil sculpt --iso2')\n", model);
+        return 2;
+    } else if (mesh_import(model, m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+        fprintf(stderr, "argil view: %s\n", err);
+        return 1;
+    }
+    if (m->n_tri == 0) {
         fprintf(stderr, "argil view: %s: no triangles to draw (a point cloud?)\n", model);
-        mesh_free(&m);
+        mesh_free(m);
+        mesh_free(wire);
         return 1;
     }
     if (!has_normals)
-        normals_from_faces(&m);
+        normals_from_faces(m);
+    return 0;
+}
+
+/* argil view: draws MODEL to a PNG or in a window; the exit status. */
+int cmd_view(int argc, char **argv)
+{
+    view_opts_t o;
+    const int st = parse_view_opts(argc, argv, &o);
+    if (st >= 0)
+        return st;
+    if (o.csv != NULL && take_telemetry(&o) != 0)
+        return 1;
+    place_in_scene(&o);
+    mesh_t m, wire;
+    mesh_init(&m);
+    mesh_init(&wire);
+    const int load = load_view_mesh(&o, &m, &wire);
+    if (load != 0)
+        return load;
     vec3_t lo, hi;
-    scene_bounds(&m, &s, &lo, &hi);
+    scene_bounds(&m, &o.scene, &lo, &hi);
     camera_t cam;
     camera_frame(&cam, lo, hi);
-    camera_orbit(&cam, yaw * (float)M_PI / 180.0f, pitch * (float)M_PI / 180.0f);
-    const int status = png ? run_screenshot(&m, &wire, &s, &cam, backend, w, h, png)
-                           : run_window(&m, &wire, &s, &cam, w, h, model);
+    camera_orbit(&cam, o.yaw_deg * (float)M_PI / 180.0f, o.pitch_deg * (float)M_PI / 180.0f);
+    const int status = o.png ? run_screenshot(&m, &wire, &o.scene, &cam, o.backend, o.w, o.h, o.png)
+                             : run_window(&m, &wire, &o.scene, &cam, o.w, o.h, o.model);
     mesh_free(&m);
     mesh_free(&wire);
     return status;
