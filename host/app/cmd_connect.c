@@ -503,6 +503,69 @@ static int check_model_opts(connect_opts_t *o, bool solve_given, bool strength_g
     return -1;
 }
 
+/* Which host-model options parse_opts met, for check_model_opts to judge together. */
+typedef struct {
+    bool solve_given, strength_given;
+    const char *host_opt;           /* the first of --action, --shape, --mirror given */
+} model_opts_seen_t;
+
+/* Takes a host-model option a (--global-solve, --knot-ratio, --strength, --action, --shape,
+ * --mirror) with its value v (NULL: none left): 0 when it took v, 2 when v is bad (one line
+ * said why), -1 when a is none of them. */
+static int take_model_opt(const char *a, const char *v, connect_opts_t *o,
+                          model_opts_seen_t *seen)
+{
+    if (strcmp(a, "--global-solve") == 0) {
+        if (!cli_global_solve(v, &o->global_solve)) {
+            fprintf(stderr, "argil connect: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS
+                            "\n");
+            return 2;
+        }
+        seen->solve_given = true;
+    } else if (strcmp(a, "--knot-ratio") == 0) {
+        if (!cli_knot_ratio(v, &o->knot_ratio)) {
+            fprintf(stderr, "argil connect: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
+            return 2;
+        }
+    } else if (strcmp(a, "--strength") == 0) {
+        char *end = NULL;
+        const double x = v ? strtod(v, &end) : 0.0;
+        if (!v || end == v || *end != '\0' || !(x >= 0.0 && x <= HOST_STRENGTH_MAX)) {
+            fprintf(stderr, "argil connect: --strength needs a number 0..%g (per second "
+                            "held)\n", (double)HOST_STRENGTH_MAX);
+            return 2;
+        }
+        o->host_tool.strength = (float)x;
+        seen->strength_given = true;
+    } else if (strcmp(a, "--action") == 0 || strcmp(a, "--shape") == 0 ||
+               strcmp(a, "--mirror") == 0) {
+        const int k = !v                 ? -1
+                      : a[2] == 'a'      ? host_action_from_name(v)
+                      : a[2] == 's'      ? host_shape_from_name(v)
+                                         : host_mirror_from_name(v);
+        if (k < 0) {
+            char list[256];
+            host_tool_names(a[2] == 's' ? 'h' : 'a', 0, list, sizeof(list));
+            fprintf(stderr, "argil connect: %s needs %s, got '%s'\n", a,
+                    a[2] == 'm' ? "none, or the axes x, y, z (e.g. xz)" : list,
+                    v ? v : "nothing");
+            return 2;
+        }
+        if (a[2] == 'a')
+            o->host_tool.action = (host_action_t)k;
+        else if (a[2] == 's')
+            o->host_tool.shape = (host_shape_t)k;
+        else
+            o->host_tool.mirror = (uint32_t)k;
+        o->host_tool_set = true;
+        if (!seen->host_opt)
+            seen->host_opt = a;
+    } else {
+        return -1;
+    }
+    return 0;
+}
+
 /* Parses the options; returns -1 to go on, else the exit status. */
 static int parse_opts(int argc, char **argv, connect_opts_t *o)
 {
@@ -515,12 +578,16 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
     o->journal = true;
     o->autosave_s = 1.0f;
     o->undo_mb = SESSION_UNDO_MB_DEFAULT;
-    bool solve_given = false, strength_given = false;
-    const char *host_opt = NULL;    /* the first of --action, --shape, --mirror given */
+    model_opts_seen_t seen = {false, false, NULL};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+        const int model_opt = take_model_opt(a, v, o, &seen);
+        if (model_opt == 0) {
+            i++;
+        } else if (model_opt > 0) {
+            return model_opt;
+        } else if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
             usage_connect(stdout);
             return 0;
         } else if (strcmp(a, "--arm") == 0) {
@@ -531,20 +598,6 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             o->journal = false;
         } else if (strcmp(a, "--discard-journal") == 0) {
             o->discard_journal = true;
-        } else if (strcmp(a, "--global-solve") == 0) {
-            if (!cli_global_solve(v, &o->global_solve)) {
-                fprintf(stderr, "argil connect: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS
-                                "\n");
-                return 2;
-            }
-            i++;
-            solve_given = true;
-        } else if (strcmp(a, "--knot-ratio") == 0) {
-            if (!cli_knot_ratio(v, &o->knot_ratio)) {
-                fprintf(stderr, "argil connect: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
-                return 2;
-            }
-            i++;
         } else if (strcmp(a, "--undo-mb") == 0) {
             char *end = NULL;
             const long mb = v ? strtol(v, &end, 10) : -1;
@@ -562,41 +615,6 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
                 return 2;
             }
             i++;
-        } else if (strcmp(a, "--strength") == 0) {
-            char *end = NULL;
-            const double x = v ? strtod(v, &end) : 0.0;
-            if (!v || end == v || *end != '\0' || !(x >= 0.0 && x <= HOST_STRENGTH_MAX)) {
-                fprintf(stderr, "argil connect: --strength needs a number 0..%g (per second "
-                                "held)\n", (double)HOST_STRENGTH_MAX);
-                return 2;
-            }
-            i++;
-            o->host_tool.strength = (float)x;
-            strength_given = true;
-        } else if (strcmp(a, "--action") == 0 || strcmp(a, "--shape") == 0 ||
-                   strcmp(a, "--mirror") == 0) {
-            const int k = !v                 ? -1
-                          : a[2] == 'a'      ? host_action_from_name(v)
-                          : a[2] == 's'      ? host_shape_from_name(v)
-                                             : host_mirror_from_name(v);
-            if (k < 0) {
-                char list[256];
-                host_tool_names(a[2] == 's' ? 'h' : 'a', 0, list, sizeof(list));
-                fprintf(stderr, "argil connect: %s needs %s, got '%s'\n", a,
-                        a[2] == 'm' ? "none, or the axes x, y, z (e.g. xz)" : list,
-                        v ? v : "nothing");
-                return 2;
-            }
-            i++;
-            if (a[2] == 'a')
-                o->host_tool.action = (host_action_t)k;
-            else if (a[2] == 's')
-                o->host_tool.shape = (host_shape_t)k;
-            else
-                o->host_tool.mirror = (uint32_t)k;
-            o->host_tool_set = true;
-            if (!host_opt)
-                host_opt = a;
         } else if (strcmp(a, "--device") == 0 || strcmp(a, "--seconds") == 0 ||
                    strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0 ||
                    strcmp(a, "--key") == 0) {
@@ -629,7 +647,7 @@ static int parse_opts(int argc, char **argv, connect_opts_t *o)
             return 2;
         }
     }
-    const int st = check_model_opts(o, solve_given, strength_given, host_opt);
+    const int st = check_model_opts(o, seen.solve_given, seen.strength_given, seen.host_opt);
     if (st >= 0)
         return st;
     link_spec_t spec;
