@@ -528,67 +528,113 @@ static argil_err_t tool_fit_lsq(field_t *f, const tool_union_t *U, const tool_pa
     return e;
 }
 
-/* Coefficient actions: new coefficients over [blo, bhi) from one read of the box (plus the ring
- * the samples and the smoothing need), written back where they changed; then d = A p again only
- * in the sample blocks a changed coefficient reaches (Hua & Qin eq. 5), the rest shape moved by
- * the same Δd, and the changes noted for undo as they are made. */
-static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const tool_params_t *p,
-                                    const int32_t blo[3], const int32_t bhi[3], undo_t *u,
-                                    tool_stats_t *stats)
+/* One coefficient action's boxes (named as in tool_box_t; the free box is [blo, blo+bn)) and the
+ * arrays it lays out in the field's scratch, kept warm between edits. */
+typedef struct {
+    int32_t blo[3], bn[3], slo[3], shi[3], clo[3], chi[3], cn[3], klo[3], kn[3];
+    size_t nc, nk, nb, naxis;     /* coefficients read, sample blocks, free coefficients, Σ bn */
+    size_t sy, sz;                /* C's row and plane strides */
+    float *C;                     /* the C box's coefficients */
+    uint8_t *mark;                /* the sample blocks a changed coefficient reaches */
+    uint32_t *ch_ci;              /* changed: index in C ... */
+    float *ch_after;              /* ... and new value */
+    size_t nch;
+    float *pa[3];                 /* per axis: coefficient positions (m) */
+    int32_t *ka[3];               /* per axis: first and last sample block reached */
+    uint32_t *row_idx;            /* the poses that reach one row */
+    float *run_d, *run_tmp;       /* one run of sample blocks along x: densities, tmp */
+} tool_coef_pass_t;
+
+/* The boxes of a coefficient action over the free coefficients [blo, bhi): the samples they
+ * reach, the coefficients those samples read, and the sample blocks that hold them. */
+static void tool_coef_boxes(const field_t *f, const int32_t blo[3], const int32_t bhi[3],
+                            tool_coef_pass_t *P)
 {
-    const float bound = tool_bound_m(U->t);
-    const int32_t R = f->ratio;
-    int32_t slo[3], shi[3], clo[3], chi[3], cn[3], bn[3], klo[3], kn[3];
-    field_samples_of_coefs(f, blo, bhi, slo, shi);
-    field_coefs_of_samples(f, slo, shi, clo, chi);
-    size_t nc = 1, nk = 1;
+    field_samples_of_coefs(f, blo, bhi, P->slo, P->shi);
+    field_coefs_of_samples(f, P->slo, P->shi, P->clo, P->chi);
+    P->nc = 1;
+    P->nk = 1;
     for (int a = 0; a < 3; a++) {
-        bn[a] = bhi[a] - blo[a];
-        cn[a] = chi[a] - clo[a];
-        nc *= (size_t)cn[a];
-        klo[a] = sparse_block_of(slo[a]);
-        kn[a] = sparse_block_of(shi[a] - 1) - klo[a] + 1;
-        nk *= (size_t)kn[a];
+        P->blo[a] = blo[a];
+        P->bn[a] = bhi[a] - blo[a];
+        P->cn[a] = P->chi[a] - P->clo[a];
+        P->nc *= (size_t)P->cn[a];
+        P->klo[a] = sparse_block_of(P->slo[a]);
+        P->kn[a] = sparse_block_of(P->shi[a] - 1) - P->klo[a] + 1;
+        P->nk *= (size_t)P->kn[a];
     }
-    argil_err_t e = ARGIL_OK;
-    if (u != NULL && (e = undo_begin(u, f, blo, blo, 0, slo, slo, 0)) != ARGIL_OK)
-        return e;
-    const size_t nb = (size_t)bn[0] * bn[1] * bn[2], naxis = (size_t)bn[0] + bn[1] + bn[2];
-    /* kept warm between edits: C box, block marks, change list, per-axis tables, row poses */
+    P->nb = (size_t)P->bn[0] * P->bn[1] * P->bn[2];
+    P->naxis = (size_t)P->bn[0] + P->bn[1] + P->bn[2];
+    P->sy = (size_t)P->cn[0];
+    P->sz = (size_t)P->cn[0] * P->cn[1];
+}
+
+/* Lays out the pass's arrays in the field's scratch for n_poses poses; false when the scratch
+ * cannot grow. */
+static bool tool_coef_scratch(field_t *f, size_t n_poses, tool_coef_pass_t *P)
+{
     /* a run of sample blocks along x: its samples, and field_samples_from's tmp (8 samples reach
      * at most (8 - 1) / R + 5 coefficients per axis) */
-    const size_t run_ns = (size_t)kn[0] * SPARSE_B, run_nc = (SPARSE_B - 1) / (size_t)R + 5;
+    const size_t run_ns = (size_t)P->kn[0] * SPARSE_B, run_nc = (SPARSE_B - 1) / (size_t)f->ratio + 5;
     const size_t run_n = run_ns * SPARSE_B * SPARSE_B, run_tmp_n = run_ns * run_nc * (run_nc + SPARSE_B);
-    float *C = field_scratch(f, nc + (nk + 3) / 4 + 2 * nb + 3 * naxis + U->n + run_n + run_tmp_n);
-    if (C == NULL) {
-        e = ARGIL_ERR_NOMEM;
-        goto out;
+    const size_t nc = P->nc, nk = P->nk, nb = P->nb, naxis = P->naxis;
+    float *C = field_scratch(f, nc + (nk + 3) / 4 + 2 * nb + 3 * naxis + n_poses + run_n + run_tmp_n);
+    if (C == NULL)
+        return false;
+    P->C = C;
+    P->mark = (uint8_t *)(C + nc);
+    P->ch_ci = (uint32_t *)(C + nc + (nk + 3) / 4);
+    P->ch_after = (float *)(P->ch_ci + nb);
+    float *pos = P->ch_after + nb;
+    int32_t *kr = (int32_t *)(pos + naxis);
+    P->row_idx = (uint32_t *)(kr + 2 * naxis);
+    P->run_d = (float *)(P->row_idx + n_poses);
+    P->run_tmp = P->run_d + run_n;
+    for (int a = 0, at = 0; a < 3; at += P->bn[a], a++) {
+        P->pa[a] = pos + at;
+        P->ka[a] = kr + 2 * at;
     }
-    uint8_t *mark = (uint8_t *)(C + nc);
-    uint32_t *ch_ci = (uint32_t *)(C + nc + (nk + 3) / 4); /* changed: index in C, new value */
-    float *ch_after = (float *)(ch_ci + nb);
-    float *pos = ch_after + nb;                 /* per axis: coefficient positions (m) */
-    int32_t *kr = (int32_t *)(pos + naxis);     /* per axis: first and last sample block reached */
-    uint32_t *row_idx = (uint32_t *)(kr + 2 * naxis);
-    float *run_d = (float *)(row_idx + U->n), *run_tmp = run_d + run_n;
+    return true;
+}
+
+/* Fills the per-axis tables: each free coefficient's position (as field_coef_pos) and the first
+ * and last of the pass's sample blocks it reaches, ((c-2)R, (c+2)R). */
+static void tool_coef_axes(const field_t *f, tool_coef_pass_t *P)
+{
     const float o[3] = {f->origin_m.x, f->origin_m.y, f->origin_m.z}, hc = f->coef_spacing_m;
-    float *pa[3];
-    int32_t *ka[3];
-    for (int a = 0, at = 0; a < 3; at += bn[a], a++) {
-        pa[a] = pos + at;
-        ka[a] = kr + 2 * at;
-        for (int32_t i = 0; i < bn[a]; i++) {
-            const int32_t c = blo[a] + i;
-            pa[a][i] = o[a] + hc * (float)c; /* as field_coef_pos */
-            const int32_t k0 = sparse_block_of((c - 2) * R + 1) - klo[a], k1 = sparse_block_of((c + 2) * R - 1) - klo[a];
-            ka[a][2 * i] = k0 < 0 ? 0 : k0;
-            ka[a][2 * i + 1] = k1 >= kn[a] ? kn[a] - 1 : k1;
+    const int32_t R = f->ratio;
+    for (int a = 0; a < 3; a++) {
+        float *pa = P->pa[a];
+        int32_t *ka = P->ka[a];
+        const int32_t blo = P->blo[a], klo = P->klo[a], kn = P->kn[a];
+        for (int32_t i = 0; i < P->bn[a]; i++) {
+            const int32_t c = blo + i;
+            pa[i] = o[a] + hc * (float)c; /* as field_coef_pos */
+            const int32_t k0 = sparse_block_of((c - 2) * R + 1) - klo, k1 = sparse_block_of((c + 2) * R - 1) - klo;
+            ka[2 * i] = k0 < 0 ? 0 : k0;
+            ka[2 * i + 1] = k1 >= kn ? kn - 1 : k1;
         }
     }
+}
+
+/* Reads the C box and computes the action's new coefficients over the free box: the change list
+ * (in increasing index order) and the marks of the sample blocks each change reaches. */
+static void tool_coef_changes(const field_t *f, const tool_union_t *U, const tool_params_t *p,
+                              float bound, tool_coef_pass_t *P)
+{
+    float *C = P->C;
+    uint8_t *mark = P->mark;
+    uint32_t *ch_ci = P->ch_ci, *row_idx = P->row_idx;
+    float *ch_after = P->ch_after;
+    const float *const pa[3] = {P->pa[0], P->pa[1], P->pa[2]};
+    const int32_t *const ka[3] = {P->ka[0], P->ka[1], P->ka[2]};
+    const int32_t blo[3] = {P->blo[0], P->blo[1], P->blo[2]}, bn[3] = {P->bn[0], P->bn[1], P->bn[2]};
+    const int32_t clo[3] = {P->clo[0], P->clo[1], P->clo[2]}, kn[3] = {P->kn[0], P->kn[1], P->kn[2]};
+    const size_t sy = P->sy, sz = P->sz;
+    const float hc = f->coef_spacing_m;
     size_t nch = 0;
-    memset(mark, 0, nk);
-    sparse_read_box(&f->coef, FC_P, clo, cn, C);
-    const size_t sy = (size_t)cn[0], sz = (size_t)cn[0] * cn[1];
+    memset(mark, 0, P->nk);
+    sparse_read_box(&f->coef, FC_P, P->clo, P->cn, C);
     for (int32_t z = 0; z < bn[2]; z++)
         for (int32_t y = 0; y < bn[1]; y++) {
             const size_t row = (size_t)(blo[0] - clo[0]) + sy * (size_t)(blo[1] - clo[1] + y) +
@@ -629,35 +675,35 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
                 kx_hi = kxx[1];
             }
         }
-    if (p->fit == TOOL_FIT_LSQ && nch > 0) {
-        const tool_box_t B = {clo, cn, blo, bn, slo, shi, klo, kn};
-        if ((e = tool_fit_lsq(f, U, p, bound, &B, C, ch_ci, ch_after, &nch, mark)) != ARGIL_OK)
-            goto out;
-    }
-    if (stats != NULL) {
-        stats->coefs_visited += nb;
-        stats->coefs_changed += nch;
-    }
-    /* write the changed coefficients (the lookup cached per block) and note them for undo */
+    P->nch = nch;
+}
+
+/* Writes the changed coefficients into the C box and the field (the block lookup cached per
+ * block) and notes each for undo. */
+static argil_err_t tool_coef_write(field_t *f, const tool_coef_pass_t *P, undo_t *u)
+{
+    float *C = P->C;
+    const size_t sy = P->sy;
+    argil_err_t e = ARGIL_OK;
     sparse_block_t *cb = NULL;
     size_t row0 = 0; /* C index of (0, cy, cz): the list is in increasing index order */
     int32_t cy = 0, cz = 0;
-    for (size_t k = 0; k < nch && e == ARGIL_OK; k++) {
-        const size_t ci = ch_ci[k];
+    for (size_t k = 0; k < P->nch && e == ARGIL_OK; k++) {
+        const size_t ci = P->ch_ci[k];
         const float before = C[ci];
-        C[ci] = ch_after[k];
+        C[ci] = P->ch_after[k];
         if (ci < row0) { /* not in order: start again from the first row */
             row0 = 0;
             cy = cz = 0;
         }
         while (ci >= row0 + sy) {
             row0 += sy;
-            if (++cy == cn[1]) {
+            if (++cy == P->cn[1]) {
                 cy = 0;
                 cz++;
             }
         }
-        const int32_t c[3] = {clo[0] + (int32_t)(ci - row0), clo[1] + cy, clo[2] + cz};
+        const int32_t c[3] = {P->clo[0] + (int32_t)(ci - row0), P->clo[1] + cy, P->clo[2] + cz};
         const int32_t key[3] = {sparse_block_of(c[0]), sparse_block_of(c[1]), sparse_block_of(c[2])};
         if (cb == NULL || memcmp(cb->key, key, sizeof(key)) != 0)
             e = sparse_touch(&f->coef, key, &cb);
@@ -665,16 +711,25 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
             break;
         cb->dirty = true;
         cb->data[FC_P * SPARSE_BN + (c[0] - key[0] * SPARSE_B) +
-                 SPARSE_B * ((c[1] - key[1] * SPARSE_B) + SPARSE_B * (c[2] - key[2] * SPARSE_B))] = ch_after[k];
+                 SPARSE_B * ((c[1] - key[1] * SPARSE_B) + SPARSE_B * (c[2] - key[2] * SPARSE_B))] = P->ch_after[k];
         if (u != NULL)
-            e = undo_note(u, UNDO_STORE_COEF, FC_P, c, before, ch_after[k]);
+            e = undo_note(u, UNDO_STORE_COEF, FC_P, c, before, P->ch_after[k]);
     }
-    /* d = A p in the reached sample blocks only, a run of consecutive marked blocks along x at a
-     * time (one separable pass over the run; each sample's arithmetic is the same as alone) */
-    size_t refreshed = 0, changed_samples = 0;
+    return e;
+}
+
+/* d = A p in the marked sample blocks only, a run of consecutive marked blocks along x at a time
+ * (one separable pass over the run; each sample's arithmetic is the same as alone), stored with
+ * the rest shape moved by the same Δd; *refreshed counts the samples computed. */
+static argil_err_t tool_coef_refresh(field_t *f, const tool_coef_pass_t *P, undo_t *u,
+                                     size_t *refreshed)
+{
+    const int32_t *klo = P->klo, *kn = P->kn, *slo = P->slo, *shi = P->shi;
+    argil_err_t e = ARGIL_OK;
+    size_t changed_samples = 0;
     for (int32_t kz = 0; kz < kn[2] && e == ARGIL_OK; kz++)
         for (int32_t ky = 0; ky < kn[1] && e == ARGIL_OK; ky++) {
-            const uint8_t *mrow = mark + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz);
+            const uint8_t *mrow = P->mark + (size_t)kn[0] * ((size_t)ky + (size_t)kn[1] * kz);
             for (int32_t kx = 0; kx < kn[0] && e == ARGIL_OK;) {
                 if (!mrow[kx]) {
                     kx++;
@@ -690,22 +745,65 @@ static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const too
                     lo[a] = key0[a] * SPARSE_B > slo[a] ? key0[a] * SPARSE_B : slo[a];
                     hi[a] = (k1 + 1) * SPARSE_B < shi[a] ? (k1 + 1) * SPARSE_B : shi[a];
                 }
-                field_samples_from(f, C, clo, cn, lo, hi, run_d, run_tmp);
+                field_samples_from(f, P->C, P->clo, P->cn, lo, hi, P->run_d, P->run_tmp);
                 const size_t dn_row = (size_t)(hi[0] - lo[0]), dn_plane = dn_row * (size_t)(hi[1] - lo[1]);
-                refreshed += dn_plane * (size_t)(hi[2] - lo[2]);
+                *refreshed += dn_plane * (size_t)(hi[2] - lo[2]);
                 for (; kx < kend && e == ARGIL_OK; kx++) {
                     const int32_t key[3] = {klo[0] + kx, key0[1], key0[2]};
                     const int32_t blo_x = key[0] * SPARSE_B > lo[0] ? key[0] * SPARSE_B : lo[0];
                     const int32_t bhi_x = (key[0] + 1) * SPARSE_B < hi[0] ? (key[0] + 1) * SPARSE_B : hi[0];
                     const int32_t bl[3] = {blo_x, lo[1], lo[2]}, bh[3] = {bhi_x, hi[1], hi[2]};
-                    e = tool_store_samples(f, key, bl, bh, run_d + (blo_x - lo[0]), dn_row, dn_plane, u,
+                    e = tool_store_samples(f, key, bl, bh, P->run_d + (blo_x - lo[0]), dn_row, dn_plane, u,
                                            &changed_samples);
                 }
             }
         }
+    return e;
+}
+
+/* The coefficient action within tool_apply_coefs's undo step: new coefficients (fitted by least
+ * squares if asked), written back, and the samples they reach refreshed. */
+static argil_err_t tool_coef_edit(field_t *f, const tool_union_t *U, const tool_params_t *p,
+                                  tool_coef_pass_t *P, undo_t *u, tool_stats_t *stats)
+{
+    const float bound = tool_bound_m(U->t);
+    if (!tool_coef_scratch(f, U->n, P))
+        return ARGIL_ERR_NOMEM;
+    tool_coef_axes(f, P);
+    tool_coef_changes(f, U, p, bound, P);
+    argil_err_t e = ARGIL_OK;
+    if (p->fit == TOOL_FIT_LSQ && P->nch > 0) {
+        const tool_box_t B = {P->clo, P->cn, P->blo, P->bn, P->slo, P->shi, P->klo, P->kn};
+        if ((e = tool_fit_lsq(f, U, p, bound, &B, P->C, P->ch_ci, P->ch_after, &P->nch, P->mark)) != ARGIL_OK)
+            return e;
+    }
+    if (stats != NULL) {
+        stats->coefs_visited += P->nb;
+        stats->coefs_changed += P->nch;
+    }
+    e = tool_coef_write(f, P, u);
+    size_t refreshed = 0;
+    if (e == ARGIL_OK)
+        e = tool_coef_refresh(f, P, u, &refreshed);
     if (stats != NULL)
         stats->samples_refreshed += refreshed;
-out:
+    return e;
+}
+
+/* Coefficient actions: new coefficients over [blo, bhi) from one read of the box (plus the ring
+ * the samples and the smoothing need), written back where they changed; then d = A p again only
+ * in the sample blocks a changed coefficient reaches (Hua & Qin eq. 5), the rest shape moved by
+ * the same Δd, and the changes noted for undo as they are made. */
+static argil_err_t tool_apply_coefs(field_t *f, const tool_union_t *U, const tool_params_t *p,
+                                    const int32_t blo[3], const int32_t bhi[3], undo_t *u,
+                                    tool_stats_t *stats)
+{
+    tool_coef_pass_t P;
+    tool_coef_boxes(f, blo, bhi, &P);
+    argil_err_t e = ARGIL_OK;
+    if (u != NULL && (e = undo_begin(u, f, P.blo, P.blo, 0, P.slo, P.slo, 0)) != ARGIL_OK)
+        return e;
+    e = tool_coef_edit(f, U, p, &P, u, stats);
     if (u != NULL) { /* whatever was done, even partly, is one undo step */
         const argil_err_t ec = undo_commit(u, f);
         if (e == ARGIL_OK)
