@@ -1027,6 +1027,271 @@ static void wait_for_news(live_t *L, view_t *v, int kind, uint64_t timeout_ns)
     atomic_store(&L->render_waiting, WAIT_NONE);
 }
 
+/* The render loop's state from pass to pass, and what the current pass found. */
+typedef struct {
+    double next_shot_s;           /* simulated time of the next --frames picture */
+    uint64_t last_swap_ns;        /* wall clock: the last swap returned (0: none yet) */
+    uint64_t done_at_ns;          /* ... the session's last snapshot was taken (0: not yet) */
+    uint64_t taken_ns;            /* ... the newest snapshot was taken */
+    frame_pacer_cfg_t pc;
+    frame_pacer_t pacer;
+    int status;                   /* 1 once a picture could not be written */
+    int drawn_w, drawn_h;         /* the window size of the last frame drawn */
+    bool have_frame;              /* a snapshot was taken */
+    bool undrawn;                 /* the newest snapshot taken is not drawn yet */
+    const live_frame_t *fr;       /* the newest snapshot taken */
+    bool done;                    /* this pass: the session has ended */
+    bool input;                   /* this pass: keys, the wheel, a drag or scripted events */
+    bool fresh;                   /* this pass: a new snapshot was taken */
+    int w, h;                     /* this pass: the window size in pixels */
+} loop_state_t;
+
+/* Whether a frame is due this pass, and why (frame_pacer_due decides when). */
+typedef struct {
+    bool unshown;                 /* the snapshot holds a change no frame has counted yet */
+    bool urgent;                  /* undrawn with a new mesh or such a change */
+    bool visible;                 /* undrawn and it changes the picture, not only the HUD */
+    bool draw;
+    uint64_t now_ns;              /* wall clock at the decision (after a frame: its swap) */
+    uint64_t draw_at_ns;          /* when a frame will be due if nothing else happens */
+} frame_plan_t;
+
+/* Wall clock along one frame. */
+typedef struct {
+    uint64_t start_ns, uploaded_ns, drawn_ns, swapped_ns;
+} frame_times_t;
+
+/* Polls the window: a close request stops the session and each key pressed goes to on_key;
+ * true when there was a key. */
+static bool poll_keys(live_t *L, view_t *v, glfw_input_t *in)
+{
+    glfw_window_poll(&v->win, in);
+    if (glfw_window_should_close(&v->win))
+        atomic_store(&L->want_stop, 1);
+    bool input = false;
+    int key;
+    if (v->script.count == 0) { /* the modifiers the keys below were pressed with */
+        v->ctrl = in->ctrl;
+        v->shift = in->shift;
+    }
+    while (glfw_window_take_key(&v->win, &key)) {
+        on_key(L, v, key);
+        input = true;
+    }
+    return input;
+}
+
+/* Takes the newest snapshot, and notes when the session's last one was taken. */
+static void take_snapshot(live_t *L, loop_state_t *S)
+{
+    uint32_t slot;
+    S->fresh = triple_buffer_take(&L->tb, &slot);
+    S->fr = &L->slot[slot];
+    if (S->fresh) {
+        S->taken_ns = now_ns();
+        S->have_frame = true;
+        S->undrawn = true;
+    }
+    if (S->done && S->done_at_ns == 0)
+        S->done_at_ns = now_ns(); /* the snapshot just taken is the session's last */
+}
+
+/* The cursor, buttons and Shift from the input script (its events due by simulated time t_s)
+ * or from the window, the wheel zooming the camera; true when that was input. */
+static bool read_pointer(live_t *L, view_t *v, const glfw_input_t *in, double t_s)
+{
+    if (v->script.count > 0)
+        return play_script(L, v, t_s);
+    v->cx = in->cursor_x;
+    v->cy = in->cursor_y;
+    v->left = in->left_down;
+    v->right = in->right_down;
+    v->shift = in->shift;
+    const double scroll = glfw_window_take_scroll(&v->win);
+    camera_zoom(&v->cam, scroll);
+    return scroll != 0.0;
+}
+
+/* Turns the pointer into commands: a right drag turns the camera, Shift inverts the tool, and
+ * with --mouse the ray under the cursor goes to the session. */
+static void steer_view(live_t *L, view_t *v, loop_state_t *S)
+{
+    S->w = S->h = 0;
+    glfw_window_size(&v->win, &S->w, &S->h);
+    const int w = S->w, h = S->h;
+    const bool moved = v->cx != v->prev_cx || v->cy != v->prev_cy;
+    if (v->right && v->prev_right && moved && w > 0 && h > 0) {
+        camera_arcball(&v->cam, v->prev_cx, v->prev_cy, v->cx, v->cy, w, h);
+        S->input = true;
+    }
+    if (v->shift != v->prev_shift)
+        ui_send(L, UI_CMD_INVERT, v->shift ? 1 : 0, 0);
+    if (L->wo->mouse && w > 0 && h > 0 && (v->left || v->prev_left || moved || S->fresh)) {
+        vec3_t o, d;
+        camera_ray(&v->cam, v->cx, v->cy, w, h, &o, &d);
+        ui_cmd_t c;
+        memset(&c, 0, sizeof(c));
+        c.kind = UI_CMD_MOUSE;
+        c.arg = v->left ? 1 : 0;
+        c.origin_m[0] = o.x, c.origin_m[1] = o.y, c.origin_m[2] = o.z;
+        c.dir[0] = d.x, c.dir[1] = d.y, c.dir[2] = d.z;
+        ui_queue_push(&L->q, &c);
+    }
+    v->prev_cx = v->cx;
+    v->prev_cy = v->cy;
+    v->prev_right = v->right;
+    v->prev_shift = v->shift;
+    v->prev_left = v->left;
+}
+
+/* Hands the renderer the snapshot's meshes it does not hold yet; true when the clay's mesh was
+ * new to it (uploaded, or failed to). */
+static bool upload_meshes(view_t *v, const live_frame_t *fr)
+{
+    const bool clay = fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial;
+    if (clay && renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
+        v->uploaded_serial = fr->mesh_serial;
+    if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial &&
+        renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
+        v->uploaded2_serial = fr->mesh2_serial;
+    return clay;
+}
+
+/* With --frames, a picture of the snapshot every screenshot_every_s of simulated time (named
+ * by its simulated ms); one that cannot be written stops the session. */
+static void shoot_frames(live_t *L, view_t *v, loop_state_t *S, char *err, size_t err_len)
+{
+    const sculpt_window_opts_t *wo = L->wo;
+    const live_frame_t *fr = S->fr;
+    if (!(S->w > 0 && S->h > 0 && S->have_frame && fr->t_s + 1e-9 >= S->next_shot_s &&
+          wo->frames_dir))
+        return;
+    char path[4096];
+    snprintf(path, sizeof(path), "%s/frame_%06ld.png", wo->frames_dir, lround(fr->t_s * 1000.0));
+    scene_from_frame(v, fr);
+    (void)upload_meshes(v, fr);
+    if (!write_shot(L, v, fr, path, S->w, S->h, err, err_len)) {
+        S->status = 1;
+        atomic_store(&L->want_stop, 1);
+    }
+    while (S->next_shot_s <= fr->t_s + 1e-9)
+        S->next_shot_s += wo->screenshot_every_s;
+}
+
+/* Decides whether to draw now: frame_pacer_due on what the snapshot and the input bring, and
+ * always once more for the session's last snapshot. */
+static void plan_frame(live_t *L, view_t *v, loop_state_t *S, frame_plan_t *pl)
+{
+    const live_frame_t *fr = S->fr;
+    const bool new_mesh =
+        (fr->mesh_serial != 0 && fr->mesh_serial != v->drawn_serial) ||
+        (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->drawn2_serial);
+    pl->unshown = fr->has_change && fr->change_pub > v->counted_pub;
+    pl->urgent = S->undrawn && (new_mesh || pl->unshown);
+    /* A snapshot that changes only the HUD's figures waits for the HUD's next refresh. */
+    pl->visible = pl->urgent || (S->undrawn && !same_picture(v, fr));
+    pl->now_ns = now_ns();
+    pl->draw_at_ns = pl->now_ns;
+    const frame_pacer_in_t pin = {pl->visible, pl->urgent,
+                                  S->input || S->w != S->drawn_w || S->h != S->drawn_h,
+                                  !S->done && atomic_load(&L->inflight) != 0};
+    pl->draw = frame_pacer_due(&S->pacer, &S->pc, &pin, pl->now_ns, &pl->draw_at_ns) ||
+               (S->done && S->undrawn);
+}
+
+/* Counts a drawn frame: its upload, draw and swap times when it uploaded, why it was drawn, and
+ * the frame rate and cost since the swap before. */
+static void count_frame(view_t *v, const loop_state_t *S, const frame_plan_t *pl,
+                        const frame_times_t *t, bool uploaded)
+{
+    if (v->n_upload < LATENCY_SAMPLES && uploaded) {
+        v->upload_ms[v->n_upload] = (double)(t->uploaded_ns - t->start_ns) * 1e-6;
+        v->draw_ms[v->n_upload] = (double)(t->drawn_ns - t->uploaded_ns) * 1e-6;
+        v->swap_ms[v->n_upload++] = (double)(t->swapped_ns - t->drawn_ns) * 1e-6;
+    }
+    if (pl->urgent)
+        v->n_drawn_mesh++;
+    else if (pl->visible)
+        v->n_drawn_snapshot++;
+    else
+        v->n_drawn_other++;
+    if (S->last_swap_ns != 0) {
+        const double dt_ms = (double)(t->swapped_ns - S->last_swap_ns) * 1e-6;
+        if (dt_ms > 0.0)
+            v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms) : 1000.0 / dt_ms;
+        if (v->n_frame < LATENCY_SAMPLES) {
+            v->frame_ms[v->n_frame] = dt_ms;
+            v->cost_ms[v->n_frame++] = (double)(t->swapped_ns - t->start_ns) * 1e-6;
+        }
+    }
+}
+
+/* Counts the change the frame shows first: wall clock from the impulse's arrival at the host to
+ * the return of the first swap whose frame shows the solve step that integrated it, by stage. */
+static void count_latency(view_t *v, const loop_state_t *S, const frame_times_t *t)
+{
+    const live_frame_t *fr = S->fr;
+    if (v->n_latency < LATENCY_SAMPLES) {
+        const uint64_t at[STAGE_COUNT + 1] = {fr->arrival_ns, fr->solved_ns, fr->meshed_ns,
+                                              S->taken_ns, t->uploaded_ns, t->drawn_ns,
+                                              t->swapped_ns};
+        for (int k = 0; k < STAGE_COUNT; k++)
+            v->stage_ms[k][v->n_latency] =
+                at[k + 1] >= at[k] ? (double)(at[k + 1] - at[k]) * 1e-6 : 0.0;
+        v->latency_ms[v->n_latency++] = (double)(t->swapped_ns - fr->arrival_ns) * 1e-6;
+    }
+    v->counted_pub = fr->change_pub;
+}
+
+/* Draws the snapshot (uploading what changed), swaps, and counts the frame's figures. */
+static void present_frame(live_t *L, view_t *v, loop_state_t *S, frame_plan_t *pl)
+{
+    const live_frame_t *fr = S->fr;
+    frame_times_t t = {pl->now_ns, 0, 0, 0};
+    bool uploaded = upload_meshes(v, fr);
+    if (fr->mesh_serial != v->drawn_serial) {
+        uploaded = true;
+        v->drawn_serial = fr->mesh_serial;
+    }
+    v->drawn2_serial = fr->mesh2_serial;
+    t.uploaded_ns = now_ns();
+    if (uploaded)
+        v->last_upload_ns = t.uploaded_ns;
+    scene_from_frame(v, fr);
+    if (S->w > 0 && S->h > 0)
+        draw_frame(L, v, fr, S->w, S->h, t.uploaded_ns);
+    v->drawn = v->scene;
+    v->drawn_any = true;
+    S->drawn_w = S->w;
+    S->drawn_h = S->h;
+    t.drawn_ns = now_ns();
+    glfw_window_swap(&v->win);
+    t.swapped_ns = now_ns();
+    count_frame(v, S, pl, &t, uploaded);
+    frame_pacer_drawn(&S->pacer, t.start_ns, t.swapped_ns);
+    S->last_swap_ns = t.swapped_ns;
+    if (S->undrawn)
+        atomic_store(&L->shown_pub, fr->pub_seq);
+    if (S->undrawn && pl->unshown)
+        count_latency(v, S, &t);
+    S->undrawn = false;
+    pl->now_ns = t.swapped_ns;
+}
+
+/* Sleeps until the frame is due or the linger after the session runs out, unless a publish or
+ * input wakes the thread first. */
+static void sleep_until_due(live_t *L, view_t *v, const loop_state_t *S, const frame_plan_t *pl)
+{
+    uint64_t until = pl->draw_at_ns;
+    if (S->done) {
+        const uint64_t end_ns = S->done_at_ns + (uint64_t)(L->wo->linger_s * 1e9);
+        until = end_ns < until ? end_ns : until;
+    }
+    /* Before draw_at only a new mesh is worth a frame: other publishes may sleep on. */
+    wait_for_news(L, v, pl->visible ? WAIT_NEWS : WAIT_ANY,
+                  until > pl->now_ns ? until - pl->now_ns : 0);
+}
+
 /* The window's main loop. Frames start when frame_pacer says so: at once for a snapshot with a
  * new mesh (or a change not shown yet) and for input that changes the view, other snapshots at
  * most 60 a second and held back a little while an impulse is on its way to a mesh, and 4 a
@@ -1035,259 +1300,80 @@ static void wait_for_news(live_t *L, view_t *v, int kind, uint64_t timeout_ns)
 static int render_loop(live_t *L, view_t *v, char *err, size_t err_len)
 {
     const sculpt_window_opts_t *wo = L->wo;
-    double next_shot_s = wo->screenshot_every_s > 0.0 ? 0.0 : INFINITY;
-    uint64_t last_swap_ns = 0, done_at_ns = 0, taken_ns = 0;
-    frame_pacer_cfg_t pc;
-    frame_pacer_cfg_default(&pc);
-    frame_pacer_t pacer;
-    frame_pacer_init(&pacer);
-    int status = 0, drawn_w = 0, drawn_h = 0;
-    bool have_frame = false, undrawn = false;
-    const live_frame_t *fr = &L->slot[L->tb.front];
+    loop_state_t S;
+    memset(&S, 0, sizeof(S));
+    S.next_shot_s = wo->screenshot_every_s > 0.0 ? 0.0 : INFINITY;
+    frame_pacer_cfg_default(&S.pc);
+    frame_pacer_init(&S.pacer);
+    S.fr = &L->slot[L->tb.front];
     for (;;) {
-        const bool done = atomic_load(&L->session_done) != 0;
+        S.done = atomic_load(&L->session_done) != 0;
         glfw_input_t in;
-        glfw_window_poll(&v->win, &in);
-        if (glfw_window_should_close(&v->win))
-            atomic_store(&L->want_stop, 1);
-        bool input = false;
-        int key;
-        if (v->script.count == 0) { /* the modifiers the keys below were pressed with */
-            v->ctrl = in.ctrl;
-            v->shift = in.shift;
-        }
-        while (glfw_window_take_key(&v->win, &key)) {
-            on_key(L, v, key);
-            input = true;
-        }
-        uint32_t slot;
-        const bool fresh = triple_buffer_take(&L->tb, &slot);
-        fr = &L->slot[slot];
-        if (fresh) {
-            taken_ns = now_ns();
-            have_frame = true;
-            undrawn = true;
-        }
-        if (done && done_at_ns == 0)
-            done_at_ns = now_ns(); /* the snapshot just taken is the session's last */
-        if (v->script.count > 0) {
-            input |= play_script(L, v, fr->t_s);
-        } else {
-            v->cx = in.cursor_x;
-            v->cy = in.cursor_y;
-            v->left = in.left_down;
-            v->right = in.right_down;
-            v->shift = in.shift;
-            const double scroll = glfw_window_take_scroll(&v->win);
-            camera_zoom(&v->cam, scroll);
-            input |= scroll != 0.0;
-        }
-        int w = 0, h = 0;
-        glfw_window_size(&v->win, &w, &h);
-        const bool moved = v->cx != v->prev_cx || v->cy != v->prev_cy;
-        if (v->right && v->prev_right && moved && w > 0 && h > 0) {
-            camera_arcball(&v->cam, v->prev_cx, v->prev_cy, v->cx, v->cy, w, h);
-            input = true;
-        }
-        if (v->shift != v->prev_shift)
-            ui_send(L, UI_CMD_INVERT, v->shift ? 1 : 0, 0);
-        if (wo->mouse && w > 0 && h > 0 && (v->left || v->prev_left || moved || fresh)) {
-            vec3_t o, d;
-            camera_ray(&v->cam, v->cx, v->cy, w, h, &o, &d);
-            ui_cmd_t c;
-            memset(&c, 0, sizeof(c));
-            c.kind = UI_CMD_MOUSE;
-            c.arg = v->left ? 1 : 0;
-            c.origin_m[0] = o.x, c.origin_m[1] = o.y, c.origin_m[2] = o.z;
-            c.dir[0] = d.x, c.dir[1] = d.y, c.dir[2] = d.z;
-            ui_queue_push(&L->q, &c);
-        }
-        v->prev_cx = v->cx;
-        v->prev_cy = v->cy;
-        v->prev_right = v->right;
-        v->prev_shift = v->shift;
-        v->prev_left = v->left;
-
-        if (w > 0 && h > 0 && have_frame && fr->t_s + 1e-9 >= next_shot_s && wo->frames_dir) {
-            char path[4096];
-            snprintf(path, sizeof(path), "%s/frame_%06ld.png", wo->frames_dir,
-                     lround(fr->t_s * 1000.0));
-            scene_from_frame(v, fr);
-            if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial &&
-                renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
-                v->uploaded_serial = fr->mesh_serial;
-            if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial &&
-                renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
-                v->uploaded2_serial = fr->mesh2_serial;
-            if (!write_shot(L, v, fr, path, w, h, err, err_len)) {
-                status = 1;
-                atomic_store(&L->want_stop, 1);
-            }
-            while (next_shot_s <= fr->t_s + 1e-9)
-                next_shot_s += wo->screenshot_every_s;
-        }
-
-        /* Draw now, or sleep until the next reason to. */
-        const bool new_mesh =
-            (fr->mesh_serial != 0 && fr->mesh_serial != v->drawn_serial) ||
-            (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->drawn2_serial);
-        const bool unshown = fr->has_change && fr->change_pub > v->counted_pub;
-        const bool urgent = undrawn && (new_mesh || unshown);
-        /* A snapshot that changes only the HUD's figures waits for the HUD's next refresh. */
-        const bool visible = urgent || (undrawn && !same_picture(v, fr));
-        uint64_t now = now_ns(), draw_at = now;
-        const frame_pacer_in_t pin = {visible, urgent, input || w != drawn_w || h != drawn_h,
-                                      !done && atomic_load(&L->inflight) != 0};
-        const bool draw = frame_pacer_due(&pacer, &pc, &pin, now, &draw_at) || (done && undrawn);
-        if (draw) {
-            const uint64_t start_ns = now;
-            bool uploaded = false;
-            if (fr->mesh_serial != 0 && fr->mesh_serial != v->uploaded_serial) {
-                if (renderer_set_mesh(&v->r, &fr->mesh) == ARGIL_OK)
-                    v->uploaded_serial = fr->mesh_serial;
-                uploaded = true;
-            }
-            if (fr->mesh_serial != v->drawn_serial) {
-                uploaded = true;
-                v->drawn_serial = fr->mesh_serial;
-            }
-            if (fr->iso2_on && fr->mesh2_serial != 0 && fr->mesh2_serial != v->uploaded2_serial) {
-                if (renderer_set_wire_mesh(&v->r, &fr->mesh2) == ARGIL_OK)
-                    v->uploaded2_serial = fr->mesh2_serial;
-            }
-            v->drawn2_serial = fr->mesh2_serial;
-            const uint64_t uploaded_ns = now_ns();
-            if (uploaded)
-                v->last_upload_ns = uploaded_ns;
-            scene_from_frame(v, fr);
-            if (w > 0 && h > 0)
-                draw_frame(L, v, fr, w, h, uploaded_ns);
-            v->drawn = v->scene;
-            v->drawn_any = true;
-            drawn_w = w;
-            drawn_h = h;
-            const uint64_t drawn_ns = now_ns();
-            glfw_window_swap(&v->win);
-            const uint64_t swapped_ns = now_ns();
-            if (v->n_upload < LATENCY_SAMPLES && uploaded) {
-                v->upload_ms[v->n_upload] = (double)(uploaded_ns - start_ns) * 1e-6;
-                v->draw_ms[v->n_upload] = (double)(drawn_ns - uploaded_ns) * 1e-6;
-                v->swap_ms[v->n_upload++] = (double)(swapped_ns - drawn_ns) * 1e-6;
-            }
-            if (urgent)
-                v->n_drawn_mesh++;
-            else if (visible)
-                v->n_drawn_snapshot++;
-            else
-                v->n_drawn_other++;
-            if (last_swap_ns != 0) {
-                const double dt_ms = (double)(swapped_ns - last_swap_ns) * 1e-6;
-                if (dt_ms > 0.0)
-                    v->fps = v->fps > 0.0 ? 0.9 * v->fps + 0.1 * (1000.0 / dt_ms)
-                                          : 1000.0 / dt_ms;
-                if (v->n_frame < LATENCY_SAMPLES) {
-                    v->frame_ms[v->n_frame] = dt_ms;
-                    v->cost_ms[v->n_frame++] = (double)(swapped_ns - start_ns) * 1e-6;
-                }
-            }
-            frame_pacer_drawn(&pacer, start_ns, swapped_ns);
-            last_swap_ns = swapped_ns;
-            if (undrawn)
-                atomic_store(&L->shown_pub, fr->pub_seq);
-            if (undrawn && unshown && v->n_latency < LATENCY_SAMPLES) {
-                /* Wall clock from the impulse's arrival at the host to the return of the first
-                 * swap whose frame shows the solve step that integrated it. */
-                const uint64_t at[STAGE_COUNT + 1] = {fr->arrival_ns, fr->solved_ns,
-                                                      fr->meshed_ns, taken_ns, uploaded_ns,
-                                                      drawn_ns, swapped_ns};
-                for (int k = 0; k < STAGE_COUNT; k++)
-                    v->stage_ms[k][v->n_latency] =
-                        at[k + 1] >= at[k] ? (double)(at[k + 1] - at[k]) * 1e-6 : 0.0;
-                v->latency_ms[v->n_latency++] = (double)(swapped_ns - fr->arrival_ns) * 1e-6;
-            }
-            if (undrawn && unshown)
-                v->counted_pub = fr->change_pub;
-            undrawn = false;
-            now = swapped_ns;
-        }
-        if (done && !undrawn &&
+        S.input = poll_keys(L, v, &in);
+        take_snapshot(L, &S);
+        S.input |= read_pointer(L, v, &in, S.fr->t_s);
+        steer_view(L, v, &S);
+        shoot_frames(L, v, &S, err, err_len);
+        frame_plan_t pl;
+        plan_frame(L, v, &S, &pl);
+        if (pl.draw)
+            present_frame(L, v, &S, &pl);
+        if (S.done && !S.undrawn &&
             (atomic_load(&L->want_stop) || v->quit ||
-             (double)(now - done_at_ns) * 1e-9 >= wo->linger_s))
+             (double)(pl.now_ns - S.done_at_ns) * 1e-9 >= wo->linger_s))
             break;
-        if (!draw) {
-            uint64_t until = draw_at;
-            if (done) {
-                const uint64_t end_ns = done_at_ns + (uint64_t)(wo->linger_s * 1e9);
-                until = end_ns < until ? end_ns : until;
-            }
-            /* Before draw_at only a new mesh is worth a frame: other publishes may sleep on. */
-            wait_for_news(L, v, visible ? WAIT_NEWS : WAIT_ANY, until > now ? until - now : 0);
-        }
+        if (!pl.draw)
+            sleep_until_due(L, v, &S, &pl);
     }
     if (wo->screenshot_path) {
         int w = 0, h = 0;
         glfw_window_size(&v->win, &w, &h);
-        if (w > 0 && h > 0 && !write_shot(L, v, fr, wo->screenshot_path, w, h, err, err_len))
-            status = 1;
+        if (w > 0 && h > 0 && !write_shot(L, v, S.fr, wo->screenshot_path, w, h, err, err_len))
+            S.status = 1;
     }
-    return status;
+    return S.status;
 }
 
-argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo,
-                              session_summary_t *sum, bool *window_failed, char *err,
-                              size_t err_len)
+/* Loads the scripted input (--input) and creates the directory for --frames; on failure nothing
+ * is left loaded. */
+static argil_err_t window_inputs(view_t *v, const session_opts_t *so, const sculpt_window_opts_t *wo,
+                                 char *err, size_t err_len)
 {
-    *window_failed = false;
-    memset(sum, 0, sizeof(*sum));
-    live_t *L = calloc(1, sizeof(*L));
-    view_t *v = calloc(1, sizeof(*v));
-    if (L == NULL || v == NULL) {
-        free(L);
-        free(v);
-        snprintf(err, err_len, "out of memory for the window");
-        return ARGIL_ERR_NOMEM;
-    }
     ui_input_init(&v->script);
     if (wo->input_path != NULL &&
-        ui_input_load(&v->script, wo->input_path, err, err_len) != ARGIL_OK) {
-        free(L);
-        free(v);
+        ui_input_load(&v->script, wo->input_path, err, err_len) != ARGIL_OK)
         return ARGIL_ERR_PARSE;
-    }
     if (wo->frames_dir != NULL && so->out_dir != NULL)
         (void)mkdir(so->out_dir, 0777); /* the session creates it too; errors show below */
     if (wo->frames_dir != NULL && mkdir(wo->frames_dir, 0777) != 0 && errno != EEXIST) {
         snprintf(err, err_len, "%s: cannot create directory: %s", wo->frames_dir,
                  strerror(errno));
         ui_input_free(&v->script);
-        free(L);
-        free(v);
         return ARGIL_ERR_IO;
     }
+    return ARGIL_OK;
+}
+
+/* Opens the window with its renderer and HUD and sets the first scene and camera; on failure
+ * nothing is left open. */
+static argil_err_t view_open(view_t *v, const session_opts_t *so, const sculpt_window_opts_t *wo,
+                             char *err, size_t err_len)
+{
     char title[256];
     snprintf(title, sizeof(title), "argil sculpt — %s",
              so->script_path ? so->script_path : "mouse");
     /* No samples in the window itself: still frames are drawn multisampled offscreen and
      * resolved into it (draw_frame). */
     if (glfw_window_open(&v->win, wo->width, wo->height, true, 0, title, &v->gl, err,
-                         err_len) != ARGIL_OK) {
-        *window_failed = true;
-        ui_input_free(&v->script);
-        free(L);
-        free(v);
+                         err_len) != ARGIL_OK)
         return ARGIL_ERR_STATE;
-    }
     argil_err_t rc = renderer_init(&v->r, &v->gl, err, err_len);
     if (rc == ARGIL_OK)
         rc = hud_init(&v->hud, &v->gl, err, err_len);
     if (rc != ARGIL_OK) {
-        *window_failed = true;
         hud_free(&v->hud);
         renderer_free(&v->r);
         glfw_window_close(&v->win);
-        ui_input_free(&v->script);
-        free(L);
-        free(v);
         return ARGIL_ERR_STATE;
     }
     v->gl.Enable(GL_MULTISAMPLE);
@@ -1295,7 +1381,26 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     v->scene.closed_mesh = true; /* mc_blocks meshes are closed, CCW seen from outside */
     camera_frame(&v->cam, vec3(-0.036f, -0.036f, -0.036f), vec3(0.036f, 0.036f, 0.036f));
     camera_orbit(&v->cam, -30.0f * (float)M_PI / 180.0f, 25.0f * (float)M_PI / 180.0f);
+    return ARGIL_OK;
+}
 
+/* Frees what view_open opened and the frames drawn since hold. */
+static void view_close(view_t *v)
+{
+    if (v->shot_ready)
+        render_target_free(&v->shot);
+    if (v->aa_ready)
+        render_target_free(&v->aa);
+    free(v->shot_rgb);
+    hud_free(&v->hud);
+    renderer_free(&v->r);
+    glfw_window_close(&v->win);
+}
+
+/* Sets up the state the two threads share and the session's options with the per-tick hook;
+ * the view starts with the second iso-surface and colour map the options ask for. */
+static void live_init(live_t *L, view_t *v, const session_opts_t *so, const sculpt_window_opts_t *wo)
+{
     triple_buffer_init(&L->tb);
     for (int i = 0; i < 3; i++) {
         mesh_init(&L->slot[i].mesh);
@@ -1326,76 +1431,11 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
     L->so.hook = &L->hook;
     if (wo->mouse)
         L->so.script_path = NULL;
+}
 
-    pthread_t th;
-    int status = 0;
-    if (pthread_create(&th, NULL, session_main, L) != 0) {
-        snprintf(err, err_len, "cannot start the session thread");
-        rc = ARGIL_ERR_STATE;
-    } else {
-        char rerr[512] = "";
-        status = render_loop(L, v, rerr, sizeof(rerr));
-        atomic_store(&L->want_stop, 1);
-        pthread_join(th, NULL);
-        *sum = L->sum;
-        if (wo->mouse)
-            sum->interrupted = false; /* closing the window is how a mouse session ends */
-        rc = L->rc;
-        if (rc != ARGIL_OK)
-            snprintf(err, err_len, "%s", L->err);
-        else if (status != 0) {
-            snprintf(err, err_len, "%s", rerr);
-            rc = ARGIL_ERR_IO;
-        }
-        if (wo->report) {
-            const size_t nf = v->n_frame, nl = v->n_latency;
-            const double fm = median(v->frame_ms, nf), lm = median(v->latency_ms, nl);
-            const double lmax = nl ? v->latency_ms[nl - 1] : 0.0;
-            const double l90 = nl ? v->latency_ms[nl * 9 / 10] : 0.0;
-            printf("  live window         %zu frames, frame time median %.1f ms; change to "
-                   "screen median %.1f ms, p90 %.1f ms, max %.1f ms (%zu changes)\n",
-                   nf, fm, lm, l90, lmax, nl);
-            printf("  latency stages      median ms:");
-            for (int k = 0; k < STAGE_COUNT; k++)
-                printf(" %s %.1f", STAGE_NAMES[k], median(v->stage_ms[k], nl));
-            printf("; frames with an upload: upload %.1f, draw %.1f, swap %.1f (%zu)\n",
-                   median(v->upload_ms, v->n_upload), median(v->draw_ms, v->n_upload),
-                   median(v->swap_ms, v->n_upload), v->n_upload);
-            printf("  frames drawn        %zu for a new mesh, %zu for the tool or view, %zu for "
-                   "input or the HUD alone; frame cost (start to swap) median %.1f ms\n",
-                   v->n_drawn_mesh, v->n_drawn_snapshot, v->n_drawn_other,
-                   median(v->cost_ms, nf));
-            uint32_t slot;
-            triple_buffer_take(&L->tb, &slot);
-            const live_frame_t *fr = &L->slot[slot];
-            const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
-            const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
-            printf("  tool at the end     %s%s, radius %.2f mm, stiffness %.3f N/mm, beta %s, "
-                   "clay stiffness %.3g, damping %.3g, plastic rate %.3g Hz\n",
-                   TOOL_NAMES[t], fr->inverted ? " (inverted)" : "",
-                   (double)fr->params[PARAM_RADIUS_MM],
-                   (double)fr->params[PARAM_STIFFNESS_N_PER_MM], FILTER_NAMES[b],
-                   (double)fr->params[PARAM_CLAY_STIFFNESS],
-                   (double)fr->params[PARAM_CLAY_DAMPING],
-                   (double)fr->params[PARAM_PLASTIC_RATE_HZ]);
-            char iso2[16] = "off";
-            if (fr->iso2_on)
-                snprintf(iso2, sizeof(iso2), "%.2f", (double)fr->iso2_level);
-            printf("  view at the end     iso2 %s, colour %s (%.3g .. %.3g x default), solve "
-                   "step %.1f ms\n",
-                   iso2, colour_map_name((colour_map_t)fr->colour), (double)fr->colour_lo,
-                   (double)fr->colour_hi, (double)fr->solve_step_ms);
-        }
-    }
-    if (v->shot_ready)
-        render_target_free(&v->shot);
-    if (v->aa_ready)
-        render_target_free(&v->aa);
-    free(v->shot_rgb);
-    hud_free(&v->hud);
-    renderer_free(&v->r);
-    glfw_window_close(&v->win);
-    ui_input_free(&v->script);
+/* Frees the session thread's meshers and the snapshots' meshes. */
+static void live_free(live_t *L)
+{
     if (L->mcb_ready)
         mc_blocks_free(&L->mcb);
     if (L->mcb2_ready)
@@ -1404,6 +1444,118 @@ argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo
         mesh_free(&L->slot[i].mesh);
         mesh_free(&L->slot[i].mesh2);
     }
+}
+
+/* --report: the frame-time, latency and frame-count figures (sorts the samples). */
+static void report_frames(view_t *v)
+{
+    const size_t nf = v->n_frame, nl = v->n_latency;
+    const double fm = median(v->frame_ms, nf), lm = median(v->latency_ms, nl);
+    const double lmax = nl ? v->latency_ms[nl - 1] : 0.0;
+    const double l90 = nl ? v->latency_ms[nl * 9 / 10] : 0.0;
+    printf("  live window         %zu frames, frame time median %.1f ms; change to "
+           "screen median %.1f ms, p90 %.1f ms, max %.1f ms (%zu changes)\n",
+           nf, fm, lm, l90, lmax, nl);
+    printf("  latency stages      median ms:");
+    for (int k = 0; k < STAGE_COUNT; k++)
+        printf(" %s %.1f", STAGE_NAMES[k], median(v->stage_ms[k], nl));
+    printf("; frames with an upload: upload %.1f, draw %.1f, swap %.1f (%zu)\n",
+           median(v->upload_ms, v->n_upload), median(v->draw_ms, v->n_upload),
+           median(v->swap_ms, v->n_upload), v->n_upload);
+    printf("  frames drawn        %zu for a new mesh, %zu for the tool or view, %zu for "
+           "input or the HUD alone; frame cost (start to swap) median %.1f ms\n",
+           v->n_drawn_mesh, v->n_drawn_snapshot, v->n_drawn_other,
+           median(v->cost_ms, nf));
+}
+
+/* --report: the tool and the view as the session's last snapshot has them. */
+static void report_end_state(live_t *L)
+{
+    uint32_t slot;
+    triple_buffer_take(&L->tb, &slot);
+    const live_frame_t *fr = &L->slot[slot];
+    const int t = fr->tool >= 0 && fr->tool < TOOL_KIND_COUNT ? fr->tool : 0;
+    const int b = fr->filter >= 0 && fr->filter < BETA_FILTER_COUNT ? fr->filter : 0;
+    printf("  tool at the end     %s%s, radius %.2f mm, stiffness %.3f N/mm, beta %s, "
+           "clay stiffness %.3g, damping %.3g, plastic rate %.3g Hz\n",
+           TOOL_NAMES[t], fr->inverted ? " (inverted)" : "",
+           (double)fr->params[PARAM_RADIUS_MM],
+           (double)fr->params[PARAM_STIFFNESS_N_PER_MM], FILTER_NAMES[b],
+           (double)fr->params[PARAM_CLAY_STIFFNESS],
+           (double)fr->params[PARAM_CLAY_DAMPING],
+           (double)fr->params[PARAM_PLASTIC_RATE_HZ]);
+    char iso2[16] = "off";
+    if (fr->iso2_on)
+        snprintf(iso2, sizeof(iso2), "%.2f", (double)fr->iso2_level);
+    printf("  view at the end     iso2 %s, colour %s (%.3g .. %.3g x default), solve "
+           "step %.1f ms\n",
+           iso2, colour_map_name((colour_map_t)fr->colour), (double)fr->colour_lo,
+           (double)fr->colour_hi, (double)fr->solve_step_ms);
+}
+
+/* Runs the session thread behind the render loop until both have ended: the session's error,
+ * else the render loop's (a picture not written), with the session's summary in *sum. */
+static argil_err_t run_threads(live_t *L, view_t *v, session_summary_t *sum, char *err,
+                               size_t err_len)
+{
+    pthread_t th;
+    if (pthread_create(&th, NULL, session_main, L) != 0) {
+        snprintf(err, err_len, "cannot start the session thread");
+        return ARGIL_ERR_STATE;
+    }
+    char rerr[512] = "";
+    const int status = render_loop(L, v, rerr, sizeof(rerr));
+    atomic_store(&L->want_stop, 1);
+    pthread_join(th, NULL);
+    *sum = L->sum;
+    if (L->wo->mouse)
+        sum->interrupted = false; /* closing the window is how a mouse session ends */
+    argil_err_t rc = L->rc;
+    if (rc != ARGIL_OK)
+        snprintf(err, err_len, "%s", L->err);
+    else if (status != 0) {
+        snprintf(err, err_len, "%s", rerr);
+        rc = ARGIL_ERR_IO;
+    }
+    if (L->wo->report) {
+        report_frames(v);
+        report_end_state(L);
+    }
+    return rc;
+}
+
+argil_err_t sculpt_window_run(session_opts_t *so, const sculpt_window_opts_t *wo,
+                              session_summary_t *sum, bool *window_failed, char *err,
+                              size_t err_len)
+{
+    *window_failed = false;
+    memset(sum, 0, sizeof(*sum));
+    live_t *L = calloc(1, sizeof(*L));
+    view_t *v = calloc(1, sizeof(*v));
+    if (L == NULL || v == NULL) {
+        free(L);
+        free(v);
+        snprintf(err, err_len, "out of memory for the window");
+        return ARGIL_ERR_NOMEM;
+    }
+    argil_err_t rc = window_inputs(v, so, wo, err, err_len);
+    if (rc != ARGIL_OK) {
+        free(L);
+        free(v);
+        return rc;
+    }
+    if (view_open(v, so, wo, err, err_len) != ARGIL_OK) {
+        *window_failed = true;
+        ui_input_free(&v->script);
+        free(L);
+        free(v);
+        return ARGIL_ERR_STATE;
+    }
+    live_init(L, v, so, wo);
+    rc = run_threads(L, v, sum, err, err_len);
+    view_close(v);
+    ui_input_free(&v->script);
+    live_free(L);
     free(L);
     free(v);
     return rc;
