@@ -66,10 +66,10 @@ REL := $(BUILD)/rel
 SAN := $(BUILD)/san
 FZ := $(BUILD)/fuzz
 
-.PHONY: all check-compile-deps check-layers run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil hil-repeat clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
+.PHONY: all check-compile-deps check-layers check-function-length run test unit sil sys fuzz fuzz-long fuzz-build bench cross hil hil-repeat clean deps deps-build deps-test deps-bench deps-fuzz deps-cross deps-hil check-freestanding tests-build cross-build
 .DEFAULT_GOAL := all
 
-all: $(REL)/argil $(REL)/argil-board check-freestanding check-layers
+all: $(REL)/argil $(REL)/argil-board check-freestanding check-layers check-function-length
 
 # A fresh machine gets one clear line instead of a compiler's "sodium.h: No such file".
 check-compile-deps:
@@ -184,6 +184,9 @@ check-freestanding: $(RT_SRC:%.c=$(REL)/%.o)
 # in shared/, and only sim/rig/ puts firmware/, sim/ and the host link together.
 check-layers:
 	@sh toolchain/check-layers.sh
+
+check-function-length:
+	@sh toolchain/check-function-length.sh
 
 tests-build: $(UNIT_TESTS:%=$(SAN)/tests/%) $(SIL_TESTS:%=$(SAN)/sil/%) $(SAN)/argil $(REL)/argil \
              $(SAN)/argil-board $(REL)/argil-board $(REL)/board_udp_client $(REL)/hil-probe $(REL)/hil-host
