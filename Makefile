@@ -31,8 +31,9 @@ INC := -I.
 REL_CFLAGS := $(CSTD) $(WARN) $(INC) -O2 -g
 SAN_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 TEST_CFLAGS := $(CSTD) $(WARN) $(INC) -O1 -g $(SAN_FLAGS)
-# libsodium: the UDP link's keyed BLAKE2b tags and its key file (firmware/hal/link_auth.c,
-# link_key.c; docs/link.md "Link key"); never in firmware/core or shared/.
+# libsodium: the UDP link's keyed BLAKE2b tags, nonces and key wiping, supplied to the envelope
+# in shared/link_envelope.c by each side (firmware/hal/link_auth.c, host/link/link_crypto.c;
+# docs/link.md "Link key"); never in firmware/core or shared/.
 LDLIBS := -lsodium -lm
 
 SHARED_SRC := $(wildcard shared/*.c)
@@ -43,7 +44,8 @@ SIM_SRC := $(wildcard sim/*.c)
 RIG_SRC := $(wildcard sim/rig/*.c)
 # host/: model/ (representations) <- solve/ (the global solve) <- app/, with mesh/ io/ fit/ render/ link/.
 HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
-# The UDP link's envelope and key file, shared by the board's link thread and the host's UDP link.
+# The board's libsodium and key-file reading for the UDP link (the envelope and the key file's
+# rules are shared/; the host's side is host/link/); in LIB_SRC too, for the unit tests.
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
 LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(RIG_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)

@@ -45,8 +45,9 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
-#include "firmware/hal/link_key.h"
 #include "host/app/peer.h"
+#include "host/link/link_crypto.h"
+#include "host/link/link_key_file.h"
 #include "host/model/grid.h"
 #include "shared/crc32c.h"
 #include "shared/proto.h"
@@ -300,8 +301,8 @@ static void stranger_tick(shost_t *h)
             pthread_mutex_lock(&g_auth_mu);
             const uint64_t nonce = g_auth.nonce;
             pthread_mutex_unlock(&g_auth_mu);
-            const size_t n = link_auth_seal(&wrong, LINK_AUTH_HOST_TO_BOARD, nonce, buf, len,
-                                            sealed, sizeof(sealed));
+            const size_t n = link_auth_seal(link_crypto_mac, &wrong, LINK_AUTH_HOST_TO_BOARD,
+                                            nonce, buf, len, sealed, sizeof(sealed));
             if (n > 0) {
                 stranger_sendto(h, false, sealed, n);
                 stranger_sendto(h, true, sealed, n);
@@ -926,12 +927,12 @@ int main(int argc, char **argv)
     }
     link_key_t key;
     char err[400];
-    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+    if (link_key_file_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "hil-host: ARGIL_LINK_KEY: %s\n", err);
         return 2;
     }
     if (g_keyed)
-        link_auth_host_init(&g_auth, &key);
+        link_auth_host_init(&g_auth, &key, link_crypto_mac);
     pthread_mutexattr_t auth_attr;
     pthread_mutexattr_init(&auth_attr);
     pthread_mutexattr_setprotocol(&auth_attr, PTHREAD_PRIO_INHERIT);

@@ -605,7 +605,7 @@ int main(int argc, char **argv)
     }
     if (c->link == BOARD_LINK_UDP && c->link_key[0] != '\0')
         link_udp_set_key(&d.udp, &key);
-    memset(&key, 0, sizeof(key));
+    link_auth_wipe(&key, sizeof(key));
 
     board_cfg_t bc;
     board_cfg_default(&bc);

@@ -1,8 +1,7 @@
-/* The UDP link's envelope (docs/protocol.md "Authenticated UDP"): a datagram is one protocol
- * frame followed by a trailer, the session nonce (u64 LE) and a 16-byte keyed BLAKE2b tag over
- * "ARGL-UDP" ‖ direction ‖ nonce ‖ frame. Pure: byte buffers in and out, no sockets, no clock.
- * Used by the board's link thread (link_udp.c), the host's UDP link (host/link/link_dgram.c)
- * and the test hosts; never by firmware/core, and never in the 1 kHz tick. */
+/* libsodium for the board's side of the UDP link's envelope (shared/link_envelope.h): start-up,
+ * the keyed BLAKE2b-128 MAC every datagram is sealed and verified with, session nonces, and
+ * wiping a key. Hosted: the daemon's link thread and main, never firmware/core, never the 1 kHz
+ * tick. */
 #ifndef ARGIL_LINK_AUTH_H
 #define ARGIL_LINK_AUTH_H
 
@@ -10,74 +9,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define LINK_KEY_BYTES 32u
-#define LINK_AUTH_NONCE_BYTES 8u
-#define LINK_AUTH_TAG_BYTES 16u
-#define LINK_AUTH_TRAILER_BYTES (LINK_AUTH_NONCE_BYTES + LINK_AUTH_TAG_BYTES)
-#define LINK_AUTH_DGRAM_MAX (1024u + LINK_AUTH_TRAILER_BYTES) /* PROTO_FRAME_MAX + trailer */
-
-/* Who sent the datagram: part of what the tag covers, so a frame cannot be reflected. */
-#define LINK_AUTH_HOST_TO_BOARD 1u
-#define LINK_AUTH_BOARD_TO_HOST 2u
-
-typedef struct {
-    uint8_t k[LINK_KEY_BYTES];
-} link_key_t;
-
-typedef enum {
-    LINK_AUTH_OK = 0,
-    LINK_AUTH_ERR_SIZE = -1,  /* not exactly one whole frame (its header's length) + trailer */
-    LINK_AUTH_ERR_TAG = -2,   /* the tag does not verify: another key, direction, or a changed
-                               * byte of frame, nonce or tag */
-    LINK_AUTH_ERR_NONCE = -3  /* the tag verifies, but the nonce is not the session's (nor 0 on a
-                               * HELLO) */
-} link_auth_err_t;
+#include "shared/link_envelope.h"
 
 /* Initialises libsodium (once per process, any thread; idempotent). False if it cannot run. */
 bool link_auth_init(void);
 
-/* Writes frame ‖ nonce ‖ tag into out; returns len + LINK_AUTH_TRAILER_BYTES, or 0 when cap is
- * short or len is 0 or above 1024. out may not overlap frame. */
-size_t link_auth_seal(const link_key_t *key, uint8_t direction, uint64_t nonce,
-                      const uint8_t *frame, size_t len, uint8_t *out, size_t cap);
-
-/* Verifies a datagram's tag (constant-time compare). On LINK_AUTH_OK *frame_len is the frame's
- * size (the frame is dgram[0 … *frame_len)) and *nonce the nonce it carried. */
-link_auth_err_t link_auth_open(const link_key_t *key, uint8_t direction, const uint8_t *dgram,
-                               size_t len, size_t *frame_len, uint64_t *nonce);
-
-/* The board's rule for a verified host frame's nonce: the session's nonce (never 0), or 0 on a
- * HELLO (the host cannot know the nonce of a session it has not started yet). */
-bool link_auth_nonce_ok(uint64_t session_nonce, uint64_t nonce, const uint8_t *frame,
-                        size_t frame_len);
+/* The envelope's MAC (a link_auth_mac_fn): BLAKE2b keyed with key, 16 bytes of output. */
+void link_auth_mac(const link_key_t *key, const uint8_t *msg, size_t len,
+                   uint8_t tag[LINK_AUTH_TAG_BYTES]);
 
 /* A fresh random nonce, never 0 (libsodium's randombytes_buf). */
 uint64_t link_auth_new_nonce(void);
 
-/* A host's side of the envelope: its key and the board's session nonce as last heard (0 until a
- * datagram from the board told it). The host's UDP link and the test hosts use it. */
-typedef struct {
-    link_key_t key;
-    uint64_t nonce;
-    uint32_t refused;            /* datagrams from the board whose tag did not verify */
-    uint32_t held;               /* frames not sealed: no nonce known yet, and not a HELLO */
-} link_auth_host_t;
-
-void link_auth_host_init(link_auth_host_t *h, const link_key_t *key);
-
-/* Seals a host frame into out: a HELLO with nonce 0 (it starts a session whose nonce the host
- * cannot know), anything else with the board's nonce. 0 (counted in held) for a non-HELLO frame
- * while no nonce is known: the board would refuse it; 0 too when it does not fit. */
-size_t link_auth_host_seal(link_auth_host_t *h, const uint8_t *frame, size_t len, uint8_t *out,
-                           size_t cap);
-
-/* Verifies a datagram from the board and learns its nonce (each session's arrives with the
- * board's answer to the HELLO). On LINK_AUTH_OK the frame is dgram[0 … *frame_len); a refusal
- * is counted in refused. */
-link_auth_err_t link_auth_host_open(link_auth_host_t *h, const uint8_t *dgram, size_t len,
-                                    size_t *frame_len);
-
-/* Verdict names for logs and tests ("bad tag"). */
-const char *link_auth_err_text(link_auth_err_t e);
+/* Zeroes len bytes at p in a way the compiler keeps (sodium_memzero): key copies. */
+void link_auth_wipe(void *p, size_t len);
 
 #endif

@@ -1,7 +1,8 @@
 /* The host link's transports for the board daemon's link thread: UDP (one frame per datagram;
- * with a key each sealed and verified here, link_auth.h; only the host whose HELLO started the
- * core's session gets through, and gets the replies: link_bind.h) and a USB FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint;
- * the same frames back to back).
+ * with a key each sealed and verified here, shared/link_envelope.h; only the host whose HELLO
+ * started the core's session gets through, and gets the replies: link_bind.h) and a USB
+ * FunctionFS gadget (vendor-class interface, one bulk OUT and one bulk IN endpoint; the same
+ * frames back to back).
  * Linux only (hosted); nothing here runs in the fast loop. */
 #ifndef ARGIL_LINK_IO_H
 #define ARGIL_LINK_IO_H
@@ -32,7 +33,7 @@ typedef struct {
     uint32_t tx_datagrams;
     uint32_t tx_errors;
     uint32_t tx_unbound;         /* frames dropped: no host bound */
-    bool keyed;                  /* every datagram sealed and verified with key (link_auth.h) */
+    bool keyed;                  /* every datagram sealed and verified with key (link_envelope.h) */
     link_key_t key;
     uint64_t nonce;              /* the bound session's nonce, drawn at each new session */
     uint32_t nonces;             /* nonces drawn */

@@ -1,6 +1,6 @@
 /* UDP transport of the host link: one frame per datagram, never blocking; with a key every
- * datagram sealed and verified here, in the link thread (link_auth.h); only the session's host
- * gets through (link_bind.h). */
+ * datagram sealed and verified here, in the link thread (shared/link_envelope.h with
+ * link_auth.h's MAC); only the session's host gets through (link_bind.h). */
 #include <arpa/inet.h>
 #include <errno.h>
 #include <stdio.h>
@@ -93,8 +93,8 @@ size_t link_udp_receive(link_udp_t *u, uint8_t *buf, size_t cap, uint64_t now_us
         size_t len = (size_t)n;
         uint64_t nonce = 0;
         if (u->keyed) {
-            if (link_auth_open(&u->key, LINK_AUTH_HOST_TO_BOARD, buf, (size_t)n, &len, &nonce) !=
-                LINK_AUTH_OK) {
+            if (link_auth_open(link_auth_mac, &u->key, LINK_AUTH_HOST_TO_BOARD, buf, (size_t)n,
+                               &len, &nonce) != LINK_AUTH_OK) {
                 u->bad_mac++;
                 continue;
             }
@@ -145,8 +145,8 @@ argil_err_t link_udp_send(link_udp_t *u, const uint8_t *buf, size_t len)
         size_t dlen = size;
         uint8_t sealed[LINK_AUTH_DGRAM_MAX];
         if (u->keyed) {
-            dlen = link_auth_seal(&u->key, LINK_AUTH_BOARD_TO_HOST, u->nonce, buf + at, size,
-                                  sealed, sizeof(sealed));
+            dlen = link_auth_seal(link_auth_mac, &u->key, LINK_AUTH_BOARD_TO_HOST, u->nonce,
+                                  buf + at, size, sealed, sizeof(sealed));
             dgram = sealed;
         }
         const ssize_t w = dlen == 0 ? -1

@@ -16,7 +16,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/hal/link_key.h"
 #include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/model/host_tool.h"
@@ -26,6 +25,8 @@
 #include "host/app/session_undo.h"
 #include "host/io/argil_file.h"
 #include "host/link/link.h"
+#include "host/link/link_crypto.h"
+#include "host/link/link_key_file.h"
 #include "host/mesh/grid_mesh.h"
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
@@ -793,17 +794,17 @@ static int connect_open_link(connect_session_t *cs)
         return 1;
     }
     link_key_t key;
-    if (o->key_file && !link_auth_init()) {
+    if (o->key_file && !link_crypto_init()) {
         fprintf(stderr, "argil connect: libsodium cannot start (no random source?)\n");
         return 1;
     }
-    if (o->key_file && link_key_load(o->key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
+    if (o->key_file && link_key_file_load(o->key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
         return 2;
     }
     const argil_err_t lo =
         link_open_keyed(&c->link, o->device, o->key_file ? key.k : NULL, err, sizeof(err));
-    memset(&key, 0, sizeof(key));
+    link_crypto_wipe(&key, sizeof(key));
     if (lo != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
         return lo == ARGIL_ERR_PARSE || lo == ARGIL_ERR_ARG ? 2 : 1;

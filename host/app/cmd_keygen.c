@@ -1,10 +1,10 @@
-/* argil keygen FILE: a new UDP link key file (firmware/hal/link_key.h, docs/link.md "Link key")
+/* argil keygen FILE: a new UDP link key file (host/link/link_key_file.h, docs/link.md "Link key")
  * for argil-board --key and argil connect --key. */
 #include <stdio.h>
 #include <string.h>
 
-#include "firmware/hal/link_key.h"
 #include "host/app/commands.h"
+#include "host/link/link_key_file.h"
 
 static void usage_keygen(FILE *f)
 {
@@ -37,7 +37,7 @@ int cmd_keygen(int argc, char **argv)
         return 2;
     }
     char err[512];
-    if (link_key_create(argv[0], err, sizeof(err)) != LINK_KEY_OK) {
+    if (link_key_file_create(argv[0], err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "argil keygen: %s\n", err);
         return 1;
     }

@@ -24,7 +24,7 @@ typedef struct {
                                 * a board without one) */
 } link_stats_t;
 
-#define LINK_KEY_SIZE 32u      /* the UDP link key (firmware/hal/link_auth.h, docs/link.md) */
+#define LINK_KEY_SIZE 32u      /* the UDP link key (shared/link_envelope.h, docs/link.md) */
 
 typedef struct link_s link_t;
 

@@ -1,8 +1,9 @@
 /* UDP transport of the host link: a connected, non-blocking socket to the board; every frame
  * is one datagram each way. With a key every datagram is sealed (the board's session nonce,
  * learned from each verified datagram of the board; 0 on a HELLO) and every datagram from the
- * board verified (firmware/hal/link_auth.h). A board that restarts on the same address is
- * simply heard again (the link state machine turns that into a reconnection). */
+ * board verified (shared/link_envelope.h, with libsodium's MAC: link_crypto.h). A board that
+ * restarts on the same address is simply heard again (the link state machine turns that into a
+ * reconnection). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <netdb.h>
@@ -13,8 +14,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "firmware/hal/link_auth.h"
 #include "host/link/link.h"
+#include "host/link/link_crypto.h"
+#include "shared/link_envelope.h"
 #include "shared/link_framer.h"
 
 _Static_assert(LINK_KEY_SIZE == LINK_KEY_BYTES, "one key size");
@@ -102,6 +104,7 @@ static void dgram_close(link_t *l)
     dgram_t *d = l->impl;
     if (d) {
         close(d->fd);
+        link_crypto_wipe(&d->auth, sizeof(d->auth));
         free(d);
     }
 }
@@ -141,8 +144,8 @@ argil_err_t link_dgram_open(link_t *l, char *err, size_t err_len)
     if (l->keyed) {
         link_key_t k;
         memcpy(k.k, l->key, sizeof(k.k));
-        link_auth_host_init(&d->auth, &k);
-        memset(&k, 0, sizeof(k));
+        link_auth_host_init(&d->auth, &k, link_crypto_mac);
+        link_crypto_wipe(&k, sizeof(k));
         d->keyed = true;
     }
     /* Room for a burst of telemetry and impulses while the link thread is descheduled. */

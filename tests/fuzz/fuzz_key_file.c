@@ -1,5 +1,5 @@
-/* libFuzzer target for the link key file's parser (firmware/hal/link_key.c): arbitrary bytes as
- * a key file's text. Checked: it never reads past the text; a refusal names a line within it;
+/* libFuzzer target for the link key file's parser (shared/link_key_text.c): arbitrary bytes as a
+ * key file's text. Checked: it never reads past the text; a refusal names a line within it;
  * an accepted key, written back as one line of hex, parses to the same 32 bytes. */
 #include <stddef.h>
 #include <stdint.h>
@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "firmware/hal/link_key.h"
+#include "shared/link_key_text.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -1,9 +1,10 @@
-/* libFuzzer target for the authenticated UDP path (firmware/hal/link_auth.c, docs/protocol.md
- * "Authenticated UDP"): arbitrary bytes as a datagram into the board's verification (tag, then
- * the nonce rule) and, when it verifies, the decoder, as link_udp.c runs them; and the same bytes
- * as a frame sealed, changed in one byte chosen by the input, and opened again. Checked: a
- * verified datagram is exactly its frame and a trailer, and sealing that frame again gives the
- * same bytes; a sealed frame opens to itself; a changed byte never opens. */
+/* libFuzzer target for the authenticated UDP path (shared/link_envelope.c with the board's MAC,
+ * firmware/hal/link_auth.c; docs/protocol.md "Authenticated UDP"): arbitrary bytes as a
+ * datagram into the board's verification (tag, then the nonce rule) and, when it verifies, the
+ * decoder, as link_udp.c runs them; and the same bytes as a frame sealed, changed in one byte
+ * chosen by the input, and opened again. Checked: a verified datagram is exactly its frame and
+ * a trailer, and sealing that frame again gives the same bytes; a sealed frame opens to itself;
+ * a changed byte never opens. */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -36,10 +37,10 @@ static void as_datagram(const link_key_t *k, const uint8_t *d, size_t n)
     for (uint8_t dir = LINK_AUTH_HOST_TO_BOARD; dir <= LINK_AUTH_BOARD_TO_HOST; dir++) {
         size_t flen = 0;
         uint64_t nonce = 0;
-        if (link_auth_open(k, dir, d, n, &flen, &nonce) != LINK_AUTH_OK)
+        if (link_auth_open(link_auth_mac, k, dir, d, n, &flen, &nonce) != LINK_AUTH_OK)
             continue;
         check(flen + LINK_AUTH_TRAILER_BYTES == n && flen <= PROTO_FRAME_MAX);
-        check(link_auth_seal(k, dir, nonce, d, flen, again, sizeof(again)) == n);
+        check(link_auth_seal(link_auth_mac, k, dir, nonce, d, flen, again, sizeof(again)) == n);
         check(memcmp(again, d, n) == 0);
         (void)link_auth_nonce_ok(nonce, nonce, d, flen);
         (void)link_auth_nonce_ok(0x0123456789ABCDEFull, nonce, d, flen);
@@ -58,8 +59,8 @@ static void as_frame(const link_key_t *k, const uint8_t *d, size_t n)
     const uint8_t *frame = d + 2;
     const size_t flen = n - 2u;
     const uint64_t nonce = (uint64_t)flip * 0x9E3779B97F4A7C15ull;
-    const size_t len = link_auth_seal(k, LINK_AUTH_HOST_TO_BOARD, nonce, frame, flen, sealed,
-                                      sizeof(sealed));
+    const size_t len = link_auth_seal(link_auth_mac, k, LINK_AUTH_HOST_TO_BOARD, nonce, frame,
+                                      flen, sealed, sizeof(sealed));
     if (len == 0) {
         check(flen > PROTO_FRAME_MAX);
         return;
@@ -72,14 +73,14 @@ static void as_frame(const link_key_t *k, const uint8_t *d, size_t n)
                                       ((size_t)frame[6] | (size_t)frame[7] << 8)
                                 : 0;
     const link_auth_err_t e =
-        link_auth_open(k, LINK_AUTH_HOST_TO_BOARD, sealed, len, &got, &got_nonce);
+        link_auth_open(link_auth_mac, k, LINK_AUTH_HOST_TO_BOARD, sealed, len, &got, &got_nonce);
     if (declared == flen)
         check(e == LINK_AUTH_OK && got == flen && got_nonce == nonce);
     else
         check(e != LINK_AUTH_OK);
     sealed[at % len] ^= (uint8_t)(flip | 1u);
-    check(link_auth_open(k, LINK_AUTH_HOST_TO_BOARD, sealed, len, &got, &got_nonce) !=
-          LINK_AUTH_OK);
+    check(link_auth_open(link_auth_mac, k, LINK_AUTH_HOST_TO_BOARD, sealed, len, &got,
+                         &got_nonce) != LINK_AUTH_OK);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

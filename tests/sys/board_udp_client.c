@@ -21,8 +21,9 @@
 #include <unistd.h>
 
 #include "firmware/core/safety.h"
-#include "firmware/hal/link_key.h"
 #include "host/app/peer.h"
+#include "host/link/link_crypto.h"
+#include "host/link/link_key_file.h"
 #include "host/model/grid.h"
 
 typedef struct {
@@ -171,12 +172,12 @@ int main(int argc, char **argv)
         return 2;
     link_key_t key;
     char err[400];
-    if (link_key_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
+    if (link_key_file_load_env("ARGIL_LINK_KEY", &key, &g_keyed, err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "board_udp_client: ARGIL_LINK_KEY: %s\n", err);
         return 2;
     }
     if (g_keyed)
-        link_auth_host_init(&g_auth, &key);
+        link_auth_host_init(&g_auth, &key, link_crypto_mac);
     static host_t h;
     host_open(&h, port);
     const int t1 = until_active(&h, 4000, false);

@@ -507,7 +507,8 @@ static size_t udp_deliver_sealed(link_udp_t *u, int fd, const struct sockaddr_in
     size_t len = frame_of(type, 0, seq, f);
     const uint8_t *out = f;
     if (key) {
-        len = link_auth_seal(key, LINK_AUTH_HOST_TO_BOARD, nonce, f, len, d, sizeof(d));
+        len = link_auth_seal(link_auth_mac, key, LINK_AUTH_HOST_TO_BOARD, nonce, f, len, d,
+                             sizeof(d));
         out = d;
     }
     assert_int_equal(sendto(fd, out, len, 0, (const struct sockaddr *)to, sizeof(*to)),
@@ -525,8 +526,9 @@ static uint64_t udp_board_nonce(int fd, const link_key_t *key)
     assert_true(n > 0);
     size_t flen = 0;
     uint64_t nonce = 0;
-    assert_int_equal(link_auth_open(key, LINK_AUTH_BOARD_TO_HOST, b, (size_t)n, &flen, &nonce),
-                     LINK_AUTH_OK);
+    assert_int_equal(
+        link_auth_open(link_auth_mac, key, LINK_AUTH_BOARD_TO_HOST, b, (size_t)n, &flen, &nonce),
+        LINK_AUTH_OK);
     (void)udp_got(fd); /* drain */
     return nonce;
 }

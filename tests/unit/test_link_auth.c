@@ -1,6 +1,8 @@
-/* The UDP link's envelope (firmware/hal/link_auth.c): the sealed golden datagrams of
- * docs/protocol.md byte for byte, and every way a datagram is refused (a flipped bit anywhere,
- * another direction or key, a torn trailer, a nonce that is not the session's). */
+/* The UDP link's envelope (shared/link_envelope.c with the board's and the host's libsodium
+ * MAC, firmware/hal/link_auth.c and host/link/link_crypto.c): the sealed golden datagrams of
+ * docs/protocol.md byte for byte from both sides, and every way a datagram is refused (a
+ * flipped bit anywhere, another direction or key, a torn trailer, a nonce that is not the
+ * session's). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -10,6 +12,7 @@
 #include <string.h>
 
 #include "firmware/hal/link_auth.h"
+#include "host/link/link_crypto.h"
 #include "shared/proto.h"
 
 /* docs/protocol.md "Sealed golden datagrams": key 00 01 … 1f, nonce 0x0123456789ABCDEF; the
@@ -45,20 +48,22 @@ static link_key_t test_key(void)
 static int setup(void **st)
 {
     (void)st;
-    return link_auth_init() ? 0 : -1;
+    return link_auth_init() && link_crypto_init() ? 0 : -1;
 }
 
-static void check_golden(const uint8_t *sealed, size_t len, uint8_t direction)
+static void check_golden(link_auth_mac_fn mac, const uint8_t *sealed, size_t len,
+                         uint8_t direction)
 {
     const link_key_t k = test_key();
     const size_t flen = len - LINK_AUTH_TRAILER_BYTES;
     uint8_t out[LINK_AUTH_DGRAM_MAX];
-    assert_int_equal(link_auth_seal(&k, direction, TEST_NONCE, sealed, flen, out, sizeof(out)),
-                     len);
+    assert_int_equal(
+        link_auth_seal(mac, &k, direction, TEST_NONCE, sealed, flen, out, sizeof(out)), len);
     assert_memory_equal(out, sealed, len);
     size_t got_len = 0;
     uint64_t nonce = 0;
-    assert_int_equal(link_auth_open(&k, direction, sealed, len, &got_len, &nonce), LINK_AUTH_OK);
+    assert_int_equal(link_auth_open(mac, &k, direction, sealed, len, &got_len, &nonce),
+                     LINK_AUTH_OK);
     assert_int_equal(got_len, flen);
     assert_true(nonce == TEST_NONCE);
     /* the frame inside is still a frame the decoder takes */
@@ -71,13 +76,16 @@ static void check_golden(const uint8_t *sealed, size_t len, uint8_t direction)
 static void test_golden_sealed_hello_matches_the_spec(void **st)
 {
     (void)st;
-    check_golden(sealed_hello, sizeof sealed_hello, LINK_AUTH_BOARD_TO_HOST);
+    check_golden(link_auth_mac, sealed_hello, sizeof sealed_hello, LINK_AUTH_BOARD_TO_HOST);
+    check_golden(link_crypto_mac, sealed_hello, sizeof sealed_hello, LINK_AUTH_BOARD_TO_HOST);
 }
 
 static void test_golden_sealed_heartbeat_matches_the_spec(void **st)
 {
     (void)st;
-    check_golden(sealed_heartbeat, sizeof sealed_heartbeat, LINK_AUTH_HOST_TO_BOARD);
+    check_golden(link_auth_mac, sealed_heartbeat, sizeof sealed_heartbeat, LINK_AUTH_HOST_TO_BOARD);
+    check_golden(link_crypto_mac, sealed_heartbeat, sizeof sealed_heartbeat,
+                 LINK_AUTH_HOST_TO_BOARD);
 }
 
 /* Any one bit changed in frame, nonce or tag: refused, and nothing handed out. */
@@ -92,7 +100,8 @@ static void test_every_flipped_bit_is_refused(void **st)
         size_t flen = 12345;
         uint64_t nonce = 777;
         const link_auth_err_t e =
-            link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d, &flen, &nonce);
+            link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d, &flen,
+                           &nonce);
         /* the header's length field (bytes 6, 7) no longer fits the datagram: SIZE */
         const size_t byte = bit / 8u;
         if (e != ((byte == 6u || byte == 7u) ? LINK_AUTH_ERR_SIZE : LINK_AUTH_ERR_TAG))
@@ -109,14 +118,15 @@ static void test_another_direction_or_key_is_refused(void **st)
     size_t flen;
     uint64_t nonce;
     /* a board's datagram reflected back to it */
-    assert_int_equal(link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, sealed_hello,
+    assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD, sealed_hello,
                                     sizeof sealed_hello, &flen, &nonce), LINK_AUTH_ERR_TAG);
-    assert_int_equal(link_auth_open(&k, LINK_AUTH_BOARD_TO_HOST, sealed_heartbeat,
+    assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_BOARD_TO_HOST, sealed_heartbeat,
                                     sizeof sealed_heartbeat, &flen, &nonce), LINK_AUTH_ERR_TAG);
     for (unsigned i = 0; i < LINK_KEY_BYTES; i++) {
         k = test_key();
         k.k[i] ^= 0x80u;
-        assert_int_equal(link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, sealed_heartbeat,
+        assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD,
+                                        sealed_heartbeat,
                                         sizeof sealed_heartbeat, &flen, &nonce),
                          LINK_AUTH_ERR_TAG);
     }
@@ -133,14 +143,17 @@ static void test_a_torn_or_missing_trailer_is_refused(void **st)
     memcpy(d, sealed_heartbeat, sizeof sealed_heartbeat);
     d[sizeof sealed_heartbeat] = 0;
     for (size_t len = 0; len < sizeof sealed_heartbeat; len++)
-        assert_int_equal(link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, d, len, &flen, &nonce),
+        assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD, d, len,
+                                        &flen, &nonce),
                          LINK_AUTH_ERR_SIZE);
-    assert_int_equal(link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d, &flen, &nonce),
+    assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d,
+                                    &flen, &nonce),
                      LINK_AUTH_ERR_SIZE);
     /* a header claiming more than a frame may hold */
     d[6] = 0xff;
     d[7] = 0xff;
-    assert_int_equal(link_auth_open(&k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d, &flen, &nonce),
+    assert_int_equal(link_auth_open(link_auth_mac, &k, LINK_AUTH_HOST_TO_BOARD, d, sizeof d,
+                                    &flen, &nonce),
                      LINK_AUTH_ERR_SIZE);
 }
 
@@ -166,10 +179,13 @@ static void test_seal_refuses_what_it_cannot_hold(void **st)
     (void)st;
     const link_key_t k = test_key();
     static uint8_t big[PROTO_FRAME_MAX + 1u], out[LINK_AUTH_DGRAM_MAX + 1u];
-    assert_int_equal(link_auth_seal(&k, 1, 1, big, 0, out, sizeof out), 0);
-    assert_int_equal(link_auth_seal(&k, 1, 1, big, sizeof big, out, sizeof out), 0);
-    assert_int_equal(link_auth_seal(&k, 1, 1, big, 33, out, 33 + LINK_AUTH_TRAILER_BYTES - 1u), 0);
-    assert_int_equal(link_auth_seal(&k, 1, 1, big, PROTO_FRAME_MAX, out, LINK_AUTH_DGRAM_MAX),
+    assert_int_equal(link_auth_seal(link_auth_mac, &k, 1, 1, big, 0, out, sizeof out), 0);
+    assert_int_equal(link_auth_seal(link_auth_mac, &k, 1, 1, big, sizeof big, out, sizeof out), 0);
+    assert_int_equal(
+        link_auth_seal(link_auth_mac, &k, 1, 1, big, 33, out, 33 + LINK_AUTH_TRAILER_BYTES - 1u),
+        0);
+    assert_int_equal(
+        link_auth_seal(link_auth_mac, &k, 1, 1, big, PROTO_FRAME_MAX, out, LINK_AUTH_DGRAM_MAX),
                      LINK_AUTH_DGRAM_MAX);
 }
 
