@@ -680,10 +680,11 @@ check_scenario() {
         skip "host-side step(s) hil-host cannot play over UDP: $(grep -o 'step line=[0-9]* .* unsupported' "$OUT/$CHECK.host.log" | tr '\n' '|'); checker: $res"
         return
     fi
-    # How long the board took to get ready, and how far behind the board the arm stand-in fell
-    # (the most SYNCs waiting for it when it woke): the figures to look at when a bound is near.
+    # How long the board took to get ready, and how long the arm stand-in ran behind the board
+    # without catching up (SYNCs read before its socket first ran empty): the figures to look at
+    # when a bound is near.
     pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\).*/ready after \1 board ticks (\2 ms)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
-    lag=$(sed -n 's/.* end .*max_backlog_syncs=\([0-9]*\).*/, arm stand-in up to \1 ticks behind/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
+    lag=$(sed -n 's/.* end .*max_backlog_syncs=\([0-9]*\).*/, arm stand-in behind for up to \1 ticks before catching up/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     # How late the bus delivered a frame: in the raw log (delivery order) the most a frame's
     # stamp lies behind the latest stamp before it (vcan0's frames wait in the sender CPU's
     # backlog until the network softirq runs; see vm/init).

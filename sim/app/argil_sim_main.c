@@ -558,9 +558,10 @@ int main(int argc, char **argv)
     }
     const int64_t preroll_t0_us = mono_us();
     bool gate_seen = false;
-    /* How far behind the board this stand-in fell: the SYNCs waiting when it woke, read one
-     * batch after another until the socket came back short (one read holds at most
-     * CAN_BATCH_MAX frames, about 8 ticks' worth, so a count per read saturates there). */
+    /* How long this stand-in ran behind the board without catching up: the SYNCs it read, one
+     * batch after another, before its socket first came back short (not how many were waiting
+     * at once; one read holds at most CAN_BATCH_MAX frames, about 8 ticks' worth, so a count per
+     * read saturated there). */
     uint32_t backlog_syncs = 0, max_backlog_syncs = 0;
 
     can_socket_stats_t st;
