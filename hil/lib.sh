@@ -372,7 +372,14 @@ check_estop() {
     # The fall lies in (lo, hi]: not before the stimulus, and surely late when even the sample
     # before it came more than 2 ticks after the stimulus.
     lo=$(field first_edge_lo "$en"); hi=$(field first_edge "$en")
-    within "$t_pre" "$hi" 9e9 || { fail "DRIVE_ENABLE fell before ESTOP_N was pulled ($en)"; return; }
+    # Fallen before the pull: something else dropped it; say what the board went through
+    # (in CI on 2026-12-03 and here the same day: "FAULT — host heartbeat lost", the host's
+    # heartbeats 51 ticks apart against a timeout of 50: the rig, not the e-stop path).
+    within "$t_pre" "$hi" 9e9 || {
+        gap=$(sed -n 's/.*max-gap-ms=\([0-9.]*\) max-gap-ticks=\([0-9]*\).*/\1 ms (\2 ticks)/p' "$OUT/$CHECK.host.log")
+        fail "DRIVE_ENABLE fell before ESTOP_N was pulled ($en); board: $(grep 'state ' "$OUT/$CHECK.board.log" | cut -d' ' -f3- | tr '\n' ' '); host heartbeats up to ${gap:-?} apart"
+        return
+    }
     late=$(ticks_between "$t0" "$lo"); ticks=$(ticks_between "$t_pre" "$hi")
     [ "$late" -le 2 ] || { fail "DRIVE_ENABLE fell more than $late ticks after ESTOP_N low, want <= 2"; return; }
     ms="$(ms_between "$t0" "$lo")..$(ms_between "$t_pre" "$hi")"
@@ -593,7 +600,7 @@ check_udp_session() {
     can)
         have argil-sim || { skip "argil-sim not built"; return; }
         if [ "$STIM" = gpio-sim ]; then simchip=$(cat "$GPIO_SIM_CONFIGFS/bank0/chip_name"); else simchip=$LOOP_CHIP; fi
-        hil-probe fifo $((HOST_PRIO - 1)) argil-sim --can "$CAN_IF" --gpio-chip "$simchip" >"$OUT/$CHECK.sim.log" 2>&1 &
+        hil-probe fifo $((HOST_PRIO - 1)) argil-sim --can "$CAN_IF" --gpio-chip "$simchip" ${SIM_SUBSTEP_US:+--arm-substep-us "$SIM_SUBSTEP_US"} >"$OUT/$CHECK.sim.log" 2>&1 &
         SIM_PID=$!
         board_start --can "$CAN_IF" --link "udp:127.0.0.1:$UDP_PORT" || { fail "did not start: $(board_tail)"; return; } ;;
     *) fail "udp_session: unknown mode '$1' (sim or can)"; return ;;
@@ -648,12 +655,22 @@ check_scenario() {
     # SIM_CPU pins it to the CPU the board's loop does not own (the VM's vCPU 1).
     ${SIM_CPU:+taskset -c "$SIM_CPU"} hil-probe fifo "$SIM_PRIO" argil-sim --can "${SIM_CAN_IF:-$CAN_IF}" --gpio-chip "$simchip" --scenario "$scn" --log-dir "$OUT/$CHECK.sim" \
         --start-when "$ready" --start-timeout "$START_TIMEOUT_S" ${SIM_RUN_PRIO:+--run-prio "$SIM_RUN_PRIO"} \
+        ${SIM_SUBSTEP_US:+--arm-substep-us "$SIM_SUBSTEP_US"} \
         >"$OUT/$CHECK.sim.out" 2>&1 &
     SIM_PID=$!
     wait "$SIM_PID" || st=$?; SIM_PID=
+    # An arm stand-in that gave up (the board never got ready) ends the check: hil-host would
+    # run out its whole budget (20 s per scenario second + START_TIMEOUT_S) for nothing, and in
+    # CI on 2026-12-03 three such waits of 170-220 s each ran the VM past its time limit.
+    [ "$st" = 0 ] || kill "$HOST_PID" 2>/dev/null
     hst=0; wait "$HOST_PID" || hst=$?; HOST_PID=
     can_log_stop
-    [ "$st" = 0 ] || { fail "argil-sim exit $st: $(tail -n 2 "$OUT/$CHECK.sim.out" | tr '\n' '|')"; return; }
+    if [ "$st" != 0 ]; then
+        # what the board went through, as hil-host saw it ("tick=714 state IDLE|…")
+        hstates=$(sed -n 's/^[0-9.]* \(tick=[0-9]* state [A-Z_]*\)$/\1/p; s/^[0-9.]* \(tick=[0-9]* ready\):.*/\1/p' "$OUT/$CHECK.host.log" | tail -n 4 | tr '\n' '|')
+        fail "argil-sim exit $st: $(tail -n 2 "$OUT/$CHECK.sim.out" | tr '\n' '|') [host saw: ${hstates:-no telemetry}]"
+        return
+    fi
     [ "$hst" = 0 ] || [ "$hst" = 3 ] || { fail "hil-host exit $hst: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
     # A CAN log with holes cannot be judged (ticks are counted in it): say so, not a verdict.
     if [ -s "$OUT/$CHECK.candump.drops" ]; then
@@ -683,7 +700,8 @@ check_scenario() {
     # How long the board took to get ready, and how long the arm stand-in ran behind the board
     # without catching up (SYNCs read before its socket first ran empty): the figures to look at
     # when a bound is near.
-    pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\).*/ready after \1 board ticks (\2 ms)/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
+    # catch_up_ms: from argil-sim seeing the ready file to its start (its socket read empty).
+    pre=$(sed -n 's/.* start scenario .*preroll_syncs=\([0-9]*\) preroll_ms=\([0-9]*\) catch_up_ms=\([0-9.]*\).*/ready after \1 board ticks (\2 ms), started \3 ms after/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     lag=$(sed -n 's/.* end .*max_backlog_syncs=\([0-9]*\).*/, arm stand-in behind for up to \1 ticks before catching up/p' "$OUT/$CHECK.sim/events.log" | head -n 1)
     # How late the bus delivered a frame: in the raw log (delivery order) the most a frame's
     # stamp lies behind the latest stamp before it (vcan0's frames wait in the sender CPU's

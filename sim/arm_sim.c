@@ -18,6 +18,39 @@ void arm_params_default(arm_params_t *p)
         p->peak_torque_nm[j] = p->desc.rated_torque_nm[j] * (float)ARM_PEAK_TORQUE_PERMILLE / 1000.0f;
     }
     p->coulomb_smooth_rad_s = 0.01f;
+    p->substep_us = ARM_SIM_SUBSTEP_US;
+}
+
+/* The width ε of the Coulomb friction's tanh smoothing (1e-3 rad/s when none is set). */
+static double friction_width_rad_s(const arm_params_t *p)
+{
+    return p->coulomb_smooth_rad_s > 0.0f ? (double)p->coulomb_smooth_rad_s : 1e-3;
+}
+
+uint32_t arm_sim_substep_max_us(const arm_params_t *p)
+{
+    const double eps = friction_width_rad_s(p);
+    double rate = 0.0; /* the largest (c/ε + b) / I_min over the joints, 1/s */
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        const double g = p->desc.gear_ratio[j];
+        const double inertia = (double)p->rotor_inertia_kg_m2[j] * g * g;
+        const double slope = fabs((double)p->coulomb_nm[j]) / eps +
+                             fabs((double)p->viscous_nm_s_per_rad[j]);
+        if (!(inertia > 0.0))
+            return 1u;
+        if (slope / inertia > rate)
+            rate = slope / inertia;
+    }
+    if (!(rate > 1.0)) /* 1 s or more: no sub-step this long is asked for */
+        return 1000000u;
+    const double h_us = 1e6 / rate;
+    return h_us < 1.0 ? 1u : (uint32_t)h_us;
+}
+
+uint32_t arm_sim_substep_us(const arm_params_t *p)
+{
+    const uint32_t hi = arm_sim_substep_max_us(p);
+    return p->substep_us < 1u ? 1u : p->substep_us > hi ? hi : p->substep_us;
 }
 
 /* Kinematic terms at (q, q̇): Jacobian, tip position, tip velocity and the velocity-product
@@ -133,43 +166,73 @@ void arm_sim_init(arm_sim_t *sim, const arm_params_t *p, const float q0_rad[ARGI
     }
 }
 
-/* One semi-implicit Euler sub-step of h seconds; tau_in_nm is the joint torque from the motors
- * and the external force, before friction and velocity-product terms. */
-static void substep(arm_sim_t *sim, const arm_params_t *p, const double tau_in_nm[ARGIL_DRIVES],
-                    const double force_n[3], double h)
+void arm_sim_kin_now(const arm_sim_t *sim, const arm_params_t *p, arm_kin_now_t *k)
 {
-    double j[3][ARGIL_DRIVES], bias[3], m[ARGIL_DRIVES][ARGIL_DRIVES];
+    kin_terms(p, sim->q_rad, sim->qd_rad_s, k->jac, k->tip_m, k->tip_vel_m_s, k->acc_bias_m_s2);
+}
+
+/* One semi-implicit Euler sub-step of h seconds from the kinematics k at the present state;
+ * tau_in_nm is the joint torque from the motors, before friction and velocity-product terms. */
+static void substep(arm_sim_t *sim, const arm_params_t *p, const arm_kin_now_t *k,
+                    const double tau_in_nm[ARGIL_DRIVES], const double force_n[3], double h)
+{
+    double m[ARGIL_DRIVES][ARGIL_DRIVES];
     double tau[ARGIL_DRIVES], qdd[ARGIL_DRIVES];
-    kin_terms(p, sim->q_rad, sim->qd_rad_s, j, NULL, NULL, bias);
-    mass_from_jacobian(p, j, m);
-    const double eps = p->coulomb_smooth_rad_s > 0.0f ? (double)p->coulomb_smooth_rad_s : 1e-3;
-    for (int k = 0; k < ARGIL_DRIVES; k++) {
-        const double v = sim->qd_rad_s[k];
-        double t = tau_in_nm[k];
+    mass_from_jacobian(p, (const double(*)[ARGIL_DRIVES])k->jac, m);
+    const double eps = friction_width_rad_s(p);
+    for (int c = 0; c < ARGIL_DRIVES; c++) {
+        const double v = sim->qd_rad_s[c];
+        double t = tau_in_nm[c];
         for (int i = 0; i < 3; i++)
-            t += j[i][k] * (force_n[i] - (double)p->tip_mass_kg * bias[i]);
-        t -= (double)p->viscous_nm_s_per_rad[k] * v;
-        t -= (double)p->coulomb_nm[k] * tanh(v / eps);
-        tau[k] = t;
+            t += k->jac[i][c] * (force_n[i] - (double)p->tip_mass_kg * k->acc_bias_m_s2[i]);
+        t -= (double)p->viscous_nm_s_per_rad[c] * v;
+        t -= (double)p->coulomb_nm[c] * tanh(v / eps);
+        tau[c] = t;
     }
     if (!arm_sim_solve3((const double(*)[3])m, tau, qdd))
         qdd[0] = qdd[1] = qdd[2] = 0.0; /* cannot happen while the rotor inertia is positive */
-    for (int k = 0; k < ARGIL_DRIVES; k++) {
-        sim->qdd_rad_s2[k] = qdd[k];
-        sim->qd_rad_s[k] += h * qdd[k];
-        sim->q_rad[k] += h * sim->qd_rad_s[k];
+    for (int c = 0; c < ARGIL_DRIVES; c++) {
+        sim->qdd_rad_s2[c] = qdd[c];
+        sim->qd_rad_s[c] += h * qdd[c];
+        sim->q_rad[c] += h * sim->qd_rad_s[c];
         /* hard stops, restitution 0 */
-        const double lo = p->desc.q_min_rad[k], hi = p->desc.q_max_rad[k];
-        if (sim->q_rad[k] < lo) {
-            sim->q_rad[k] = lo;
-            if (sim->qd_rad_s[k] < 0.0)
-                sim->qd_rad_s[k] = 0.0;
-        } else if (sim->q_rad[k] > hi) {
-            sim->q_rad[k] = hi;
-            if (sim->qd_rad_s[k] > 0.0)
-                sim->qd_rad_s[k] = 0.0;
+        const double lo = p->desc.q_min_rad[c], hi = p->desc.q_max_rad[c];
+        if (sim->q_rad[c] < lo) {
+            sim->q_rad[c] = lo;
+            if (sim->qd_rad_s[c] < 0.0)
+                sim->qd_rad_s[c] = 0.0;
+        } else if (sim->q_rad[c] > hi) {
+            sim->q_rad[c] = hi;
+            if (sim->qd_rad_s[c] > 0.0)
+                sim->qd_rad_s[c] = 0.0;
         }
     }
+}
+
+/* The motor torques at the joints (clamped to the peak limit; non-finite counts as 0) and the
+ * tip force (0 unless finite), in double. */
+static void step_inputs(const arm_params_t *p, const float motor_torque_nm[ARGIL_DRIVES],
+                        vec3_t tip_force_n, double tau_in[ARGIL_DRIVES], double f[3])
+{
+    for (int c = 0; c < ARGIL_DRIVES; c++) {
+        const double peak = p->peak_torque_nm[c];
+        double t = isfinite(motor_torque_nm[c]) ? (double)motor_torque_nm[c] : 0.0;
+        t = fmin(fmax(t, -peak), peak);
+        tau_in[c] = t * (double)p->desc.gear_ratio[c];
+    }
+    const bool ok = vec3_isfinite(tip_force_n);
+    f[0] = ok ? tip_force_n.x : 0.0;
+    f[1] = ok ? tip_force_n.y : 0.0;
+    f[2] = ok ? tip_force_n.z : 0.0;
+}
+
+void arm_sim_substep_from(arm_sim_t *sim, const arm_params_t *p, const arm_kin_now_t *k,
+                          const float motor_torque_nm[ARGIL_DRIVES], vec3_t tip_force_n,
+                          uint32_t h_us)
+{
+    double tau_in[ARGIL_DRIVES], f[3];
+    step_inputs(p, motor_torque_nm, tip_force_n, tau_in, f);
+    substep(sim, p, k, tau_in, f, (double)h_us * 1e-6);
 }
 
 void arm_sim_step(arm_sim_t *sim, const arm_params_t *p,
@@ -177,19 +240,13 @@ void arm_sim_step(arm_sim_t *sim, const arm_params_t *p,
                   uint32_t dt_us)
 {
     double tau_in[ARGIL_DRIVES], f[3];
-    for (int k = 0; k < ARGIL_DRIVES; k++) {
-        const double peak = p->peak_torque_nm[k];
-        double t = isfinite(motor_torque_nm[k]) ? (double)motor_torque_nm[k] : 0.0;
-        t = fmin(fmax(t, -peak), peak);
-        tau_in[k] = t * (double)p->desc.gear_ratio[k];
-    }
-    const bool ok = vec3_isfinite(tip_force_n);
-    f[0] = ok ? tip_force_n.x : 0.0;
-    f[1] = ok ? tip_force_n.y : 0.0;
-    f[2] = ok ? tip_force_n.z : 0.0;
+    step_inputs(p, motor_torque_nm, tip_force_n, tau_in, f);
+    const uint32_t sub_us = arm_sim_substep_us(p);
     while (dt_us > 0) {
-        const uint32_t h_us = dt_us < ARM_SIM_SUBSTEP_US ? dt_us : ARM_SIM_SUBSTEP_US;
-        substep(sim, p, tau_in, f, (double)h_us * 1e-6);
+        const uint32_t h_us = dt_us < sub_us ? dt_us : sub_us;
+        arm_kin_now_t k;
+        arm_sim_kin_now(sim, p, &k);
+        substep(sim, p, &k, tau_in, f, (double)h_us * 1e-6);
         dt_us -= h_us;
     }
 }
@@ -208,14 +265,14 @@ vec3_t arm_sim_tip_m(const arm_sim_t *sim, const arm_params_t *p)
 {
     double t[3];
     kin_terms(p, sim->q_rad, NULL, NULL, t, NULL, NULL);
-    return vec3((float)t[0], (float)t[1], (float)t[2]);
+    return vec3_from_d(t);
 }
 
 vec3_t arm_sim_tip_vel_m_s(const arm_sim_t *sim, const arm_params_t *p)
 {
     double v[3];
     kin_terms(p, sim->q_rad, sim->qd_rad_s, NULL, NULL, v, NULL);
-    return vec3((float)v[0], (float)v[1], (float)v[2]);
+    return vec3_from_d(v);
 }
 
 void arm_sim_q_rad(const arm_sim_t *sim, float q_rad[ARGIL_DRIVES])

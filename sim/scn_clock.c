@@ -47,3 +47,8 @@ void scn_clock_wall_while_bus_off(scn_clock_t *c, bool bus_off)
 {
     c->bus_off = bus_off;
 }
+
+bool scn_clock_is_tick(const can_frame_t *f)
+{
+    return f->id == CANOPEN_COB_SYNC && f->len <= 1u;
+}

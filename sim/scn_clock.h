@@ -10,6 +10,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "shared/canopen.h"
+
 #define SCN_CLOCK_TICK_US 1000u        /* one board tick at the nominal 1 kHz */
 #define SCN_CLOCK_SILENCE_US 400000    /* no SYNC this long: follow the wall clock (longer
                                           than a stall of the emulated board: 250 ms seen) */
@@ -24,6 +26,10 @@ typedef struct {
     uint32_t syncs;          /* SYNCs counted */
     uint32_t wall_steps;     /* steps taken on the wall clock */
 } scn_clock_t;
+
+/* A frame that is one board tick on this clock (and in the HIL checker's counts): a SYNC, with
+ * or without CiA 301's counter byte. */
+bool scn_clock_is_tick(const can_frame_t *f);
 
 /* Starts at scenario time 0, wall time wall_us; ticks: SYNC-driven, else wall clock only. */
 void scn_clock_init(scn_clock_t *c, bool ticks, int64_t wall_us);

@@ -49,7 +49,7 @@ static void usage(FILE *to)
 {
     fputs("usage: argil-sim --can IFACE [--gpio-chip CHIP] [--scenario FILE] [--log-dir DIR]\n"
           "                 [--seconds S] [--clock ticks|wall] [--start-when FILE]\n"
-          "                 [--start-timeout S] [--run-prio N] [--help]\n"
+          "                 [--start-timeout S] [--run-prio N] [--arm-substep-us US] [--help]\n"
           "  The simulated arm (3 CiA 402 drives, arm dynamics, GPIO, a scripted hand) on a\n"
           "  SocketCAN interface, one 1 ms step per SYNC of the board (--clock).\n"
           "  --can IFACE       CAN interface the board is on (vcan0, can0)\n"
@@ -71,8 +71,12 @@ static void usage(FILE *to)
           "  --start-timeout S give up when FILE has not appeared after S s (default 60)\n"
           "  --run-prio N      SCHED_FIFO priority N (1-98) once set up, before the first SYNC\n"
           "                    is answered: the arm is its own hardware and answers in time\n"
+          "  --arm-substep-us US  the arm dynamics' integration sub-step, 1 up to the longest\n"
+          "                    that keeps its friction stable (default 50; docs/arm.md): longer\n"
+          "                    sub-steps cost less CPU per SYNC, for a rig that cannot keep up\n"
           "exit: 0 ran to the end, 1 bus/GPIO could not be opened or failed, 2 bad usage,\n"
-          "      3 --start-when's FILE never appeared (the board never got ready)\n",
+          "      3 --start-when's FILE never appeared (the board never got ready), or this\n"
+          "        stand-in had not caught up with the board's SYNCs, within --start-timeout\n",
           to);
 }
 
@@ -406,6 +410,8 @@ int main(int argc, char **argv)
     double seconds = -1.0, start_timeout_s = 60.0;
     int run_prio = 0;
     bool clock_ticks = true;
+    sim_params_t sp;
+    sim_params_default(&sp);
     static const struct option opts[] = {
         {"can", required_argument, NULL, 'c'},      {"gpio-chip", required_argument, NULL, 'g'},
         {"scenario", required_argument, NULL, 's'}, {"log-dir", required_argument, NULL, 'l'},
@@ -413,6 +419,7 @@ int main(int argc, char **argv)
         {"start-when", required_argument, NULL, 'w'},
         {"start-timeout", required_argument, NULL, 'T'},
         {"run-prio", required_argument, NULL, 'P'},
+        {"arm-substep-us", required_argument, NULL, 'S'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     opterr = 0;
@@ -458,6 +465,18 @@ int main(int argc, char **argv)
                 return EXIT_USAGE;
             }
             run_prio = (int)v;
+            break;
+        }
+        case 'S': {
+            char *end = NULL;
+            const uint32_t hi = arm_sim_substep_max_us(&sp.arm);
+            const long v = strtol(optarg, &end, 10);
+            if (end == optarg || *end != '\0' || v < 1 || v > (long)hi) {
+                fprintf(stderr, "argil-sim: --arm-substep-us '%s': expected 1-%u (longer makes "
+                        "the arm's friction overshoot each sub-step; docs/arm.md)\n", optarg, hi);
+                return EXIT_USAGE;
+            }
+            sp.arm.substep_us = (uint32_t)v;
             break;
         }
         case 'h': usage(stdout); return 0;
@@ -523,8 +542,6 @@ int main(int argc, char **argv)
     signal(SIGTERM, on_signal);
 
     static sim_runner_t run;
-    sim_params_t sp;
-    sim_params_default(&sp);
     sim_runner_init(&run, &sp, scn_path ? &scn : NULL, gpio.mode != GPIO_NONE, log_event, NULL);
     const int64_t end_us = seconds > 0.0 ? (int64_t)(seconds * 1e6)
                            : scn_path ? scn.duration_us
@@ -558,6 +575,7 @@ int main(int argc, char **argv)
     }
     const int64_t preroll_t0_us = mono_us();
     bool gate_seen = false;
+    int64_t gate_seen_us = 0; /* when FILE was first seen: the start should follow at once */
     /* How long this stand-in ran behind the board without catching up: the SYNCs it read, one
      * batch after another, before its socket first came back short (not how many were waiting
      * at once; one read holds at most CAN_BATCH_MAX frames, about 8 ticks' worth, so a count per
@@ -595,15 +613,36 @@ int main(int argc, char **argv)
     while (!stop_requested && (preroll || clk.now_us < end_us) && rc == 0) {
         if (preroll && !gate_seen) {
             gate_seen = access(gate, F_OK) == 0;
-            if (!gate_seen && mono_us() - preroll_t0_us > (int64_t)(start_timeout_s * 1e6)) {
+            if (gate_seen)
+                gate_seen_us = mono_us();
+        }
+        if (preroll && mono_us() - preroll_t0_us > (int64_t)(start_timeout_s * 1e6)) {
+            /* One budget for both waits. After the ready file, every read still finding frames
+             * queued means this stand-in answers SYNCs barely faster (or slower) than the board
+             * sends them: without a bound it read on for ever (make hil, 2026-12-03); a bound of
+             * 5 s after the ready file failed 12 of 18 scenarios in a clean-clone run that day,
+             * while runs with the old start rule, whose start came 1-25 s after it, passed. */
+            if (!gate_seen)
                 fprintf(stderr, "argil-sim: %s did not appear within %.0f s: the board never got "
                         "ready to sculpt (%u SYNCs seen), the scenario was not played\n",
                         gate, start_timeout_s, clk.syncs);
-                rc = EXIT_NOT_READY;
-                break;
-            }
+            else
+                fprintf(stderr, "argil-sim: the board got ready %.1f s after the start, but this "
+                        "arm stand-in had not caught up with its SYNCs %.0f s after the start "
+                        "(its socket never ran empty; %u SYNCs seen): the machine is too slow to "
+                        "play the scenario, nothing was played\n",
+                        (double)(gate_seen_us - preroll_t0_us) / 1e6, start_timeout_s, clk.syncs);
+            rc = EXIT_NOT_READY;
+            break;
         }
-        if (clock_ticks) {
+        if (preroll && gate_seen) {
+            /* The board is ready: read again at once, and the first read that finds the socket
+             * empty (this stand-in has caught up) starts the scenario. Waiting for frames here
+             * instead (poll or the wall tick) made "empty" mean 1 ms without a frame on the
+             * bus, which a board sending a SYNC every 1 ms seldom leaves: the start came 12-25 s
+             * of board ticks after the board was ready, or not within --start-timeout (CI,
+             * 2026-12-02/03). */
+        } else if (clock_ticks) {
             /* The board's SYNC starts each step: wait for frames (1 ms at most, so a silent
              * bus still lets the wall clock take over). */
             struct pollfd pfd = {.fd = fd, .events = POLLIN};
@@ -638,7 +677,7 @@ int main(int argc, char **argv)
             break;
         }
         for (uint8_t i = 0; i < rx.n; i++)
-            backlog_syncs += rx.f[i].id == CANOPEN_COB_SYNC && rx.f[i].len <= 1u;
+            backlog_syncs += scn_clock_is_tick(&rx.f[i]);
         if (backlog_syncs > max_backlog_syncs)
             max_backlog_syncs = backlog_syncs;
         if (rx.n < CAN_BATCH_MAX)
@@ -651,12 +690,15 @@ int main(int argc, char **argv)
              * it is one this clock counts. */
             preroll = false;
             snprintf(line, sizeof(line),
-                     "start scenario %s can %s gpio %s preroll_syncs=%u preroll_ms=%lld",
+                     "start scenario %s can %s gpio %s preroll_syncs=%u preroll_ms=%lld "
+                     "catch_up_ms=%.1f",
                      scn_path ? scn.name : "none", iface, gpio_name, clk.syncs,
-                     (long long)((mono_us() - preroll_t0_us) / 1000));
+                     (long long)((mono_us() - preroll_t0_us) / 1000),
+                     (double)(mono_us() - gate_seen_us) / 1000.0);
             write_event(&t_before_read, 0, line);
             fflush(event_log);
             scn_clock_init(&clk, clock_ticks, mono_us());
+            clock_gettime(CLOCK_MONOTONIC, &next); /* the wall tick restarts here too */
             max_backlog_syncs = 0; /* the backlog of the scenario, not of the start-up */
             sim_runner_hold(&run, false);
             run.have_gpio_out = false; /* the next tick logs DRIVE_ENABLE's level */
@@ -670,7 +712,7 @@ int main(int argc, char **argv)
             if (i < rx.n) {
                 const can_frame_t *f = &rx.f[i];
                 (void)can_batch_push(&held, f);
-                if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
+                if (scn_clock_is_tick(f))
                     dt_us = scn_clock_sync(&clk, mono_us());
                 else if (held.n < CAN_BATCH_MAX)
                     continue;

@@ -21,16 +21,7 @@ for opt in bus can drive-heartbeat-ms bus-recovery-ms gpio-chip line-estop line-
 done
 
 # One line on stderr, the expected status, within 5 s.
-expect_error() {
-    want=$1; pattern=$2; shift 2
-    st=0
-    timeout 5 "$bin" "$@" >"$tmp/out" 2>"$tmp/err" || st=$?
-    [ "$st" = 124 ] && fail "'$*' hung"
-    [ "$st" = "$want" ] || fail "'$*' exit $st, want $want: $(cat "$tmp/err")"
-    [ "$(wc -l <"$tmp/err")" = 1 ] || fail "'$*' printed $(wc -l <"$tmp/err") lines: $(cat "$tmp/err")"
-    grep -q -- "$pattern" "$tmp/err" || fail "'$*' said: $(cat "$tmp/err")"
-    echo "ok: $* -> $(cat "$tmp/err")"
-}
+. "$(dirname "$0")/expect_one_line_error.sh"
 expect_error 2 "unknown option '--frobnicate'" --frobnicate 1
 expect_error 2 "rate_hz '3000'" --rate-hz 3000
 expect_error 2 "needs a value" --can
