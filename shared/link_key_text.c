@@ -1,8 +1,10 @@
-/* The link key file's rules and messages (link_key_text.h): the parser with its own hex
- * decoding, the verdict on what fstat says, and a new file's text. */
+/* The link key file's rules and messages (link_key_text.h): the parser, the verdict on what
+ * fstat says, and a new file's text. */
 #include "shared/link_key_text.h"
 
 #include <string.h>
+
+#include "shared/hex_digit.h"
 
 static const char HEX_DIGITS[] = "0123456789abcdef";
 
@@ -46,18 +48,6 @@ static void say_uint(say_t *s, uint32_t v, uint32_t base, unsigned min_digits)
     say(s, digits + n);
 }
 
-/* The value of hex digit c (either case), or -1. */
-static int hex_value(char c)
-{
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F')
-        return c - 'A' + 10;
-    return -1;
-}
-
 /* True for the blanks a line may have around its content. */
 static bool is_blank(char c)
 {
@@ -84,7 +74,7 @@ static void line_content(const char *text, size_t at, size_t end, size_t *a, siz
 static link_key_err_t check_key_line(const char *text, size_t a, size_t b, bool have)
 {
     for (size_t i = a; i < b; i++)
-        if (hex_value(text[i]) < 0)
+        if (hex_digit_value(text[i]) < 0)
             return LINK_KEY_ERR_HEX;
     if (have)
         return LINK_KEY_ERR_EXTRA;
@@ -123,8 +113,8 @@ link_key_err_t link_key_parse(const char *text, size_t len, link_key_t *key, uin
     *line = ln;
     if (rc == LINK_KEY_OK)
         for (size_t i = 0; i < LINK_KEY_BYTES; i++)
-            key->k[i] = (uint8_t)((hex_value(text[key_at + 2u * i]) << 4) |
-                                  hex_value(text[key_at + 2u * i + 1u]));
+            key->k[i] = (uint8_t)((hex_digit_value(text[key_at + 2u * i]) << 4) |
+                                  hex_digit_value(text[key_at + 2u * i + 1u]));
     return rc;
 }
 

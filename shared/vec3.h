@@ -10,6 +10,11 @@ typedef struct {
 } vec3_t;
 
 static inline vec3_t vec3(float x, float y, float z) { vec3_t v = {x, y, z}; return v; }
+/* A double-precision triple rounded to a vec3_t. */
+static inline vec3_t vec3_from_d(const double d[3])
+{
+    return vec3((float)d[0], (float)d[1], (float)d[2]);
+}
 static inline vec3_t vec3_add(vec3_t a, vec3_t b) { return vec3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline vec3_t vec3_sub(vec3_t a, vec3_t b) { return vec3(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline vec3_t vec3_scale(vec3_t a, float s) { return vec3(a.x * s, a.y * s, a.z * s); }

@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "shared/argil_limits.h"
+#include "shared/hex_digit.h"
+#include "sim/scn_clock.h"
 
 #define ERR_FLAG 0x20000000u   /* <linux/can.h> CAN_ERR_FLAG */
 
@@ -35,7 +37,7 @@ hil_err_t hil_obs_push_frame(hil_obs_t *o, int64_t t_us, const can_frame_t *f)
     o->frame[o->n_frames].t_us = t_us;
     o->frame[o->n_frames].f = *f;
     o->n_frames++;
-    if (f->id == CANOPEN_COB_SYNC && f->len <= 1u)
+    if (scn_clock_is_tick(f))
         o->n_syncs++;
     return HIL_OK;
 }
@@ -76,17 +78,6 @@ const char *hil_err_name(hil_err_t e)
     case HIL_ERR_SCENARIO: return "the event log is of another scenario (start scenario NAME)";
     }
     return "?";
-}
-
-static int hex(char c)
-{
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F')
-        return c - 'A' + 10;
-    return -1;
 }
 
 /* "(SECONDS.UUUUUU)" at p; returns the characters used, 0 when malformed. */
@@ -134,7 +125,7 @@ hil_err_t hil_candump_line(const char *line, size_t len, int64_t *t_us, can_fram
     const size_t id0 = i;
     uint32_t id = 0;
     while (i < len && line[i] != '#') {
-        const int h = hex(line[i]);
+        const int h = hex_digit_value(line[i]);
         if (h < 0 || i - id0 >= 8)
             return HIL_ERR_FRAME;
         id = id << 4 | (uint32_t)h;
@@ -155,7 +146,7 @@ hil_err_t hil_candump_line(const char *line, size_t len, int64_t *t_us, can_fram
     if (n % 2u != 0 || n > 16u)
         return HIL_ERR_FRAME; /* also refuses "R" (remote) and "#" (CAN FD) */
     for (size_t k = 0; k < n / 2u; k++) {
-        const int a = hex(line[i + 2 * k]), b = hex(line[i + 2 * k + 1]);
+        const int a = hex_digit_value(line[i + 2 * k]), b = hex_digit_value(line[i + 2 * k + 1]);
         if (a < 0 || b < 0)
             return HIL_ERR_FRAME;
         f->data[k] = (uint8_t)(a << 4 | b);
@@ -396,8 +387,8 @@ static int64_t abs_time(const scenario_t *s, const hil_obs_t *o, int64_t t_us)
             continue;
         uint32_t n = 0;
         for (size_t k = 0; o->mark_sync[m] > 0 && k < o->n_frames; k++)
-            if (o->frame[k].t_us > o->start_us && o->frame[k].f.id == CANOPEN_COB_SYNC &&
-                o->frame[k].f.len <= 1u && ++n == o->mark_sync[m])
+            if (o->frame[k].t_us > o->start_us && is_sync(&o->frame[k]) &&
+                ++n == o->mark_sync[m])
                 return o->frame[k].t_us;
         return o->mark_us[m];
     }
@@ -464,7 +455,7 @@ static int32_t cw_target(uint16_t cw)
 
 static bool is_sync(const hil_frame_t *h)
 {
-    return h->f.id == CANOPEN_COB_SYNC && h->f.len <= 1u;
+    return scn_clock_is_tick(&h->f);
 }
 
 /* Board ticks from t0 to t: SYNC frames in (t0, t]; −1 when the log has none. */

@@ -85,19 +85,21 @@ void sim_device_step(sim_device_t *d, const can_batch_t *from_board, uint32_t gp
     /* 3. the arm, in sub-steps with the hand's grip force re-evaluated each sub-step */
     vec3_t impulse_ns = vec3(0.0f, 0.0f, 0.0f);
     uint32_t done_us = 0;
+    const uint32_t sub_us = arm_sim_substep_us(&d->p.arm);
     while (done_us < dt_us) {
         const uint32_t left = dt_us - done_us;
-        const uint32_t h_us = left < ARM_SIM_SUBSTEP_US ? left : ARM_SIM_SUBSTEP_US;
+        const uint32_t h_us = left < sub_us ? left : sub_us;
+        arm_kin_now_t k; /* once per sub-step: for the hand and for the dynamics */
+        arm_sim_kin_now(&d->arm, &d->p.arm, &k);
         vec3_t f = vec3(0.0f, 0.0f, 0.0f);
         if (d->hand_holding) {
             const float t_s = (float)done_us * 1e-6f;
             const vec3_t target =
                 vec3_add(d->hand_target_m, vec3_scale(d->hand_target_vel_m_s, t_s));
-            f = hand_force_n(&d->p.hand, target, d->hand_target_vel_m_s,
-                             arm_sim_tip_m(&d->arm, &d->p.arm),
-                             arm_sim_tip_vel_m_s(&d->arm, &d->p.arm));
+            f = hand_force_n(&d->p.hand, target, d->hand_target_vel_m_s, vec3_from_d(k.tip_m),
+                             vec3_from_d(k.tip_vel_m_s));
         }
-        arm_sim_step(&d->arm, &d->p.arm, motor_nm, f, h_us);
+        arm_sim_substep_from(&d->arm, &d->p.arm, &k, motor_nm, f, h_us);
         impulse_ns = vec3_add(impulse_ns, vec3_scale(f, (float)h_us * 1e-6f));
         done_us += h_us;
     }

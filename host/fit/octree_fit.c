@@ -620,7 +620,7 @@ static float of_cloud_prior(const void *ctx, const double p[3])
     const of_cloud_prior_t *c = ctx;
     uint32_t i[8];
     float d2[8];
-    const uint32_t got = knn_grid_query(&c->g, vec3((float)p[0], (float)p[1], (float)p[2]), 8, i, d2);
+    const uint32_t got = knn_grid_query(&c->g, vec3_from_d(p), 8, i, d2);
     if (got == 0)
         return 0.0f;
     double s = 0.0;

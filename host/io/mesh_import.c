@@ -383,7 +383,7 @@ argil_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *err
                     any_rgb = true;
                 }
                 uint32_t id;
-                if (mesh_add_vertex(out, vec3((float)d[0], (float)d[1], (float)d[2]),
+                if (mesh_add_vertex(out, vec3_from_d(d),
                                     vec3(0, 0, 0), &id) != ARGIL_OK) {
                     e = ARGIL_ERR_NOMEM;
                     break;

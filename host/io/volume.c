@@ -245,7 +245,7 @@ static argil_err_t nrrd_field(const char *path, size_t ln, const char *key, cons
                    ln);
             return ARGIL_ERR_PARSE;
         }
-        out->origin_m = vec3((float)v[0], (float)v[1], (float)v[2]);
+        out->origin_m = vec3_from_d(v);
     } else if (strcmp(key, "data file") == 0 || strcmp(key, "datafile") == 0) {
         if (strchr(val, '/') != NULL || strchr(val, '%') != NULL || strchr(val, ' ') != NULL ||
             val[0] == '\0' || strcmp(val, "..") == 0 || strcmp(val, ".") == 0) {

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "shared/hex_digit.h"
+
 /* A decimal number lo..hi made of the whole of [s, s+len); false otherwise. */
 static bool parse_dec(const char *s, size_t len, unsigned lo, unsigned hi, unsigned *out)
 {
@@ -27,17 +29,10 @@ static bool parse_hex16(const char *s, size_t len, uint16_t *out)
         return false;
     unsigned v = 0;
     for (size_t i = 0; i < len; i++) {
-        const char c = s[i];
-        unsigned d;
-        if (c >= '0' && c <= '9')
-            d = (unsigned)(c - '0');
-        else if (c >= 'a' && c <= 'f')
-            d = (unsigned)(c - 'a') + 10u;
-        else if (c >= 'A' && c <= 'F')
-            d = (unsigned)(c - 'A') + 10u;
-        else
+        const int d = hex_digit_value(s[i]);
+        if (d < 0)
             return false;
-        v = v * 16u + d;
+        v = v * 16u + (unsigned)d;
     }
     *out = (uint16_t)v;
     return true;

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "shared/canopen.h"
+#include "shared/hex_digit.h"
 
 #define DBC_MESSAGES_MAX 64u
 #define DBC_SIGNALS_MAX 16u
@@ -351,17 +352,6 @@ static inline double dbc_physical(const dbc_signal_t *s, const uint8_t data[8])
     return r * s->factor + s->offset;
 }
 
-static inline int dbc_hex_digit(char ch)
-{
-    if (ch >= '0' && ch <= '9')
-        return ch - '0';
-    if (ch >= 'A' && ch <= 'F')
-        return ch - 'A' + 10;
-    if (ch >= 'a' && ch <= 'f')
-        return ch - 'a' + 10;
-    return -1;
-}
-
 /* One line of `candump -L` / `candump -l` output: "(SECONDS) IFACE ID#DATA", standard ids only
  * (3 hex digits), up to 8 data bytes as hex pairs. */
 static inline dbc_err_t dbc_candump_line(const char *line, size_t len, can_frame_t *f)
@@ -378,7 +368,7 @@ static inline dbc_err_t dbc_candump_line(const char *line, size_t len, can_frame
     uint32_t id = 0;
     int digits = 0;
     while (c.p < c.end && *c.p != '#') {
-        const int h = dbc_hex_digit(*c.p);
+        const int h = hex_digit_value(*c.p);
         if (h < 0)
             return DBC_ERR_SYNTAX;
         if (++digits > 3)
@@ -390,12 +380,12 @@ static inline dbc_err_t dbc_candump_line(const char *line, size_t len, can_frame
         return digits == 0 ? DBC_ERR_SYNTAX : DBC_ERR_RANGE;
     DBC_TRY(dbc_expect(&c, '#'));
     uint8_t n = 0;
-    while (c.p < c.end && dbc_hex_digit(*c.p) >= 0) {
-        if (c.p + 1 >= c.end || dbc_hex_digit(c.p[1]) < 0)
+    while (c.p < c.end && hex_digit_value(*c.p) >= 0) {
+        if (c.p + 1 >= c.end || hex_digit_value(c.p[1]) < 0)
             return DBC_ERR_SYNTAX;
         if (n >= 8u)
             return DBC_ERR_RANGE;
-        f->data[n++] = (uint8_t)(dbc_hex_digit(c.p[0]) * 16 + dbc_hex_digit(c.p[1]));
+        f->data[n++] = (uint8_t)(hex_digit_value(c.p[0]) * 16 + hex_digit_value(c.p[1]));
         c.p += 2;
     }
     while (c.p < c.end && (*c.p == ' ' || *c.p == '\t' || *c.p == '\r' || *c.p == '\n'))
