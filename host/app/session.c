@@ -290,26 +290,24 @@ static argil_err_t load_script(session_t *s, const session_opts_t *opts, char *e
     const argil_err_t rc = script_load(&s->script, opts->script_path, err, err_len);
     if (rc != ARGIL_OK)
         return rc;
-    const int paint_line = script_first_paint_line(&s->script);
-    if (paint_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
-        snprintf(err, err_len, "%s: line %d: 'paint' needs the B-spline model "
-                 "(--global-solve bspline); the springs' material is uniform",
-                 opts->script_path, paint_line);
-        return ARGIL_ERR_ARG;
-    }
-    const int history_line = script_first_history_line(&s->script);
-    if (history_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
-        snprintf(err, err_len, "%s: line %d: 'undo' and 'redo' need the B-spline model "
-                 "(--global-solve bspline); the springs keep no history",
-                 opts->script_path, history_line);
-        return ARGIL_ERR_ARG;
-    }
-    const int host_line = script_first_host_tool_line(&s->script);
-    if (host_line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
-        snprintf(err, err_len, "%s: line %d: host tool settings need the B-spline model "
-                 "(--global-solve bspline); the springs only carve",
-                 opts->script_path, host_line);
-        return ARGIL_ERR_ARG;
+    /* Script lines only the B-spline model can carry out, with why the springs cannot. */
+    static const struct {
+        int (*first_line)(const script_t *s);
+        const char *what;
+        const char *why;
+    } needs_bspline[] = {
+        {script_first_paint_line, "'paint' needs", "the springs' material is uniform"},
+        {script_first_history_line, "'undo' and 'redo' need", "the springs keep no history"},
+        {script_first_host_tool_line, "host tool settings need", "the springs only carve"},
+    };
+    for (size_t i = 0; i < sizeof(needs_bspline) / sizeof(needs_bspline[0]); i++) {
+        const int line = needs_bspline[i].first_line(&s->script);
+        if (line > 0 && opts->global_solve != PEER_SOLVE_BSPLINE) {
+            snprintf(err, err_len, "%s: line %d: %s the B-spline model "
+                     "(--global-solve bspline); %s",
+                     opts->script_path, line, needs_bspline[i].what, needs_bspline[i].why);
+            return ARGIL_ERR_ARG;
+        }
     }
     /* Each refine halves R: R = 2 allows one, R = 4 two; with springs there are no knots. */
     const int allowed = opts->global_solve != PEER_SOLVE_BSPLINE ? 0

@@ -33,4 +33,19 @@ expect_error 1 "$tmp/none.scn: cannot open" sculpt --script "$tmp/none.scn" --ou
 printf 'tool push\nmove 0 0 abc 1\n' >"$tmp/bad.scn"
 expect_error 1 "bad.scn: line 2: 'move' arguments must be numbers" sculpt --script "$tmp/bad.scn" --out "$tmp/o2"
 [ ! -e "$tmp/o2/final.ply" ] || fail "a refused script still wrote files"
+# What only the B-spline model can do, asked of the springs: refused before the session starts,
+# naming the script's line and why, and nothing written.
+springs_refuse() { # name script-text expected-message
+    printf "$2" >"$tmp/$1.scn"
+    expect_error 1 "$1.scn: $3" sculpt --global-solve springs --script "$tmp/$1.scn" --out "$tmp/o-$1"
+    [ ! -e "$tmp/o-$1/final.ply" ] || fail "the refused $1.scn still wrote files"
+}
+springs_refuse paint 'tool push\nmove 0 0 0 0.1\npaint stiffness 2 radius 10\n' \
+    "line 3: 'paint' needs the B-spline model (--global-solve bspline); the springs' material is uniform"
+springs_refuse undo 'tool push\nundo\n' \
+    "line 2: 'undo' and 'redo' need the B-spline model (--global-solve bspline); the springs keep no history"
+springs_refuse mirror 'tool carve\nmirror x\n' \
+    "line 2: host tool settings need the B-spline model (--global-solve bspline); the springs only carve"
+springs_refuse refine 'refine\n' \
+    "line 1: 'refine' needs the B-spline model (--global-solve bspline); the springs have no knots"
 echo "cli: all checks passed"
