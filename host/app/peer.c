@@ -199,6 +199,7 @@ void peer_receive(peer_t *p, const uint8_t *bytes, size_t len)
             if (m->u.hello.role == PROTO_ROLE_BOARD) {
                 /* A (re)started board: resend the tool and a fresh window. */
                 p->board_seen = true;
+                p->board_tick_hz = m->u.hello.tick_hz;
                 p->tool_dirty = true;
                 p->have_current = false;
                 p->sending_active = false;

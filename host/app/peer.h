@@ -88,6 +88,7 @@ typedef struct {
     uint32_t tx_seq;
     uint64_t time_us;
     bool board_seen;
+    uint16_t board_tick_hz;           /* the board's loop rate from its newest HELLO (0: none yet) */
     msg_telemetry_t last_tm;
     bool have_tm;
     msg_rt_stats_t last_rt;           /* the board's newest deadline statistics (RT_STATS) */

@@ -1,9 +1,10 @@
 /* A host for tests/sys/test_board_daemon.sh: talks to a running argil-board over real UDP on
  * 127.0.0.1 with the host's protocol peer, and checks what a person would notice:
  *   1. HELLO → the board answers, takes the window, arms and goes ACTIVE;
- *   2. the host falls silent → FAULT (host lost) 50 board ticks after the board's last host
- *      heartbeat and the force zero, sculpting off, 20 ticks later (50 ms timeout + 20 ms fade
- *      at 1 kHz), counted in the board's own ticks (its telemetry's tick), so the bounds hold on
+ *   2. the host falls silent → FAULT (host lost) 50 ms of board ticks after the board's last
+ *      host heartbeat and the force zero, sculpting off, 20 ms of ticks later (50 + 20 ticks at
+ *      1 kHz, 100 + 40 at 2 kHz: the rate is the one the board's HELLO gives), counted in the
+ *      board's own ticks (its telemetry's tick), so the bounds hold on
  *      a board that ticks slower than 1 kHz (the HIL VM) as on a real one;
  *   3. a new host (new socket) says HELLO → window re-sent, re-arm → ACTIVE again, no restart.
  * Usage: board_udp_client PORT [LINK_TICKS]. LINK_TICKS (default 1): board ticks the link may
@@ -25,6 +26,10 @@
 #include "host/link/link_crypto.h"
 #include "host/link/link_key_file.h"
 #include "host/model/grid.h"
+
+/* The daemon's defaults (firmware/board/board_config.c), which the test runs with. */
+#define HOST_TIMEOUT_MS 50
+#define HOST_FADE_MS 20
 
 typedef struct {
     int fd;
@@ -187,6 +192,10 @@ int main(int argc, char **argv)
         printf("FAIL: board state %u, never ACTIVE\n", h.tm.state);
         return 1;
     }
+    if (h.peer.board_tick_hz == 0) {
+        printf("FAIL: the board's HELLO gave no loop rate\n");
+        return 1;
+    }
     /* ACTIVE for 300 ms more, heartbeats every 5 ms (no solve, which would stall this loop):
      * the window's frames are through and our view of the board's tick is as fresh as the
      * link makes it (right after ACTIVE it lagged 24 ticks in the VM while they queued). */
@@ -231,9 +240,13 @@ int main(int argc, char **argv)
     }
     /* The board took our last heartbeat in no earlier than tick0, and no later than the link's
      * delivery after the tick it was at when we sent it, which our view (tick0) trails by the
-     * link's delivery of telemetry: FAULT (50 ticks of silence) within 50 .. 50 + 2 links + 1. */
-    const int64_t fault_lo = 50, fault_hi = 50 + 2 * link_ticks + 1;
-    const int64_t zero_hi = 70 + 2 * link_ticks + 1;
+     * link's delivery of telemetry: FAULT (50 ms of silence in the board's ticks at the rate its
+     * HELLO gave: 50 at 1 kHz, 100 at 2 kHz) within timeout .. timeout + 2 links + 1, and the
+     * force zero once the 20 ms fade has run too. */
+    const int64_t timeout_ticks = (int64_t)HOST_TIMEOUT_MS * h.peer.board_tick_hz / 1000;
+    const int64_t fade_ticks = (int64_t)HOST_FADE_MS * h.peer.board_tick_hz / 1000;
+    const int64_t fault_lo = timeout_ticks, fault_hi = timeout_ticks + 2 * link_ticks + 1;
+    const int64_t zero_hi = timeout_ticks + fade_ticks + 2 * link_ticks + 1;
     printf("phase 2: host silent: FAULT (host lost) after %lld board ticks (%d ms), force zero "
            "and sculpting off after %lld ticks, peak force after that %.3f N (bounds: FAULT "
            "%lld..%lld, zero by %lld ticks)\n", (long long)fault_tick, fault_ms,
