@@ -492,8 +492,11 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     }
     if (b->stats.ticks > 1u && timed)
         (void)rt_stats_add(&b->rt, in->prev_wake_ns, in->prev_compute_ns, dt_us * 1000u);
-    if (overrun)
+    if (overrun) {
+        if (b->stats.deadline_misses < BOARD_PREEMPTED_KEPT)
+            b->stats.deadline_miss_tick[b->stats.deadline_misses] = b->stats.ticks - 1u;
         b->stats.deadline_misses++;
+    }
     if (timed && in->prev_compute_ns > b->stats.worst_compute_ns)
         b->stats.worst_compute_ns = in->prev_compute_ns;
 

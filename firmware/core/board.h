@@ -91,6 +91,9 @@ typedef struct {
 typedef struct {
     uint32_t ticks;
     uint32_t deadline_misses;          /* timed ticks whose wake-up plus compute passed the period */
+    uint32_t deadline_miss_tick[BOARD_PREEMPTED_KEPT]; /* the first ones' tick numbers: a real
+                                        * overrun repeats at the same tick in a rerun, a machine
+                                        * that held the vCPU does not */
     uint32_t worst_compute_ns;         /* of the timed ticks */
     uint32_t preempted_ticks;          /* ticks not timed (board_in_t.prev_compute_preempted) */
     uint32_t preempted_over_period;    /* … of them charged past the period: a real overrun

@@ -357,6 +357,15 @@ static void print_timing(const sculpt_args_t *sa, const session_summary_t *s)
            s->board_ticks, s->tick_hz);
     printf("  worst tick compute  %.1f us of a %u us period, deadline misses %u\n",
            s->worst_compute_ns / 1000.0, 1000000u / s->tick_hz, s->deadline_misses);
+    if (s->deadline_misses > 0) {
+        /* The session is deterministic: real work past the period misses at the same tick
+         * again when the same script runs again; a machine that held the vCPU does not
+         * (docs/board.md, "Timing a simulated tick"). */
+        printf("  deadline missed     at ticks");
+        for (uint32_t i = 0; i < s->deadline_misses && i < SESSION_PREEMPTED_KEPT; i++)
+            printf(" %u", s->deadline_miss_tick[i]);
+        printf("%s\n", s->deadline_misses > SESSION_PREEMPTED_KEPT ? " …" : "");
+    }
     printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time); "
            "%u ticks preempted by the machine, not timed\n",
            s->median_compute_ns / 1000u, s->p99_compute_ns / 1000u, s->preempted_ticks);

@@ -652,8 +652,10 @@ static void summarise_run(const session_t *s, const lockstep_t *lp, session_summ
     sum->deadline_misses = board.deadline_misses;
     sum->preempted_ticks = board.preempted_ticks;
     sum->preempted_over_period = board.preempted_over_period;
-    for (uint32_t i = 0; i < SESSION_PREEMPTED_KEPT && i < BOARD_PREEMPTED_KEPT; i++)
+    for (uint32_t i = 0; i < SESSION_PREEMPTED_KEPT && i < BOARD_PREEMPTED_KEPT; i++) {
         sum->preempted_over_tick[i] = board.preempted_over_tick[i];
+        sum->deadline_miss_tick[i] = board.deadline_miss_tick[i];
+    }
     sum->rt_stats_frames = s->peer.stats.rt_stats_frames;
     sum->rt = s->peer.last_rt;
     sum->median_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.5) * 1000u;

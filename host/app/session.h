@@ -72,6 +72,7 @@ typedef struct {
     uint32_t median_compute_ns;   /* of every timed tick, 1 µs resolution */
     uint32_t p99_compute_ns;
     uint32_t deadline_misses;
+    uint32_t deadline_miss_tick[SESSION_PREEMPTED_KEPT]; /* the first ones' tick numbers */
     uint32_t preempted_ticks;     /* ticks the machine preempted: not timed, in no figure above */
     uint32_t preempted_over_period; /* … of them charged past the period; the first ones: */
     uint32_t preempted_over_tick[SESSION_PREEMPTED_KEPT];

@@ -78,6 +78,8 @@ void sim_rig_board_stats(const sim_rig_t *r, sim_rig_board_stats_t *out)
 {
     out->ticks = r->board.stats.ticks;
     out->deadline_misses = r->board.stats.deadline_misses;
+    memcpy(out->deadline_miss_tick, r->board.stats.deadline_miss_tick,
+           sizeof(out->deadline_miss_tick));
     out->worst_compute_ns = r->board.stats.worst_compute_ns;
     out->preempted_ticks = r->board.stats.preempted_ticks;
     out->preempted_over_period = r->board.stats.preempted_over_period;

@@ -35,6 +35,7 @@ typedef struct {
 typedef struct {
     uint32_t ticks;
     uint32_t deadline_misses;
+    uint32_t deadline_miss_tick[BOARD_PREEMPTED_KEPT]; /* the first ones' tick numbers */
     uint32_t worst_compute_ns;
     uint32_t preempted_ticks;      /* not timed: the machine took the core (board_stats_t) */
     uint32_t preempted_over_period;

