@@ -171,8 +171,12 @@ typedef struct {
     atomic_uint window_version, impulse_seq; /* the peer's, for the beat thread's heartbeats */
     atomic_uint beats;
     uint64_t rt_max_gap_us;         /* the real-time thread's longest time between two turns of
-                                     * its 1 ms loop (heartbeats, held frames): how long the rig
-                                     * held the host back */
+                                     * its 1 ms loop (heartbeats, held frames) once the board is
+                                     * seen and heartbeats are due: how long the rig held the
+                                     * host back */
+    uint64_t rt_max_gap_at_us;      /* ... when that gap ended, from t0_us */
+    uint64_t rt_first_turn_us;      /* the first turn: it reads every SYNC queued since the
+                                     * socket opened (hundreds under TCG), no heartbeat due yet */
     /* the scenario clock and its steps, run by the real-time thread (shost_rt) */
     const scenario_t *scn;
     const msg_tool_t *tool;         /* the peer's tool, for nan_tool */
@@ -500,10 +504,17 @@ static void *shost_rt(void *arg)
     static proto_msg_t m;
     uint32_t seq = 0x20000000u;
     uint64_t next_beat = mono_us() + 5000u, last_turn = mono_us();
+    uint32_t turns = 0;
+    bool beats_due = false;
     while (!atomic_load(&h->stop)) {
         const uint64_t turn = mono_us();
-        if (turn - last_turn > h->rt_max_gap_us)
+        if (beats_due && turn - last_turn > h->rt_max_gap_us) {
             h->rt_max_gap_us = turn - last_turn;
+            h->rt_max_gap_at_us = turn - h->t0_us;
+        }
+        if (++turns == 2u)
+            h->rt_first_turn_us = turn - last_turn;
+        beats_due = atomic_load(&h->board_seen);
         last_turn = turn;
         if (h->sync_fd >= 0) {
             struct pollfd pfd = {.fd = h->sync_fd, .events = POLLIN};
@@ -864,10 +875,12 @@ static int run_scenario(int fd, const struct sockaddr_in *board, long seconds, c
     atomic_store(&h.stop, true);
     pthread_join(beat, NULL);
     printf("%.6f telemetry=%u frames_sent=%u dropped=%u windows=%u beats=%u solves=%u "
-           "clock %s syncs=%u wall_steps=%u scn_t=%.3f rt_max_gap_ms=%.1f\n",
+           "clock %s syncs=%u wall_steps=%u scn_t=%.3f rt_max_gap_ms=%.1f rt_max_gap_at_s=%.3f "
+           "rt_first_turn_ms=%.1f\n",
            realtime_s(), h.tm_n, h.frames_sent, h.frames_dropped, peer.stats.windows_sent,
            atomic_load(&h.beats), peer.stats.solves, sync_fd >= 0 ? "ticks" : "wall", h.clk.syncs,
-           h.clk.wall_steps, (double)h.clk.now_us / 1e6, (double)h.rt_max_gap_us / 1e3);
+           h.clk.wall_steps, (double)h.clk.now_us / 1e6, (double)h.rt_max_gap_us / 1e3,
+           (double)h.rt_max_gap_at_us / 1e6, (double)h.rt_first_turn_us / 1e3);
     if (h.stranger_fd >= 0) {
         /* what the stranger sent, and the board's refusals as its last RT_STATS counts them */
         const proto_link_counts_t *lc = &peer.last_rt.link;
