@@ -56,8 +56,11 @@ BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/hal_sim_bus.c firmware/ha
                  firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
-BOARD_LDLIBS := -lgpiod -lsodium -lpthread -lm
-# Sources a fuzz target may need beyond LIB_SRC (the board's config parser; no libgpiod).
+# libinih (Debian's libinih-dev): reads argil-board's INI file, under the rules board_config.c
+# adds (docs/board.md, "The configuration file"); every link of board_config.o needs it.
+INI_LDLIBS := -linih
+BOARD_LDLIBS := -lgpiod -lsodium $(INI_LDLIBS) -lpthread -lm
+# Sources a fuzz target may need beyond LIB_SRC (the board's config parser: libinih, no libgpiod).
 FUZZ_EXTRA_SRC := firmware/board/board_config.c firmware/hal/gpio_port.c
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
@@ -233,7 +236,7 @@ $(FZ)/libargil.a: $(FUZZ_LIB_SRC:%.c=$(FZ)/obj/%.o)
 	ar rcs $@ $^
 
 $(FUZZ_TARGETS:%=$(FZ)/%): $(FZ)/%: tests/fuzz/%.c $(FZ)/libargil.a
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer,address,undefined -MMD -MP $< $(FZ)/libargil.a -o $@ $(LDLIBS)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer,address,undefined -MMD -MP $< $(FZ)/libargil.a -o $@ $(LDLIBS) $(INI_LDLIBS)
 
 fuzz-build: $(FUZZ_TARGETS:%=$(FZ)/%)
 

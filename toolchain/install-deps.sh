@@ -9,9 +9,10 @@
 #   With no group: all of them. --check lists what is missing and exits 1 if anything is.
 set -eu
 
-BUILD_PKGS="make gcc libc6-dev libgpiod-dev libusb-1.0-0-dev libsodium-dev" # the build (libgpiod 1.6: argil-board's GPIO lines;
+BUILD_PKGS="make gcc libc6-dev libgpiod-dev libusb-1.0-0-dev libsodium-dev libinih-dev" # the build (libgpiod 1.6: argil-board's GPIO lines;
 # libusb: its header for the host's USB link, the library itself is opened with dlopen at run time;
-# libsodium: the UDP link's keyed BLAKE2b tags and the link key, docs/link.md "Link key")
+# libsodium: the UDP link's keyed BLAKE2b tags and the link key, docs/link.md "Link key";
+# libinih: the reader of argil-board's INI file, docs/board.md "The configuration file")
 TEST_PKGS="libcmocka-dev assimp-utils valgrind" # unit-test runner; a third-party mesh reader; callgrind (+ valgrind/callgrind.h) for make bench
 FUZZ_PKGS="clang libclang-rt-14-dev"     # libFuzzer targets (make fuzz)
 # argil view / argil plot (docs/render.md): headers at build time (GL, EGL, GLFW, stb's PNG
@@ -29,7 +30,7 @@ BENCH_PKGS="valgrind python3-skimage python3-openvdb"
 # into its initramfs; cpio packs it, kmod's depmod/modprobe resolve the module closure;
 # iproute2's ip sets the emulated CAN controllers' bit rate (busybox's ip has no "type can").
 HIL_PKGS="qemu-system-x86 busybox-static cpio kmod can-utils gpiod xz-utils iproute2"
-CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64 libsodium-dev:arm64"
+CROSS_PKGS="gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi libgpiod-dev:arm64 libcmocka-dev:arm64 libsodium-dev:arm64 libinih-dev:arm64"
 
 check_only=0
 groups=""

@@ -1,7 +1,9 @@
-/* argil-board settings: one table, parsed from INI text or the command line. */
+/* argil-board settings: one table, set from the command line or from INI text read by libinih
+ * (Debian's libinih-dev) under argil's rules (board_config.h). */
 #include "board_config.h"
 
 #include <errno.h>
+#include <ini.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -303,81 +305,150 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
     return ARGIL_ERR_ARG;
 }
 
-static const char *trim(char *s)
+/* board_config_parse_ini's state, shared by libinih's line reader and its setting handler:
+ * the text, the line last handed to libinih and argil's first refusal. */
+typedef struct {
+    const char *text;
+    size_t len;
+    size_t at;                  /* the next byte to hand over */
+    uint32_t line;              /* 1-based: the line libinih is reading */
+    board_daemon_cfg_t *cfg;
+    uint32_t refused_line;      /* 0 = nothing refused yet */
+    argil_err_t refused;
+    char *why;
+    size_t why_len;
+} ini_text_t;
+
+static bool is_blank(char ch)
 {
-    while (*s == ' ' || *s == '\t')
+    return ch == ' ' || ch == '\t';
+}
+
+/* Records argil's refusal of the current line; why is the caller's to write. */
+static void ini_refuse(ini_text_t *t, argil_err_t err)
+{
+    t->refused_line = t->line;
+    t->refused = err;
+}
+
+/* True when a line that starts with '[' has more than blanks or a ';' comment after its first
+ * ']' (libinih ignores the rest, so "[limits] max_force_n = 1" would lose its setting). */
+static bool section_has_trailing_text(const char *s, size_t n)
+{
+    const char *close = memchr(s, ']', n);
+    if (n == 0 || s[0] != '[' || close == NULL)
+        return false;
+    const char *p = close + 1;
+    while (p < s + n && (is_blank(*p) || *p == '\r'))
+        p++;
+    return p < s + n && *p != ';';
+}
+
+/* libinih's reader (fgets-like): copies the next line of the text into buf (cap bytes) without
+ * a UTF-8 byte-order mark or leading blanks, so libinih never takes an indented line for a
+ * continuation of the value above. NULL at the end of the text or once argil refused a line. */
+static char *ini_text_reader(char *buf, int cap, void *stream)
+{
+    ini_text_t *t = stream;
+    if (t->refused_line != 0 || t->at >= t->len)
+        return NULL;
+    t->line++;
+    const char *s = t->text + t->at;
+    const char *nl = memchr(s, '\n', t->len - t->at);
+    size_t n = nl != NULL ? (size_t)(nl - s) : t->len - t->at;
+    t->at += nl != NULL ? n + 1u : n;
+    /* libinih's documented limit: its buffer holds the line, "\r\n" and a NUL */
+    const size_t max = cap > 3 ? (size_t)cap - 3u : 0u;
+    const size_t shown = n > 0 && s[n - 1u] == '\r' ? n - 1u : n;
+    if (memchr(s, '\0', n) != NULL) {
+        ini_refuse(t, ARGIL_ERR_PARSE);
+        snprintf(t->why, t->why_len, "NUL byte in the file");
+        return NULL;
+    }
+    if (shown > max) {
+        ini_refuse(t, ARGIL_ERR_PARSE);
+        snprintf(t->why, t->why_len, "line longer than %zu characters", max);
+        return NULL;
+    }
+    if (t->line == 1 && n >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) {
+        s += 3;
+        n -= 3;
+    }
+    while (n > 0 && is_blank(*s)) {
         s++;
-    size_t n = strlen(s);
-    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r'))
-        s[--n] = '\0';
-    return s;
+        n--;
+    }
+    if (section_has_trailing_text(s, n)) {
+        ini_refuse(t, ARGIL_ERR_PARSE);
+        snprintf(t->why, t->why_len, "text after the section's ']': a setting goes on a line "
+                 "of its own");
+        return NULL;
+    }
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    return buf;
+}
+
+/* libinih's handler: applies one key = value; returns nonzero to read on. */
+static int ini_text_setting(void *user, const char *section, const char *key, const char *value)
+{
+    ini_text_t *t = user;
+    if (section[0] == '\0') {
+        ini_refuse(t, ARGIL_ERR_PARSE);
+        snprintf(t->why, t->why_len, "'%s' is outside any [section]", key);
+        return 0;
+    }
+    const argil_err_t rc = board_config_set(t->cfg, section, key, value, t->why, t->why_len);
+    if (rc == ARGIL_OK)
+        return 1;
+    ini_refuse(t, rc);
+    const size_t n = strnlen(t->why, t->why_len);
+    if (strchr(value, '#') != NULL && n < t->why_len)
+        snprintf(t->why + n, t->why_len - n, "; inline comments start with ';'");
+    return 0;
+}
+
+/* True when line (1-based) of the text starts with '[' after its blanks (and, on line 1, a
+ * UTF-8 byte-order mark, which libinih skips). */
+static bool line_starts_section(const char *text, size_t len, uint32_t line)
+{
+    size_t at = 0;
+    for (uint32_t l = 1; l < line && at < len; at++)
+        if (text[at] == '\n')
+            l++;
+    if (line == 1 && len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        at = 3;
+    while (at < len && is_blank(text[at]))
+        at++;
+    return at < len && text[at] == '[';
 }
 
 argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
                                    uint32_t *line, char *why, size_t why_len)
 {
-    char section[32] = "";
-    char buf[256];
-    size_t at = 0;
-    *line = 0;
-    while (at < len) {
-        (*line)++;
-        size_t end = at;
-        while (end < len && text[end] != '\n')
-            end++;
-        const size_t n = end - at;
-        if (n >= sizeof(buf)) {
-            snprintf(why, why_len, "line longer than %zu characters", sizeof(buf) - 1u);
-            return ARGIL_ERR_PARSE;
-        }
-        memcpy(buf, text + at, n);
-        buf[n] = '\0';
-        at = end < len ? end + 1 : end;
-        if (memchr(buf, '\0', n) != NULL) {
-            snprintf(why, why_len, "NUL byte in the file");
-            return ARGIL_ERR_PARSE;
-        }
-        char *s = (char *)trim(buf);
-        if (*s == '\0' || *s == ';' || *s == '#')
-            continue;
-        if (*s == '[') {
-            char *close = strchr(s, ']');
-            if (close == NULL || trim(close + 1)[0] != '\0') {
-                snprintf(why, why_len, "expected [section]");
-                return ARGIL_ERR_PARSE;
-            }
-            *close = '\0';
-            const char *name = trim(s + 1);
-            if (name[0] == '\0' || strlen(name) >= sizeof(section)) {
-                snprintf(why, why_len, "empty or overlong section name");
-                return ARGIL_ERR_PARSE;
-            }
-            copy_str(section, sizeof(section), name);
-            continue;
-        }
-        char *eq = strchr(s, '=');
-        if (eq == NULL) {
-            snprintf(why, why_len, "expected key = value or [section]");
-            return ARGIL_ERR_PARSE;
-        }
-        *eq = '\0';
-        const char *key = trim(s);
-        char *value = eq + 1;
-        /* An inline comment starts at ';' or '#' after whitespace. */
-        for (char *p = value; *p; p++)
-            if ((*p == ';' || *p == '#') && (p == value || p[-1] == ' ' || p[-1] == '\t')) {
-                *p = '\0';
-                break;
-            }
-        const char *val = trim(value);
-        if (section[0] == '\0') {
-            snprintf(why, why_len, "'%s' is outside any [section]", key);
-            return ARGIL_ERR_PARSE;
-        }
-        const argil_err_t rc = board_config_set(c, section, key, val, why, why_len);
-        if (rc != ARGIL_OK)
-            return rc;
+    board_daemon_cfg_t parsed = *c;
+    ini_text_t t = {.text = text, .len = len, .cfg = &parsed, .why = why, .why_len = why_len};
+    /* libinih returns the first line it refused (its own or the handler's) and reads on past
+     * its own refusals; argil's reader stops at the first of argil's. */
+    const int first = ini_parse_stream(ini_text_reader, &t, ini_text_setting, &t);
+    if (first > 0 && (t.refused_line == 0 || (uint32_t)first < t.refused_line)) {
+        /* libinih's two refusals: a '[' line without its ']', a line without '=' or ':' */
+        *line = (uint32_t)first;
+        snprintf(why, why_len, "%s", line_starts_section(text, len, *line)
+                                         ? "expected [section]: no closing ']'"
+                                         : "expected key = value or [section]");
+        return ARGIL_ERR_PARSE;
     }
+    if (t.refused_line != 0) {
+        *line = t.refused_line;
+        return t.refused;
+    }
+    *line = t.line;
+    if (first != 0) {
+        snprintf(why, why_len, "libinih could not read the text (%d)", first);
+        return ARGIL_ERR_PARSE;
+    }
+    *c = parsed;
     return ARGIL_OK;
 }
 

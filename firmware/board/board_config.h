@@ -61,8 +61,12 @@ void board_config_default(board_daemon_cfg_t *c);
 argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
                              const char *value, char *why, size_t why_len);
 
-/* Applies INI text: [section] headers, key = value, ';' or '#' comments, blank lines.
- * On error *line is the 1-based line and why says what is wrong. */
+/* Applies INI text of len bytes (no NUL needed) through libinih: [section] headers, key = value
+ * or key: value, ';' or '#' comments at the start of a line, ';' after a blank inline, blank
+ * lines, a UTF-8 byte-order mark. Refused besides: a NUL byte, a line over libinih's 197
+ * characters, text after a section's ']', a key outside any [section], an unknown setting, a
+ * bad value; an indented line is a line of its own, never a continuation. On error *line is
+ * the 1-based line, why says what is wrong and *c is unchanged. */
 argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
                                    uint32_t *line, char *why, size_t why_len);
 

@@ -663,6 +663,110 @@ static void test_config_ini_and_refusals(void **st)
     }
 }
 
+/* libinih reads the file; argil's rules on top of it: every line stands alone (an indented line
+ * is no continuation), a line has a length limit and never a NUL, nothing follows a section's
+ * ']', only len bytes are read, and a refused file leaves the settings as they were. */
+static void test_config_ini_rules_over_libinih(void **st)
+{
+    (void)st;
+    board_daemon_cfg_t c;
+    char why[200];
+    uint32_t line = 0;
+
+    /* indented keys are settings of their own (libinih alone reads "cpu = 1" as rate_hz's
+     * second line) */
+    board_config_default(&c);
+    const char *indented = "[loop]\n  rate_hz = 2000\n\tcpu = 1\n";
+    assert_int_equal(board_config_parse_ini(&c, indented, strlen(indented), &line, why,
+                                            sizeof(why)), ARGIL_OK);
+    assert_int_equal(c.rate_hz, 2000);
+    assert_int_equal(c.cpu, 1);
+
+    /* what libinih accepts beyond the old reader: a UTF-8 BOM, key: value, ';' after ']' */
+    board_config_default(&c);
+    const char *forms = "\xEF\xBB\xBF[loop] ; the fast loop\r\nrate_hz: 4000\r\n"
+                        "[can]\r\ninterface = can1 ; inline\r\n";
+    assert_int_equal(board_config_parse_ini(&c, forms, strlen(forms), &line, why, sizeof(why)),
+                     ARGIL_OK);
+    assert_int_equal(c.rate_hz, 4000);
+    assert_string_equal(c.can_if, "can1");
+
+    /* the text is len bytes, not a C string: what lies past len is not read */
+    board_config_default(&c);
+    const char *cut = "[loop]\nrate_hz = 2000\ncpu = 5";
+    assert_int_equal(board_config_parse_ini(&c, cut, strlen("[loop]\nrate_hz = 2000\n"), &line,
+                                            why, sizeof(why)), ARGIL_OK);
+    assert_int_equal(c.rate_hz, 2000);
+    assert_int_equal(c.cpu, -1);
+
+    /* a NUL byte is refused, not taken as the end of its line ("2000" alone would pass) */
+    board_config_default(&c);
+    const char nul[] = "[loop]\ncpu = 1\nrate_hz = 2000" "\0" "x\n";
+    assert_int_equal(board_config_parse_ini(&c, nul, sizeof(nul) - 1u, &line, why, sizeof(why)),
+                     ARGIL_ERR_PARSE);
+    assert_int_equal(line, 3);
+    assert_non_null(strstr(why, "NUL byte"));
+
+    /* 197 characters fit libinih's 200-byte line with "\r\n" and its NUL; one more is refused
+     * at its own line number, never split into two lines */
+    char text[400];
+    for (size_t n = 197; n <= 198; n++) {
+        const size_t head = strlen("[loop]\n");
+        memcpy(text, "[loop]\n", head);
+        memset(text + head, 'x', n);
+        text[head] = ';';
+        memcpy(text + head + n, "\r\nrate_hz = 2000\n", strlen("\r\nrate_hz = 2000\n") + 1u);
+        board_config_default(&c);
+        why[0] = '\0';
+        const argil_err_t rc = board_config_parse_ini(&c, text, strlen(text), &line, why,
+                                                      sizeof(why));
+        if (n == 197) {
+            assert_int_equal(rc, ARGIL_OK);
+            assert_int_equal(c.rate_hz, 2000);
+        } else {
+            assert_int_equal(rc, ARGIL_ERR_PARSE);
+            assert_int_equal(line, 2);
+            assert_non_null(strstr(why, "longer than 197 characters"));
+        }
+    }
+
+    /* a refused file changes nothing, though libinih reads on past its own refusals */
+    board_config_default(&c);
+    const char *late = "[loop]\nrate_hz = 2000\n[can\ncpu = 3\n";
+    assert_int_equal(board_config_parse_ini(&c, late, strlen(late), &line, why, sizeof(why)),
+                     ARGIL_ERR_PARSE);
+    assert_int_equal(line, 3);
+    assert_int_equal(c.rate_hz, 1000);
+    assert_int_equal(c.cpu, -1);
+
+    static const struct { const char *text; uint32_t line; const char *says; } bad[] = {
+        /* a setting on its section's line would otherwise be dropped without a word */
+        {"[limits] max_force_n = 1\n", 1, "after the section's ']'"},
+        {"[loop]] ; x\n", 1, "after the section's ']'"},
+        {"\xEF\xBB\xBF [limits] max_force_n = 1\n", 1, "after the section's ']'"},
+        /* '#' is a comment at the start of a line only; the value says why it failed */
+        {"[loop]\nrate_hz = 2000 # fast\n", 2, "inline comments start with ';'"},
+        {"[]\nrate_hz = 2000\n", 2, "outside any [section]"},
+        {"[ loop ]\nrate_hz = 2000\n", 2, "unknown setting ' loop .rate_hz'"},
+        {"[a_section_name_longer_than_the_49_characters_libinih_keeps]\nk = 1\n", 2,
+         "unknown setting"},
+        /* the first refusal is the one reported, libinih's or argil's */
+        {"[loop\n[loop]\nbogus = 1\n", 1, "expected [section]"},
+        {"[loop]\nrate_hz\nbogus = 1\n", 2, "expected key = value"},
+        {"\xEF\xBB\xBF[loop\n", 1, "expected [section]"},
+        {"[loop]\n\t[link\n", 2, "expected [section]"},
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        board_config_default(&c);
+        why[0] = '\0';
+        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
+                                                    why, sizeof(why)), ARGIL_OK);
+        if (line != bad[i].line || strstr(why, bad[i].says) == NULL)
+            fail_msg("case %zu: line %u '%s', expected line %u saying '%s'", i, line, why,
+                     bad[i].line, bad[i].says);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -678,6 +782,7 @@ int main(void)
         cmocka_unit_test(test_ffs_descriptors),
         cmocka_unit_test(test_spsc_ring_wraps_and_refuses),
         cmocka_unit_test(test_config_ini_and_refusals),
+        cmocka_unit_test(test_config_ini_rules_over_libinih),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
