@@ -506,6 +506,7 @@ static void *shost_rt(void *arg)
     uint64_t next_beat = mono_us() + 5000u, last_turn = mono_us();
     uint32_t turns = 0;
     bool beats_due = false;
+    uint64_t last_beat_us = 0;
     while (!atomic_load(&h->stop)) {
         const uint64_t turn = mono_us();
         if (beats_due && turn - last_turn > h->rt_max_gap_us) {
@@ -566,6 +567,13 @@ static void *shost_rt(void *arg)
         if (proto_encode(&m, seq++, buf, sizeof(buf), &len) == PROTO_OK) {
             (void)shost_send(h, buf, len);
             atomic_fetch_add(&h->beats, 1u);
+            /* A gap of 4 heartbeats or more is printed when it ends, stamped like the board's
+             * log, so a "host heartbeat lost" can be matched against what this host sent. */
+            const uint64_t sent = mono_us();
+            if (last_beat_us > 0 && sent - last_beat_us >= 20000u)
+                printf("%.6f heartbeat gap %.1f ms\n", realtime_s(),
+                       (double)(sent - last_beat_us) / 1e3);
+            last_beat_us = sent;
         }
     }
     return NULL;
