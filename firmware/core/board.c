@@ -467,6 +467,14 @@ static vec3_t shape_force(board_t *b, const haptics_out_t *h, float scale, float
     return f;
 }
 
+/* Counts one more tick and keeps its number among the first BOARD_PREEMPTED_KEPT. */
+static void keep_tick(uint32_t kept[BOARD_PREEMPTED_KEPT], uint32_t *count, uint32_t tick)
+{
+    if (*count < BOARD_PREEMPTED_KEPT)
+        kept[*count] = tick;
+    (*count)++;
+}
+
 void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
 {
     const uint32_t dt_us = b->cfg.tick_us;
@@ -485,18 +493,14 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     if (!timed) {
         b->stats.preempted_ticks++;
         if (prev_used_ns > dt_us * 1000u) {
-            if (b->stats.preempted_over_period < BOARD_PREEMPTED_KEPT)
-                b->stats.preempted_over_tick[b->stats.preempted_over_period] = b->stats.ticks - 1u;
-            b->stats.preempted_over_period++;
+            keep_tick(b->stats.preempted_over_tick, &b->stats.preempted_over_period,
+                      b->stats.ticks - 1u);
         }
     }
     if (b->stats.ticks > 1u && timed)
         (void)rt_stats_add(&b->rt, in->prev_wake_ns, in->prev_compute_ns, dt_us * 1000u);
-    if (overrun) {
-        if (b->stats.deadline_misses < BOARD_PREEMPTED_KEPT)
-            b->stats.deadline_miss_tick[b->stats.deadline_misses] = b->stats.ticks - 1u;
-        b->stats.deadline_misses++;
-    }
+    if (overrun)
+        keep_tick(b->stats.deadline_miss_tick, &b->stats.deadline_misses, b->stats.ticks - 1u);
     if (timed && in->prev_compute_ns > b->stats.worst_compute_ns)
         b->stats.worst_compute_ns = in->prev_compute_ns;
 

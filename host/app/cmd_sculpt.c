@@ -346,6 +346,14 @@ static argil_err_t run_sculpt_session(sculpt_args_t *sa, bool live, session_summ
 }
 
 /* The summary's lines on time: ticks, their compute time, the board's RT reports, the solve. */
+/* " 12 345 …\n": the tick numbers the summary kept of count ticks (the first ones). */
+static void print_ticks(const uint32_t *kept, uint32_t count)
+{
+    for (uint32_t i = 0; i < count && i < SESSION_PREEMPTED_KEPT; i++)
+        printf(" %u", kept[i]);
+    printf("%s\n", count > SESSION_PREEMPTED_KEPT ? " …" : "");
+}
+
 static void print_timing(const sculpt_args_t *sa, const session_summary_t *s)
 {
     const session_opts_t *o = &sa->o;
@@ -362,9 +370,7 @@ static void print_timing(const sculpt_args_t *sa, const session_summary_t *s)
          * again when the same script runs again; a machine that held the vCPU does not
          * (docs/board.md, "Timing a simulated tick"). */
         printf("  deadline missed     at ticks");
-        for (uint32_t i = 0; i < s->deadline_misses && i < SESSION_PREEMPTED_KEPT; i++)
-            printf(" %u", s->deadline_miss_tick[i]);
-        printf("%s\n", s->deadline_misses > SESSION_PREEMPTED_KEPT ? " …" : "");
+        print_ticks(s->deadline_miss_tick, s->deadline_misses);
     }
     printf("  tick compute        median %u us, 99th percentile %u us (thread CPU time); "
            "%u ticks preempted by the machine, not timed\n",
@@ -373,9 +379,7 @@ static void print_timing(const sculpt_args_t *sa, const session_summary_t *s)
         /* Not misses, but not hidden: a real overrun is past the period again at the same
          * tick when the same script runs again (docs/board.md, "Timing a simulated tick"). */
         printf("  preempted, charged  %u past the period, at ticks", s->preempted_over_period);
-        for (uint32_t i = 0; i < s->preempted_over_period && i < SESSION_PREEMPTED_KEPT; i++)
-            printf(" %u", s->preempted_over_tick[i]);
-        printf("%s\n", s->preempted_over_period > SESSION_PREEMPTED_KEPT ? " …" : "");
+        print_ticks(s->preempted_over_tick, s->preempted_over_period);
     }
     if (s->rt_stats_frames > 0)
         printf("  board RT stats      %u reports, last over %u ticks: wake-up latency "

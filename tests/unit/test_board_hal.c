@@ -617,6 +617,25 @@ static void test_udp_link_with_a_key(void **st)
     link_udp_close(&u);
 }
 
+typedef struct { const char *text; uint32_t line; const char *says; } ini_refusal_t;
+
+/* Each text is refused, at its line, with words that say why. */
+static void expect_ini_refusals(const ini_refusal_t *bad, size_t n)
+{
+    board_daemon_cfg_t c;
+    uint32_t line = 0;
+    char why[200];
+    for (size_t i = 0; i < n; i++) {
+        board_config_default(&c);
+        why[0] = '\0';
+        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
+                                                    why, sizeof(why)), ARGIL_OK);
+        if (line != bad[i].line || strstr(why, bad[i].says) == NULL)
+            fail_msg("case %zu: line %u '%s', expected line %u saying '%s'", i, line, why,
+                     bad[i].line, bad[i].says);
+    }
+}
+
 static void test_config_ini_and_refusals(void **st)
 {
     (void)st;
@@ -636,7 +655,7 @@ static void test_config_ini_and_refusals(void **st)
     assert_int_equal(c.rate_hz, 4000);
     assert_int_equal(c.link_rt_priority, 79);
     assert_float_equal(c.model_offset_m[1], -0.02f, 1e-7f);
-    static const struct { const char *text; uint32_t line; const char *says; } bad[] = {
+    static const ini_refusal_t bad[] = {
         {"x = 1\n", 1, "outside any [section]"},
         {"[loop\n", 1, "expected [section]"},
         {"[loop]\nrate_hz\n", 2, "expected key = value"},
@@ -652,15 +671,7 @@ static void test_config_ini_and_refusals(void **st)
         {"[link]\ninsecure = maybe\n", 2, "expected yes or no"},
         {"[link]\nkey =\n", 2, "link.key"},
     };
-    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
-        board_config_default(&c);
-        why[0] = '\0';
-        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
-                                                    why, sizeof(why)), ARGIL_OK);
-        assert_int_equal(line, bad[i].line);
-        if (strstr(why, bad[i].says) == NULL)
-            fail_msg("case %zu: '%s' does not say '%s'", i, why, bad[i].says);
-    }
+    expect_ini_refusals(bad, sizeof(bad) / sizeof(bad[0]));
 }
 
 /* libinih reads the file; argil's rules on top of it: every line stands alone (an indented line
@@ -739,7 +750,7 @@ static void test_config_ini_rules_over_libinih(void **st)
     assert_int_equal(c.rate_hz, 1000);
     assert_int_equal(c.cpu, -1);
 
-    static const struct { const char *text; uint32_t line; const char *says; } bad[] = {
+    static const ini_refusal_t bad[] = {
         /* a setting on its section's line would otherwise be dropped without a word */
         {"[limits] max_force_n = 1\n", 1, "after the section's ']'"},
         {"[loop]] ; x\n", 1, "after the section's ']'"},
@@ -756,15 +767,7 @@ static void test_config_ini_rules_over_libinih(void **st)
         {"\xEF\xBB\xBF[loop\n", 1, "expected [section]"},
         {"[loop]\n\t[link\n", 2, "expected [section]"},
     };
-    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
-        board_config_default(&c);
-        why[0] = '\0';
-        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
-                                                    why, sizeof(why)), ARGIL_OK);
-        if (line != bad[i].line || strstr(why, bad[i].says) == NULL)
-            fail_msg("case %zu: line %u '%s', expected line %u saying '%s'", i, line, why,
-                     bad[i].line, bad[i].says);
-    }
+    expect_ini_refusals(bad, sizeof(bad) / sizeof(bad[0]));
 }
 
 int main(void)
