@@ -1,6 +1,10 @@
 /* Arm dynamics for the simulated device. The arm is counterbalanced (no gravity); its moving
- * mass is lumped at the stylus tip, so with tip acceleration a = J q̈ + J̇ q̇ Lagrange gives
- *   (Jᵀ m J + R) q̈ = τ_motor·gear + Jᵀ F_ext − τ_friction − Jᵀ m J̇ q̇,   R = diag(I_rotor gear²).
+ * mass is lumped at the stylus tip, so with tip acceleration a = J q̈ + J̇ q̇ Lagrange gives, for
+ * rigid joints (motor and link one body),
+ *   (Jᵀ m J + L + R) q̈ = τ·gear + Jᵀ F_ext − τ_friction − Jᵀ m J̇ q̇,   R = diag(I_rotor gear²),
+ * L = diag(link inertia). A compliant joint splits its rotor off behind the cable spring
+ * τ_c = k (qm − q) + d (q̇m − q̇): the link row takes τ_c in place of the motor torque, friction
+ * and R, and the rotor I_rotor gear² q̈m = τ·gear − τ_c − τ_friction(q̇m) (docs/arm.md).
  * Double precision inside: this is the "physics", the board sees it only through encoders. */
 #include "arm_sim.h"
 
@@ -16,9 +20,36 @@ void arm_params_default(arm_params_t *p)
         p->viscous_nm_s_per_rad[j] = 0.002f;
         p->coulomb_nm[j] = 0.005f;
         p->peak_torque_nm[j] = p->desc.rated_torque_nm[j] * (float)ARM_PEAK_TORQUE_PERMILLE / 1000.0f;
+        p->link_inertia_kg_m2[j] = 0.0f;
+        p->cable_compliance_rad_per_nm[j] = 0.0f;
+        p->cable_damping_nm_s_per_rad[j] = 0.0f;
+        p->current_loop_hz[j] = 0.0f;
+        p->torque_dac_bits[j] = 0u;
     }
     p->coulomb_smooth_rad_s = 0.01f;
     p->substep_us = ARM_SIM_SUBSTEP_US;
+}
+
+void arm_params_premium(arm_params_t *p)
+{
+    /* each value's source and its tip equivalent at home: docs/arm.md, "Premium profile" */
+    static const float link_inertia_kg_m2[ARGIL_DRIVES] = {5e-4f, 5e-5f, 5e-5f};
+    arm_params_default(p);
+    p->tip_mass_kg = 0.050f;
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        p->viscous_nm_s_per_rad[j] = 1e-4f;
+        p->coulomb_nm[j] = 0.003f;
+        p->link_inertia_kg_m2[j] = link_inertia_kg_m2[j];
+        p->cable_compliance_rad_per_nm[j] = 1.0f / 800.0f;
+        p->cable_damping_nm_s_per_rad[j] = 0.017f;
+        p->current_loop_hz[j] = 1000.0f;
+        p->torque_dac_bits[j] = 12u;
+    }
+}
+
+bool arm_sim_joint_compliant(const arm_params_t *p, int j)
+{
+    return p->cable_compliance_rad_per_nm[j] > 0.0f;
 }
 
 /* The width ε of the Coulomb friction's tanh smoothing (1e-3 rad/s when none is set). */
@@ -27,19 +58,49 @@ static double friction_width_rad_s(const arm_params_t *p)
     return p->coulomb_smooth_rad_s > 0.0f ? (double)p->coulomb_smooth_rad_s : 1e-3;
 }
 
+/* The inertia the rotor of joint j brings, joint side: I_rotor gear². */
+static double rotor_at_joint(const arm_params_t *p, int j)
+{
+    const double g = p->desc.gear_ratio[j];
+    return (double)p->rotor_inertia_kg_m2[j] * g * g;
+}
+
+/* The smallest diagonal term M adds to m JᵀJ (link inertia, plus the rotor on a rigid joint):
+ * a lower bound on the link side's smallest eigenvalue in every pose. */
+static double link_side_floor_kg_m2(const arm_params_t *p)
+{
+    double lo = INFINITY;
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        double i = (double)p->link_inertia_kg_m2[j];
+        if (!arm_sim_joint_compliant(p, j))
+            i += rotor_at_joint(p, j);
+        lo = fmin(lo, i);
+    }
+    return lo;
+}
+
 uint32_t arm_sim_substep_max_us(const arm_params_t *p)
 {
     const double eps = friction_width_rad_s(p);
-    double rate = 0.0; /* the largest (c/ε + b) / I_min over the joints, 1/s */
+    const double link_floor = link_side_floor_kg_m2(p);
+    double rate = 0.0; /* the largest s / I or ω / ARM_SIM_OMEGA_H_MAX over the joints, 1/s */
     for (int j = 0; j < ARGIL_DRIVES; j++) {
-        const double g = p->desc.gear_ratio[j];
-        const double inertia = (double)p->rotor_inertia_kg_m2[j] * g * g;
+        const bool compliant = arm_sim_joint_compliant(p, j);
+        /* the body friction acts on: the rotor alone, or the rigid joint's whole floor */
+        const double inertia = compliant ? rotor_at_joint(p, j)
+                                         : rotor_at_joint(p, j) + (double)p->link_inertia_kg_m2[j];
+        const double damper = compliant ? fabs((double)p->cable_damping_nm_s_per_rad[j]) : 0.0;
         const double slope = fabs((double)p->coulomb_nm[j]) / eps +
-                             fabs((double)p->viscous_nm_s_per_rad[j]);
-        if (!(inertia > 0.0))
+                             fabs((double)p->viscous_nm_s_per_rad[j]) + damper;
+        if (!(inertia > 0.0) || (compliant && !(link_floor > 0.0)))
             return 1u;
-        if (slope / inertia > rate)
-            rate = slope / inertia;
+        rate = fmax(rate, slope / inertia);
+        if (compliant) {
+            const double k = 1.0 / (double)p->cable_compliance_rad_per_nm[j];
+            const double inv = 1.0 / inertia + 1.0 / link_floor;
+            rate = fmax(rate, damper / link_floor);
+            rate = fmax(rate, sqrt(k * inv) / ARM_SIM_OMEGA_H_MAX);
+        }
     }
     if (!(rate > 1.0)) /* 1 s or more: no sub-step this long is asked for */
         return 1000000u;
@@ -95,7 +156,7 @@ static void kin_terms(const arm_params_t *p, const double q[ARGIL_DRIVES],
     }
 }
 
-/* M = Jᵀ m J + R from a Jacobian. */
+/* The link side's M = Jᵀ m J + L (+ R on rigid joints) from a Jacobian. */
 static void mass_from_jacobian(const arm_params_t *p, const double j[3][ARGIL_DRIVES],
                                double m[ARGIL_DRIVES][ARGIL_DRIVES])
 {
@@ -106,8 +167,9 @@ static void mass_from_jacobian(const arm_params_t *p, const double j[3][ARGIL_DR
                 s += j[i][r] * j[i][c];
             m[r][c] = (double)p->tip_mass_kg * s;
         }
-        const double g = p->desc.gear_ratio[r];
-        m[r][r] += (double)p->rotor_inertia_kg_m2[r] * g * g;
+        if (!arm_sim_joint_compliant(p, r))
+            m[r][r] += rotor_at_joint(p, r);
+        m[r][r] += (double)p->link_inertia_kg_m2[r];
     }
 }
 
@@ -163,6 +225,9 @@ void arm_sim_init(arm_sim_t *sim, const arm_params_t *p, const float q0_rad[ARGI
         sim->q_rad[j] = q;
         sim->qd_rad_s[j] = 0.0;
         sim->qdd_rad_s2[j] = 0.0;
+        sim->qm_rad[j] = q; /* the cable unloaded */
+        sim->qmd_rad_s[j] = 0.0;
+        sim->torque_nm[j] = 0.0;
     }
 }
 
@@ -171,54 +236,100 @@ void arm_sim_kin_now(const arm_sim_t *sim, const arm_params_t *p, arm_kin_now_t 
     kin_terms(p, sim->q_rad, sim->qd_rad_s, k->jac, k->tip_m, k->tip_vel_m_s, k->acc_bias_m_s2);
 }
 
+/* The motor torque the current loop of joint j applies over the next h seconds (its mean, so the
+ * impulse is exact for a command held over the sub-step), moving the loop's state to the
+ * sub-step's end: τ' = (cmd − τ) / T_c, T_c = 1 / (2π f_c). No lag when f_c is not positive. */
+static double current_loop(arm_sim_t *sim, const arm_params_t *p, int j, double cmd_nm, double h)
+{
+    const double f_hz = p->current_loop_hz[j];
+    if (!(f_hz > 0.0)) {
+        sim->torque_nm[j] = cmd_nm;
+        return cmd_nm;
+    }
+    const double tc = 1.0 / (2.0 * M_PI * f_hz);
+    const double decay = exp(-h / tc);
+    const double gap = sim->torque_nm[j] - cmd_nm;
+    sim->torque_nm[j] = cmd_nm + gap * decay;
+    return cmd_nm + gap * (tc / h) * (1.0 - decay);
+}
+
+/* The cable torque k (qm − q) + d (q̇m − q̇) on compliant joint j, joint side (motor → link). */
+static double cable_torque_nm(const arm_sim_t *sim, const arm_params_t *p, int j)
+{
+    const double k = 1.0 / (double)p->cable_compliance_rad_per_nm[j];
+    return k * (sim->qm_rad[j] - sim->q_rad[j]) +
+           (double)p->cable_damping_nm_s_per_rad[j] * (sim->qmd_rad_s[j] - sim->qd_rad_s[j]);
+}
+
+/* t less joint j's friction at velocity v: viscous, then tanh-smoothed Coulomb. */
+static double less_friction_nm(const arm_params_t *p, int j, double t, double v)
+{
+    t -= (double)p->viscous_nm_s_per_rad[j] * v;
+    t -= (double)p->coulomb_nm[j] * tanh(v / friction_width_rad_s(p));
+    return t;
+}
+
+/* Semi-implicit Euler for joint c's link side, then the hard stops (restitution 0). */
+static void advance_link(arm_sim_t *sim, const arm_params_t *p, int c, double qdd, double h)
+{
+    sim->qdd_rad_s2[c] = qdd;
+    sim->qd_rad_s[c] += h * qdd;
+    sim->q_rad[c] += h * sim->qd_rad_s[c];
+    const double lo = p->desc.q_min_rad[c], hi = p->desc.q_max_rad[c];
+    if (sim->q_rad[c] < lo) {
+        sim->q_rad[c] = lo;
+        if (sim->qd_rad_s[c] < 0.0)
+            sim->qd_rad_s[c] = 0.0;
+    } else if (sim->q_rad[c] > hi) {
+        sim->q_rad[c] = hi;
+        if (sim->qd_rad_s[c] > 0.0)
+            sim->qd_rad_s[c] = 0.0;
+    }
+}
+
 /* One semi-implicit Euler sub-step of h seconds from the kinematics k at the present state;
- * tau_in_nm is the joint torque from the motors, before friction and velocity-product terms. */
+ * cmd_nm is the commanded motor torque (motor side, clamped), which the current loop follows. */
 static void substep(arm_sim_t *sim, const arm_params_t *p, const arm_kin_now_t *k,
-                    const double tau_in_nm[ARGIL_DRIVES], const double force_n[3], double h)
+                    const double cmd_nm[ARGIL_DRIVES], const double force_n[3], double h)
 {
     double m[ARGIL_DRIVES][ARGIL_DRIVES];
-    double tau[ARGIL_DRIVES], qdd[ARGIL_DRIVES];
+    double tau[ARGIL_DRIVES], qdd[ARGIL_DRIVES], motor_tau[ARGIL_DRIVES], cable[ARGIL_DRIVES];
     mass_from_jacobian(p, (const double(*)[ARGIL_DRIVES])k->jac, m);
-    const double eps = friction_width_rad_s(p);
     for (int c = 0; c < ARGIL_DRIVES; c++) {
-        const double v = sim->qd_rad_s[c];
-        double t = tau_in_nm[c];
+        const bool compliant = arm_sim_joint_compliant(p, c);
+        motor_tau[c] = current_loop(sim, p, c, cmd_nm[c], h) * (double)p->desc.gear_ratio[c];
+        cable[c] = compliant ? cable_torque_nm(sim, p, c) : 0.0;
+        double t = compliant ? cable[c] : motor_tau[c];
         for (int i = 0; i < 3; i++)
             t += k->jac[i][c] * (force_n[i] - (double)p->tip_mass_kg * k->acc_bias_m_s2[i]);
-        t -= (double)p->viscous_nm_s_per_rad[c] * v;
-        t -= (double)p->coulomb_nm[c] * tanh(v / eps);
-        tau[c] = t;
+        tau[c] = compliant ? t : less_friction_nm(p, c, t, sim->qd_rad_s[c]);
     }
     if (!arm_sim_solve3((const double(*)[3])m, tau, qdd))
-        qdd[0] = qdd[1] = qdd[2] = 0.0; /* cannot happen while the rotor inertia is positive */
+        qdd[0] = qdd[1] = qdd[2] = 0.0; /* cannot happen while M's diagonal terms are positive */
     for (int c = 0; c < ARGIL_DRIVES; c++) {
-        sim->qdd_rad_s2[c] = qdd[c];
-        sim->qd_rad_s[c] += h * qdd[c];
-        sim->q_rad[c] += h * sim->qd_rad_s[c];
-        /* hard stops, restitution 0 */
-        const double lo = p->desc.q_min_rad[c], hi = p->desc.q_max_rad[c];
-        if (sim->q_rad[c] < lo) {
-            sim->q_rad[c] = lo;
-            if (sim->qd_rad_s[c] < 0.0)
-                sim->qd_rad_s[c] = 0.0;
-        } else if (sim->q_rad[c] > hi) {
-            sim->q_rad[c] = hi;
-            if (sim->qd_rad_s[c] > 0.0)
-                sim->qd_rad_s[c] = 0.0;
+        if (arm_sim_joint_compliant(p, c)) {
+            const double t = less_friction_nm(p, c, motor_tau[c] - cable[c], sim->qmd_rad_s[c]);
+            const double qmdd = t / rotor_at_joint(p, c);
+            sim->qmd_rad_s[c] += h * qmdd;
+            sim->qm_rad[c] += h * sim->qmd_rad_s[c];
+            advance_link(sim, p, c, qdd[c], h);
+        } else {
+            advance_link(sim, p, c, qdd[c], h);
+            sim->qm_rad[c] = sim->q_rad[c];
+            sim->qmd_rad_s[c] = sim->qd_rad_s[c];
         }
     }
 }
 
-/* The motor torques at the joints (clamped to the peak limit; non-finite counts as 0) and the
- * tip force (0 unless finite), in double. */
+/* The commanded motor torques (clamped to the peak limit; non-finite counts as 0) and the tip
+ * force (0 unless finite), in double. */
 static void step_inputs(const arm_params_t *p, const float motor_torque_nm[ARGIL_DRIVES],
-                        vec3_t tip_force_n, double tau_in[ARGIL_DRIVES], double f[3])
+                        vec3_t tip_force_n, double cmd_nm[ARGIL_DRIVES], double f[3])
 {
     for (int c = 0; c < ARGIL_DRIVES; c++) {
         const double peak = p->peak_torque_nm[c];
-        double t = isfinite(motor_torque_nm[c]) ? (double)motor_torque_nm[c] : 0.0;
-        t = fmin(fmax(t, -peak), peak);
-        tau_in[c] = t * (double)p->desc.gear_ratio[c];
+        const double t = isfinite(motor_torque_nm[c]) ? (double)motor_torque_nm[c] : 0.0;
+        cmd_nm[c] = fmin(fmax(t, -peak), peak);
     }
     const bool ok = vec3_isfinite(tip_force_n);
     f[0] = ok ? tip_force_n.x : 0.0;
@@ -230,23 +341,23 @@ void arm_sim_substep_from(arm_sim_t *sim, const arm_params_t *p, const arm_kin_n
                           const float motor_torque_nm[ARGIL_DRIVES], vec3_t tip_force_n,
                           uint32_t h_us)
 {
-    double tau_in[ARGIL_DRIVES], f[3];
-    step_inputs(p, motor_torque_nm, tip_force_n, tau_in, f);
-    substep(sim, p, k, tau_in, f, (double)h_us * 1e-6);
+    double cmd[ARGIL_DRIVES], f[3];
+    step_inputs(p, motor_torque_nm, tip_force_n, cmd, f);
+    substep(sim, p, k, cmd, f, (double)h_us * 1e-6);
 }
 
 void arm_sim_step(arm_sim_t *sim, const arm_params_t *p,
                   const float motor_torque_nm[ARGIL_DRIVES], vec3_t tip_force_n,
                   uint32_t dt_us)
 {
-    double tau_in[ARGIL_DRIVES], f[3];
-    step_inputs(p, motor_torque_nm, tip_force_n, tau_in, f);
+    double cmd[ARGIL_DRIVES], f[3];
+    step_inputs(p, motor_torque_nm, tip_force_n, cmd, f);
     const uint32_t sub_us = arm_sim_substep_us(p);
     while (dt_us > 0) {
         const uint32_t h_us = dt_us < sub_us ? dt_us : sub_us;
         arm_kin_now_t k;
         arm_sim_kin_now(sim, p, &k);
-        substep(sim, p, &k, tau_in, f, (double)h_us * 1e-6);
+        substep(sim, p, &k, cmd, f, (double)h_us * 1e-6);
         dt_us -= h_us;
     }
 }
@@ -258,7 +369,33 @@ double arm_sim_kinetic_energy_j(const arm_sim_t *sim, const arm_params_t *p)
     for (int r = 0; r < ARGIL_DRIVES; r++)
         for (int c = 0; c < ARGIL_DRIVES; c++)
             e += sim->qd_rad_s[r] * m[r][c] * sim->qd_rad_s[c];
+    for (int j = 0; j < ARGIL_DRIVES; j++)
+        if (arm_sim_joint_compliant(p, j))
+            e += rotor_at_joint(p, j) * sim->qmd_rad_s[j] * sim->qmd_rad_s[j];
     return 0.5 * e;
+}
+
+double arm_sim_cable_energy_j(const arm_sim_t *sim, const arm_params_t *p)
+{
+    double e = 0.0;
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        if (!arm_sim_joint_compliant(p, j))
+            continue;
+        const double twist = sim->qm_rad[j] - sim->q_rad[j];
+        e += twist * twist / (double)p->cable_compliance_rad_per_nm[j];
+    }
+    return 0.5 * e;
+}
+
+double arm_sim_encoder_rad(const arm_sim_t *sim, const arm_params_t *p, int j)
+{
+    return arm_sim_joint_compliant(p, j) ? sim->qm_rad[j] : sim->q_rad[j];
+}
+
+void arm_sim_applied_torque_nm(const arm_sim_t *sim, float out[ARGIL_DRIVES])
+{
+    for (int j = 0; j < ARGIL_DRIVES; j++)
+        out[j] = (float)sim->torque_nm[j];
 }
 
 vec3_t arm_sim_tip_m(const arm_sim_t *sim, const arm_params_t *p)

@@ -12,6 +12,19 @@ void drive_cfg_default(drive_cfg_t *cfg)
     cfg->rated_torque_nm = 0.030f;
     cfg->peak_torque_nm = cfg->rated_torque_nm * (float)ARM_PEAK_TORQUE_PERMILLE / 1000.0f;
     cfg->quick_stop_us = 10000u;
+    cfg->dac_bits = 0u;
+}
+
+/* tq_nm (within ±peak) on the DAC's grid: the nearest of the codes −2^(bits−1) .. 2^(bits−1) − 1
+ * of 2 peak / 2^bits each (mid-tread, so zero is a code; +peak is one step out of reach). */
+static float dac_quantise_nm(float tq_nm, float peak_nm, uint8_t bits)
+{
+    if (bits == 0u || bits > 24u || !(peak_nm > 0.0f))
+        return tq_nm;
+    const float half = (float)(1ul << (bits - 1u));
+    const float step_nm = peak_nm / half;
+    const float code = fminf(fmaxf(rintf(tq_nm / step_nm), -half), half - 1.0f);
+    return code * step_nm;
 }
 
 /* Resets the application (power-on or NMT reset node). */
@@ -231,6 +244,7 @@ void drive_tick(drive_t *d, int32_t position_counts, bool power_enabled, uint32_
         const float peak = d->cfg.peak_torque_nm;
         tq_nm = (float)d->target_torque_permille * d->cfg.rated_torque_nm / 1000.0f;
         tq_nm = fminf(fmaxf(tq_nm, -peak), peak);
+        tq_nm = dac_quantise_nm(tq_nm, peak, d->cfg.dac_bits);
     }
     d->torque_nm = tq_nm;
     /* synchronous TPDO1 */

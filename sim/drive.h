@@ -15,6 +15,8 @@ typedef struct {
     float rated_torque_nm;         /* motor rated torque = 1000 ‰ (0x6076) */
     float peak_torque_nm;          /* torque limit the drive clips to (0x6072 in N m) */
     uint32_t quick_stop_us;        /* QUICK_STOP_ACTIVE lasts this long, then SWITCH_ON_DISABLED */
+    uint8_t dac_bits;              /* torque command resolution: 2^bits codes over ±peak (the
+                                      current reference's DAC/PWM); 0 = continuous, at most 24 */
 } drive_cfg_t;
 
 typedef struct {
@@ -36,7 +38,8 @@ typedef struct {
     uint32_t tx_dropped;           /* frames lost because the tx batch was full */
 } drive_t;
 
-/* Heartbeat 100 ms, rated 0.030 N m, peak 4x rated, quick stop 10 ms (the default arm). */
+/* Heartbeat 100 ms, rated 0.030 N m, peak 4x rated, quick stop 10 ms, continuous torque (the
+ * default arm). */
 void drive_cfg_default(drive_cfg_t *cfg);
 
 /* Powers the drive up: NOT_READY, NMT initialising; the boot-up heartbeat goes out at the
@@ -50,7 +53,7 @@ void drive_receive(drive_t *d, const can_frame_t *f);
 
 /* Advances the drive by dt_us: boot-up / heartbeat, a pending fault (EMCY, FAULT), the quick
  * stop timer, the torque stage (torque only in OPERATIONAL + OPERATION_ENABLED with the
- * power-enable input high, clipped to ±peak) and, if a SYNC arrived, TPDO1 with the
+ * power-enable input high, clipped to ±peak, rounded to the DAC's step) and, if a SYNC arrived, TPDO1 with the
  * statusword, position_counts and the applied torque in ‰. Frames are appended to tx. */
 void drive_tick(drive_t *d, int32_t position_counts, bool power_enabled, uint32_t dt_us,
                 can_batch_t *tx);

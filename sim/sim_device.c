@@ -22,6 +22,7 @@ void sim_device_init(sim_device_t *d, const sim_params_t *p)
         cfg.quick_stop_us = p->quick_stop_ms * 1000u;
         cfg.rated_torque_nm = p->arm.desc.rated_torque_nm[j];
         cfg.peak_torque_nm = p->arm.peak_torque_nm[j];
+        cfg.dac_bits = p->arm.torque_dac_bits[j];
         drive_init(&d->drive[j], (uint8_t)(j + 1), &cfg);
     }
     d->hand_holding = true;
@@ -78,7 +79,8 @@ void sim_device_step(sim_device_t *d, const can_batch_t *from_board, uint32_t gp
     const bool power = (gpio_out & GPIO_OUT_DRIVE_ENABLE) != 0 && !d->estop_pressed;
     float motor_nm[ARGIL_DRIVES];
     for (int j = 0; j < ARGIL_DRIVES; j++) {
-        const int32_t counts = arm_rad_to_counts(&d->p.arm.desc, j, (float)d->arm.q_rad[j]);
+        const float enc_rad = (float)arm_sim_encoder_rad(&d->arm, &d->p.arm, j);
+        const int32_t counts = arm_rad_to_counts(&d->p.arm.desc, j, enc_rad);
         drive_tick(&d->drive[j], counts, power, dt_us, to_board);
         motor_nm[j] = drive_motor_torque_nm(&d->drive[j]);
     }
