@@ -645,6 +645,262 @@ static void test_hard_stop_at_joint_limit(void **state)
     assert_true(s.qd_rad_s[0] == 0.0);                  /* restitution 0: no bounce */
 }
 
+/* ---------- the Premium profile: cable mode, current loop, torque DAC ---------- */
+
+/* The premium profile with no friction and an undamped cable: what a formula can predict. */
+static void premium_lossless(arm_params_t *p)
+{
+    arm_params_premium(p);
+    for (int j = 0; j < 3; j++) {
+        p->coulomb_nm[j] = 0.0f;
+        p->viscous_nm_s_per_rad[j] = 0.0f;
+        p->cable_damping_nm_s_per_rad[j] = 0.0f;
+    }
+}
+
+/* The yaw's cable mode rings at √(k (1/I_motor + 1/I_link)) / 2π, with I_motor = I_rotor gear²
+ * and I_link = m r² + the yaw's link inertia (the yaw column of J is orthogonal to the other
+ * two, so the yaw decouples): a torque step on the yaw motor makes the motor-side angle, which
+ * the encoder reads, swing about the link's. Measured from the twist rate's zero crossings over
+ * 100 ms (about 44 periods) at the longest sub-step the bound allows. */
+static void test_premium_cable_mode_frequency(void **state)
+{
+    (void)state;
+    arm_params_t p;
+    premium_lossless(&p);
+    p.substep_us = 100000u;                        /* the bound's own sub-step */
+    const uint32_t h_us = arm_sim_substep_us(&p);
+    assert_true(h_us > 20u && h_us <= arm_sim_substep_max_us(&p));
+    arm_sim_t s;
+    arm_sim_init(&s, &p, p.desc.q_home_rad);
+    const vec3_t tip = arm_sim_tip_m(&s, &p);
+    const double r = hypot(tip.x, tip.z), g = p.desc.gear_ratio[0];
+    const double i_motor = p.rotor_inertia_kg_m2[0] * g * g;
+    const double i_link = p.tip_mass_kg * r * r + p.link_inertia_kg_m2[0];
+    const double k = 1.0 / p.cable_compliance_rad_per_nm[0];
+    const double want_hz = sqrt(k * (1.0 / i_motor + 1.0 / i_link)) / (2.0 * M_PI);
+    assert_true(want_hz > 300.0 && want_hz < 600.0);  /* docs/arm.md: 441 Hz at home */
+    const float step_nm[3] = {0.01f, 0.0f, 0.0f};
+    double first_s = -1.0, last_s = -1.0, prev = 0.0, max_twist = 0.0;
+    int crossings = 0;
+    for (uint32_t n = 1; n * h_us <= 100000u; n++) {
+        arm_sim_step(&s, &p, step_nm, vec3(0, 0, 0), h_us);
+        const double rate = s.qmd_rad_s[0] - s.qd_rad_s[0];
+        const double t_s = (double)(n * h_us) * 1e-6;
+        if (n > 1 && rate * prev < 0.0) {
+            const double at = t_s - (double)h_us * 1e-6 * rate / (rate - prev);
+            if (first_s < 0.0)
+                first_s = at;
+            last_s = at;
+            crossings++;
+        }
+        prev = rate;
+        max_twist = fmax(max_twist, fabs(arm_sim_encoder_rad(&s, &p, 0) - s.q_rad[0]));
+    }
+    assert_true(crossings > 60);
+    const double got_hz = (double)(crossings - 1) / (2.0 * (last_s - first_s));
+    assert_true(fabs(got_hz - want_hz) <= 0.01 * want_hz);
+    /* the encoder sees the swing: up to twice the static twist g τ i_link / ((i_m + i_l) k) */
+    const double static_twist = g * step_nm[0] / k * i_link / (i_motor + i_link);
+    assert_true(max_twist > 1.8 * static_twist && max_twist < 2.2 * static_twist);
+}
+
+/* On a PHANToM the encoders sit on the motors: with the elbow motor pushing steadily against
+ * the hand's grip, the counts the board reads are the motor side's, ahead of the link by the
+ * cable's twist gear τ / k (7 counts at 3000 ‰). */
+static void test_premium_encoder_reads_motor_side(void **state)
+{
+    (void)state;
+    sim_params_t p;
+    sim_params_default(&p);
+    arm_params_premium(&p.arm);
+    static sim_device_t d;
+    dev_enable(&d, &p);
+    const int16_t tq[3] = {0, 0, 3000};
+    can_batch_t out;
+    for (int t = 0; t < 300; t++)
+        dev_cmd(&d, CIA402_CW_ENABLE_OP, tq, ENABLE, &out);
+    int32_t counts;
+    assert_int_equal(tpdo_state(&out, 3, &counts, NULL), CIA402_OPERATION_ENABLED);
+    float applied[3];
+    arm_sim_applied_torque_nm(&d.arm, applied);
+    const double twist_rad = p.arm.desc.gear_ratio[2] * applied[2] * p.arm.cable_compliance_rad_per_nm[2];
+    const double rad_per_count = 2.0 * M_PI / (p.arm.desc.gear_ratio[2] *
+                                               p.arm.desc.encoder_counts_per_rev[2]);
+    assert_true(twist_rad / rad_per_count > 5.0);
+    const int32_t link_counts = arm_rad_to_counts(&p.arm.desc, 2, (float)d.arm.q_rad[2]);
+    /* the TPDO went out before the latest step's motion: compare with the twist, ±1 count */
+    assert_true(fabs(((double)counts - (double)link_counts) - twist_rad / rad_per_count) <= 1.5);
+}
+
+/* The current loop: a torque step reaches 1 − 1/e = 63 % of the command at T_c = 1 / (2π f_c)
+ * and 99 % by 5 T_c, and the joint gets the matching impulse: a free rigid yaw's speed at T_c is
+ * gear τ T_c / (e I), where with no lag it would be gear τ T_c / I. */
+static void test_premium_current_loop_step(void **state)
+{
+    (void)state;
+    arm_params_t p;
+    premium_lossless(&p);
+    for (int j = 0; j < 3; j++)
+        p.cable_compliance_rad_per_nm[j] = 0.0f;      /* rigid: the yaw's inertia is M00 */
+    arm_sim_t s;
+    arm_sim_init(&s, &p, p.desc.q_home_rad);
+    const double tc_s = 1.0 / (2.0 * M_PI * p.current_loop_hz[0]);
+    const uint32_t tc_us = (uint32_t)lrint(tc_s * 1e6);
+    assert_int_equal(tc_us, 159u);                    /* 1 kHz */
+    const float cmd[3] = {0.05f, 0.0f, 0.0f};
+    float applied[3];
+    arm_sim_step(&s, &p, cmd, vec3(0, 0, 0), tc_us);
+    arm_sim_applied_torque_nm(&s, applied);
+    const double t_s = (double)tc_us * 1e-6;
+    assert_true(fabs(applied[0] / cmd[0] - (1.0 - exp(-t_s / tc_s))) < 1e-4);
+    assert_true(fabs(applied[0] / cmd[0] - 0.632) < 0.005);
+    double m[3][3];
+    arm_sim_mass_matrix(&p, s.q_rad, m);
+    const double gear_tau = p.desc.gear_ratio[0] * cmd[0];
+    const double want = gear_tau / m[0][0] * (t_s - tc_s * (1.0 - exp(-t_s / tc_s)));
+    assert_true(fabs(s.qd_rad_s[0] - want) <= 0.01 * want);
+    assert_true(s.qd_rad_s[0] < 0.4 * gear_tau / m[0][0] * t_s);  /* far from the unlagged */
+    arm_sim_step(&s, &p, cmd, vec3(0, 0, 0), 4u * tc_us);
+    arm_sim_applied_torque_nm(&s, applied);
+    assert_true(applied[0] > 0.99f * cmd[0] && applied[0] <= cmd[0]);
+}
+
+/* The torque DAC: every torque a drive applies is a whole number of steps of 2 peak / 2^12
+ * (58.6 µN m, coarser than the 30 µN m of one ‰), the nearest one to the command, and stepping
+ * the command ‰ by ‰ moves the torque by 0 or one step. */
+static void test_premium_torque_dac_steps(void **state)
+{
+    (void)state;
+    sim_params_t p;
+    sim_params_default(&p);
+    arm_params_premium(&p.arm);
+    static sim_device_t d;
+    dev_enable(&d, &p);
+    const double step_nm = 2.0 * p.arm.peak_torque_nm[0] / 4096.0;
+    assert_true(fabs(step_nm - 58.59375e-6) < 1e-9);
+    can_batch_t out;
+    double prev = 0.0;
+    int levels = 0;
+    for (int pm = -4000; pm <= 4000; pm += 1) {
+        const int16_t tq[3] = {(int16_t)pm, 0, 0};
+        dev_cmd(&d, CIA402_CW_ENABLE_OP, tq, ENABLE, &out);
+        float m[3];
+        sim_device_motor_torque_nm(&d, m);
+        const double codes = m[0] / step_nm;
+        assert_true(fabs(codes - rint(codes)) < 1e-3);
+        const double want_nm = pm * 0.030 / 1000.0;
+        assert_true(fabs(m[0] - want_nm) <= 0.5 * step_nm + 1e-9 ||
+                    (pm == 4000 && fabs(m[0] - (want_nm - step_nm)) < 1e-9)); /* +peak: a code short */
+        if (pm > -4000) {
+            const double moved = rint((m[0] - prev) / step_nm);
+            assert_true(moved == 0.0 || moved == 1.0);
+            levels += moved == 1.0;
+        }
+        prev = m[0];
+        dev_step(&d, NULL, 0, &out);  /* power off between commands: keep the arm home */
+    }
+    assert_int_equal(levels, 4095);
+}
+
+/* The free compliant arm with friction and cable damping off keeps its energy, kinetic (links
+ * and rotors) plus the cables', through 0.5 s of ringing: no drift (0.1 % between the first and
+ * the last 50 ms), and excursions within the bound's ±ω h / 2 = ±12.5 % of the most energy the
+ * cables held (measured: 0.8 % of the total where that allows 1.3 %). */
+static void test_premium_free_arm_conserves_energy(void **state)
+{
+    (void)state;
+    arm_params_t p;
+    premium_lossless(&p);
+    arm_sim_t s;
+    arm_sim_init(&s, &p, p.desc.q_home_rad);
+    s.qd_rad_s[0] = 0.2;                   /* links moving, rotors still: the cables ring */
+    s.qd_rad_s[1] = -0.16;
+    s.qd_rad_s[2] = 0.3;
+    const float zero[3] = {0, 0, 0};
+    const double e0 = arm_sim_kinetic_energy_j(&s, &p) + arm_sim_cable_energy_j(&s, &p);
+    double worst = 0.0, early = 0.0, late = 0.0, cable_max = 0.0;
+    for (int t = 0; t < 500; t++) {
+        arm_sim_step(&s, &p, zero, vec3(0, 0, 0), TICK_US);
+        const double cable = arm_sim_cable_energy_j(&s, &p);
+        const double e = arm_sim_kinetic_energy_j(&s, &p) + cable;
+        worst = fmax(worst, fabs(e - e0));
+        cable_max = fmax(cable_max, cable);
+        if (t < 50)
+            early += e / 50.0;
+        if (t >= 450)
+            late += e / 50.0;
+    }
+    assert_true(cable_max > 0.01 * e0);               /* the modes were excited */
+    for (int j = 0; j < 3; j++)                       /* no joint reached a stop */
+        assert_true(s.q_rad[j] > p.desc.q_min_rad[j] && s.q_rad[j] < p.desc.q_max_rad[j]);
+    assert_true(worst < 0.5 * ARM_SIM_OMEGA_H_MAX * cable_max);
+    assert_true(fabs(late - early) < 0.002 * e0);
+}
+
+/* The sub-step bound with a cable mode: the fastest mode any pose can have, ω_max =
+ * √(k (1/I_motor + 1/min link-side floor)), gets ω_max h <= ARM_SIM_OMEGA_H_MAX at the bound and
+ * not one microsecond longer; the premium arm still runs at the default 50 µs, and the default
+ * arm's bound is the 219 µs docs/arm.md gives (no cable: friction alone sets it). */
+static void test_premium_substep_bound(void **state)
+{
+    (void)state;
+    arm_params_t p;
+    arm_params_premium(&p);
+    const uint32_t hi = arm_sim_substep_max_us(&p);
+    const double g = p.desc.gear_ratio[0];
+    double floor_kg_m2 = INFINITY;
+    for (int j = 0; j < 3; j++)
+        floor_kg_m2 = fmin(floor_kg_m2, p.link_inertia_kg_m2[j]);
+    const double w_max = sqrt(1.0 / p.cable_compliance_rad_per_nm[0] *
+                              (1.0 / (p.rotor_inertia_kg_m2[0] * g * g) + 1.0 / floor_kg_m2));
+    assert_true(w_max * (double)hi * 1e-6 <= ARM_SIM_OMEGA_H_MAX);
+    assert_true(w_max * (double)(hi + 1u) * 1e-6 > ARM_SIM_OMEGA_H_MAX);
+    assert_int_equal(arm_sim_substep_us(&p), ARM_SIM_SUBSTEP_US);
+    p.substep_us = 1000u;
+    assert_int_equal(arm_sim_substep_us(&p), hi);
+    arm_params_t def;
+    arm_params_default(&def);
+    assert_int_equal(arm_sim_substep_max_us(&def), 219u);
+    /* a cable with no link-side inertia behind it has no bound: refuse with 1 µs */
+    p.link_inertia_kg_m2[1] = 0.0f;
+    assert_int_equal(arm_sim_substep_max_us(&p), 1u);
+}
+
+/* The default arm has none of it: the torque is the command from the first microsecond, the
+ * encoder reads the joint, the cables store nothing, and one ‰ gives its 30 µN m exactly. */
+static void test_default_arm_is_rigid_and_unlagged(void **state)
+{
+    (void)state;
+    arm_params_t p;
+    arm_params_default(&p);
+    arm_sim_t s;
+    arm_sim_init(&s, &p, p.desc.q_home_rad);
+    const float cmd[3] = {0.01f, -0.02f, 0.03f};
+    float applied[3];
+    arm_sim_step(&s, &p, cmd, vec3(0.3f, 0, 0), 1u);
+    arm_sim_applied_torque_nm(&s, applied);
+    for (int j = 0; j < 3; j++)
+        assert_true(applied[j] == cmd[j]);
+    arm_sim_step(&s, &p, cmd, vec3(0.3f, 0, 0), TICK_US);
+    for (int j = 0; j < 3; j++) {
+        assert_true(s.q_rad[j] != (double)p.desc.q_home_rad[j]);  /* it moved */
+        assert_true(arm_sim_encoder_rad(&s, &p, j) == s.q_rad[j]);
+    }
+    assert_true(arm_sim_cable_energy_j(&s, &p) == 0.0);
+    sim_params_t sp;
+    sim_params_default(&sp);
+    static sim_device_t d;
+    dev_enable(&d, &sp);
+    const int16_t one[3] = {1, -1, 1};
+    can_batch_t out;
+    dev_cmd(&d, CIA402_CW_ENABLE_OP, one, ENABLE, &out);
+    float m[3];
+    sim_device_motor_torque_nm(&d, m);
+    assert_float_equal(m[0], 30e-6f, 1e-10f);
+    assert_float_equal(m[1], -30e-6f, 1e-10f);
+}
+
 static void test_hand_force_formula(void **state)
 {
     (void)state;
@@ -727,6 +983,13 @@ int main(void)
         cmocka_unit_test(test_arm_coarse_substep_follows_default),
         cmocka_unit_test(test_constant_torque_gives_inverse_mass_acceleration),
         cmocka_unit_test(test_hard_stop_at_joint_limit),
+        cmocka_unit_test(test_premium_cable_mode_frequency),
+        cmocka_unit_test(test_premium_encoder_reads_motor_side),
+        cmocka_unit_test(test_premium_current_loop_step),
+        cmocka_unit_test(test_premium_torque_dac_steps),
+        cmocka_unit_test(test_premium_free_arm_conserves_energy),
+        cmocka_unit_test(test_premium_substep_bound),
+        cmocka_unit_test(test_default_arm_is_rigid_and_unlagged),
         cmocka_unit_test(test_hand_force_formula),
         cmocka_unit_test(test_buttons_and_gpio),
         cmocka_unit_test(test_determinism),
