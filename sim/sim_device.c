@@ -154,3 +154,21 @@ void sim_device_q_rad(const sim_device_t *d, float out[3])
 {
     arm_sim_q_rad(&d->arm, out);
 }
+
+vec3_t sim_device_delivered_force_n(const sim_device_t *d)
+{
+    arm_kin_now_t k;
+    arm_sim_kin_now(&d->arm, &d->p.arm, &k);
+    double jt[3][3], tau[3], f[3];
+    for (int j = 0; j < ARGIL_DRIVES; j++) {
+        const double peak = d->p.arm.peak_torque_nm[j];
+        double t = drive_motor_torque_nm(&d->drive[j]);
+        t = t > peak ? peak : (t < -peak ? -peak : t);
+        tau[j] = d->p.arm.desc.gear_ratio[j] * t;
+        for (int a = 0; a < 3; a++)
+            jt[j][a] = k.jac[a][j];
+    }
+    if (!arm_sim_solve3(jt, tau, f))
+        return vec3(0.0f, 0.0f, 0.0f);
+    return vec3((float)f[0], (float)f[1], (float)f[2]);
+}

@@ -32,7 +32,9 @@ typedef struct {
     uint32_t window_version;
     bool armed_sent;
     uint8_t rx[SIM_RIG_LINK_BYTES];
-    uint32_t ms;
+    uint32_t ms;              /* host milliseconds so far: the host acts once per millisecond */
+    uint32_t tick_us;         /* the board's loop period the rig steps (rig_set_tick_us) */
+    uint32_t tick_us_in_ms;   /* of the current host millisecond, the microseconds stepped */
     /* Optional: every frame the host's peer sends goes here instead of straight to the link
      * (tests/sil/test_faults.c loses, delays, duplicates and reorders them). NULL: direct. */
     bool (*link_hook)(void *hook_ctx, const uint8_t *f, size_t len);
@@ -104,6 +106,7 @@ static rig_t *rig_new_host(float stiffness_n_per_mm, bool manual_host, const rep
     rc.board.safety.overrun_streak = 0;
     assert_int_equal(sim_rig_init(&r->rig, &rc), ARGIL_OK);
     r->manual_host = manual_host;
+    r->tick_us = 1000u;
     r->offset_m = vec3_sub(vec3(0, 0, 0.060f), sim_rig_tip_m(&r->rig));
     r->hand_model_m = vec3(0, 0, 0.060f);
     r->host_alive = true;
@@ -212,7 +215,16 @@ static inline void rig_send_window(rig_t *r, const float *density, const float *
     }
 }
 
-/* One millisecond of the whole system. */
+/* Runs the board and the simulated device at tick_us (the board's loop period: 1000 at 1 kHz,
+ * 250 at 4 kHz); call before the first tick. The host still acts once per millisecond: the
+ * manual host's heartbeat every 5 ms, the peer's tick, r->ms. */
+static inline void rig_set_tick_us(rig_t *r, uint32_t tick_us)
+{
+    r->tick_us = tick_us;
+    r->rig.board.cfg.tick_us = tick_us;
+}
+
+/* One board tick of the whole system (one millisecond unless rig_set_tick_us said otherwise). */
 static inline void rig_tick(rig_t *r)
 {
     if (r->hand_released)
@@ -224,7 +236,7 @@ static inline void rig_tick(rig_t *r)
         /* A late bus: the device's frames reach the board only every can_burst_ticks ticks,
          * all at once (as argil-sim under emulation answers several SYNCs in one read). */
         can_batch_t to_board;
-        sim_rig_step_device_frames(&r->rig, 1000, &to_board);
+        sim_rig_step_device_frames(&r->rig, r->tick_us, &to_board);
         for (uint8_t i = 0; i < to_board.n; i++)
             (void)can_batch_push(&r->can_held, &to_board.f[i]);
         if (r->ms % r->can_burst_ticks == 0) {
@@ -233,11 +245,16 @@ static inline void rig_tick(rig_t *r)
         }
         (void)sim_rig_step_board(&r->rig);
     } else {
-        (void)sim_rig_step_ns(&r->rig, 1000);
+        (void)sim_rig_step_ns(&r->rig, r->tick_us);
     }
     const size_t n = sim_rig_host_receive(&r->rig, r->rx, sizeof(r->rx));
-    if (r->host_alive && !r->manual_host) {
+    if (r->host_alive && !r->manual_host)
         peer_receive(&r->peer, r->rx, n);
+    r->tick_us_in_ms += r->tick_us;
+    if (r->tick_us_in_ms < 1000u)
+        return;
+    r->tick_us_in_ms -= 1000u;
+    if (r->host_alive && !r->manual_host) {
         peer_tick(&r->peer, 1000);
     } else if (r->host_alive && r->ms % 5u == 0) {
         proto_msg_t m;
@@ -255,23 +272,31 @@ static inline void rig_tick(rig_t *r)
     r->ms++;
 }
 
-/* Runs until the board is ACTIVE; returns the milliseconds it took (or -1). */
+/* The board ticks in ms milliseconds. */
+static inline int rig_ticks_in_ms(const rig_t *r, int ms)
+{
+    return (int)((int64_t)ms * 1000 / (int64_t)r->tick_us);
+}
+
+/* Runs until the board is ACTIVE; returns the milliseconds it took, rounded up (or -1). */
 static inline int rig_until_active(rig_t *r, int max_ms)
 {
-    for (int i = 0; i < max_ms; i++) {
+    const int ticks = rig_ticks_in_ms(r, max_ms);
+    for (int i = 0; i < ticks; i++) {
         rig_tick(r);
         if (r->rig.board.safety.state == SAFETY_ACTIVE)
-            return i + 1;
+            return (int)(((int64_t)(i + 1) * r->tick_us + 999) / 1000);
     }
     return -1;
 }
 
-/* Moves the hand in a straight line over ms milliseconds. */
+/* Moves the hand in a straight line over ms milliseconds, a step each board tick. */
 static inline void rig_move(rig_t *r, vec3_t to_m, int ms)
 {
     const vec3_t from = r->hand_model_m;
-    for (int i = 1; i <= ms; i++) {
-        r->hand_model_m = vec3_add(from, vec3_scale(vec3_sub(to_m, from), (float)i / (float)ms));
+    const int ticks = rig_ticks_in_ms(r, ms);
+    for (int i = 1; i <= ticks; i++) {
+        r->hand_model_m = vec3_add(from, vec3_scale(vec3_sub(to_m, from), (float)i / (float)ticks));
         rig_tick(r);
     }
 }
