@@ -159,12 +159,11 @@ vec3_t sim_device_delivered_force_n(const sim_device_t *d)
 {
     arm_kin_now_t k;
     arm_sim_kin_now(&d->arm, &d->p.arm, &k);
+    float applied[ARGIL_DRIVES];
+    arm_sim_applied_torque_nm(&d->arm, applied);
     double jt[3][3], tau[3], f[3];
     for (int j = 0; j < ARGIL_DRIVES; j++) {
-        const double peak = d->p.arm.peak_torque_nm[j];
-        double t = drive_motor_torque_nm(&d->drive[j]);
-        t = t > peak ? peak : (t < -peak ? -peak : t);
-        tau[j] = d->p.arm.desc.gear_ratio[j] * t;
+        tau[j] = d->p.arm.desc.gear_ratio[j] * (double)applied[j];
         for (int a = 0; a < 3; a++)
             jt[j][a] = k.jac[a][j];
     }

@@ -81,9 +81,10 @@ void sim_device_motor_torque_nm(const sim_device_t *d, float out[3]);
 /* The joint angles now, rad (ground truth, not quantised). */
 void sim_device_q_rad(const sim_device_t *d, float out[3]);
 /* The force the drives deliver at the stylus tip now, device frame, N: the F with
- * Jᵀ(q) F = gear · τ_motor (each torque clipped to its peak, as the arm applies it) at the true
- * pose — what the hand feels of the motors, not the force the board commanded. Zero where J is
- * singular. */
+ * Jᵀ(q) F = gear · τ at the true pose, τ the motor torques the arm applied in its latest step
+ * (clipped to the peak, after the current loop's lag where the arm has one:
+ * arm_sim_applied_torque_nm) — what the hand feels of the motors, not the force the board
+ * commanded. Zero where J is singular. */
 vec3_t sim_device_delivered_force_n(const sim_device_t *d);
 
 #endif

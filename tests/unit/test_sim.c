@@ -915,9 +915,10 @@ static void test_hand_force_formula(void **state)
     assert_float_equal(f.z, -0.4f, 1e-5f);
 }
 
-/* The delivered force is the tip force the drives' torques make: at a pose off home, torques
- * worked out from a known force by Jᵀ F give that force back; an opposite external force at the
- * tip holds the arm still; a torque beyond the peak delivers what the peak delivers. */
+/* The delivered force is the tip force the arm's applied torques make: at a pose off home,
+ * torques worked out from a known force by Jᵀ F give that force back; an opposite external
+ * force at the tip holds the arm still; a drive command beyond the peak delivers what the peak
+ * delivers. */
 static void test_delivered_force_from_drive_torques(void **state)
 {
     (void)state;
@@ -932,26 +933,26 @@ static void test_delivered_force_from_drive_torques(void **state)
     arm_jacobian(&p.arm.desc, q, j);
     arm_jt_force(j, want, tau);
     for (int k = 0; k < 3; k++)
-        d.drive[k].torque_nm = tau[k] / p.arm.desc.gear_ratio[k];
+        d.arm.torque_nm[k] = tau[k] / p.arm.desc.gear_ratio[k];
     const vec3_t got = sim_device_delivered_force_n(&d);
     assert_float_equal(got.x, want.x, 1e-4f);
     assert_float_equal(got.y, want.y, 1e-4f);
     assert_float_equal(got.z, want.z, 1e-4f);
 
-    /* the drives' torques against −F at the tip: no joint accelerates */
+    /* the applied torques against −F at the tip: no joint accelerates */
     float motor[3];
-    sim_device_motor_torque_nm(&d, motor);
+    arm_sim_applied_torque_nm(&d.arm, motor);
     arm_sim_step(&d.arm, &d.p.arm, motor, vec3_scale(got, -1.0f), TICK_US);
     for (int k = 0; k < 3; k++)
         assert_true(fabs(d.arm.qd_rad_s[k]) < 1e-6);
 
-    /* clipped at the peak torque, as the arm applies it */
+    /* a command beyond the peak torque: the arm applies the peak, and that is delivered */
+    const float over_cmd[3] = {5.0f, 0.0f, 0.0f}, peak_cmd[3] = {p.arm.peak_torque_nm[0], 0, 0};
     arm_sim_init(&d.arm, &d.p.arm, q);
-    d.drive[0].torque_nm = 5.0f;
-    d.drive[1].torque_nm = 0.0f;
-    d.drive[2].torque_nm = 0.0f;
+    arm_sim_step(&d.arm, &d.p.arm, over_cmd, vec3(0, 0, 0), TICK_US);
     const vec3_t over = sim_device_delivered_force_n(&d);
-    d.drive[0].torque_nm = p.arm.peak_torque_nm[0];
+    arm_sim_init(&d.arm, &d.p.arm, q);
+    arm_sim_step(&d.arm, &d.p.arm, peak_cmd, vec3(0, 0, 0), TICK_US);
     const vec3_t at_peak = sim_device_delivered_force_n(&d);
     assert_true(vec3_norm(vec3_sub(over, at_peak)) == 0.0f);
     assert_true(vec3_norm(at_peak) > 0.1f);
