@@ -25,7 +25,7 @@ void board_cfg_default(board_cfg_t *cfg)
     cfg->rt_stats_period_us = 1000000u;
     cfg->swap_fade_ticks = 20u;
     cfg->contact_damping_n_s_per_m = 0.5f;
-    cfg->contact_damping_s = 0.0025f;
+    cfg->contact_damping_s = 0.0f;
     cfg->io_delay_ticks = 2u;
     cfg->slew_n_per_s = 1000.0f;
     cfg->passivity = true;
@@ -432,21 +432,36 @@ static vec3_t shape_force(board_t *b, const haptics_out_t *h, float scale, float
 {
     vec3_t f = h->force_n;
     if (h->contact) {
-        /* Contact damping grows with the wall's stiffness: b = b0 + K·τ, enough to offset
-         * the loop's sample-and-hold and bus delay (Colgate: b > K·(T/2 + delay)). */
+        /* Contact damping b0 (+ K·τ if configured; τ = 0 by default). By Colgate & Schenkel
+         * a sampled wall of stiffness K with virtual damping B is passive only while the
+         * device's own damping b > K·T/2 + |B|: virtual damping spends passivity margin, it
+         * does not buy it, and on the quantised backward-difference velocity it turns each
+         * encoder step into a force kick (docs/haptics.md, "Stability and limits"). Energy the
+         * loop generates is the passivity controller's to dissipate, below. */
         const float damping = b->cfg.contact_damping_n_s_per_m +
                               b->tool.contact_stiffness_n_per_m * b->cfg.contact_damping_s;
         f = vec3_sub(f, vec3_scale(b->vel_m_s, damping));
     }
     const window_buf_t *w = window_active(&b->window);
-    const uint32_t env = (w ? w->version : 0u) * TOOL_KIND_COUNT + (b->tool_valid ? b->tool.kind : 0u);
+    /* The environment whose stored energy the observer follows: the window, the tool and
+     * whether its button holds the clay (a pull's or rope's spring to the grab point, a push's
+     * clamped contact) or not (the plain contact). Letting go of a pull inside the bump it
+     * raised swaps one spring for another; counting that jump in stored energy as generated
+     * made the controller drag and buzz in free space for half a second afterwards. */
+    const bool holding = b->haptics.grabbing || b->haptics.pushing;
+    const uint32_t env = ((w ? w->version : 0u) * TOOL_KIND_COUNT +
+                          (b->tool_valid ? b->tool.kind : 0u)) * 2u + (holding ? 1u : 0u);
     const vec3_t device_m = b->tip_device_m;
     f = vec3_add(f, passivity_process(&b->passivity, device_m, b->vel_m_s, h->potential_j, env,
                                       dt_s, b->cfg.passivity && scale > 0.0f,
                                       b->cfg.pc_deadband_j, b->cfg.pc_max_damping_n_s_per_m));
-    /* A window swap's force step is brought in by Guo et al.'s exponential weighted average:
-     * the difference from the force felt before the swap decays by α each tick. */
-    if (b->swapped) {
+    /* A force step the board makes on its own is brought in by Guo et al.'s exponential
+     * weighted average: the difference from the force felt before decays by α each tick. Two
+     * make one: a window swap, and a button going down or up with a tool whose force law it
+     * changes (push: the contact slides freely while the clay may flow; pull and rope: the
+     * spring to the grab point; letting go of a pull inside the bump it raised met the clay
+     * 3 mm deep and threw the stylus out at the 3.3 N limit). */
+    if (b->swapped || h->hold_edge) {
         b->swap_offset_n = vec3_add(b->swap_offset_n, vec3_sub(b->force_n, f));
         b->swapped = false;
     }
@@ -546,7 +561,7 @@ void board_tick(board_t *b, const board_in_t *in, board_out_t *out)
     window_buf_t *w = window_active_mut(&b->window);
     const bool btn1 = (in->gpio_in & GPIO_IN_STYLUS_BTN1) != 0;
     haptics_out_t h = {vec3(0, 0, 0), 0.0f, false, false, false, vec3(0, 0, 0), 0.0f,
-                       {INT32_MAX, INT32_MAX, INT32_MAX}, {-1, -1, -1}};
+                       {INT32_MAX, INT32_MAX, INT32_MAX}, {-1, -1, -1}, false};
     if (w && b->tool_valid && b->have_tip && !nonfinite) {
         haptics_process(&b->haptics, &b->tool, w, b->pos_m, b->vel_m_s, btn1,
                         safety_may_sculpt(&b->safety), dt_s, b->impulse_ns, &h);

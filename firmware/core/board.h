@@ -42,7 +42,8 @@ typedef struct {
                                         * many ticks: Guo et al.'s exponential weighted average
                                         * with α = 1 − 1/ticks (0: no fade) */
     float contact_damping_n_s_per_m;   /* velocity damping while in contact, b0 */
-    float contact_damping_s;           /* … plus this many seconds × the contact stiffness */
+    float contact_damping_s;           /* … plus this many seconds × the contact stiffness (0:
+                                          it costs passivity margin, board.c shape_force) */
     uint32_t io_delay_ticks;           /* ticks from a force to the motion it acts on (2: CiA 402) */
     float slew_n_per_s;                /* largest change of the force per second */
     bool passivity;                    /* passivity observer + controller (Hannaford & Ryu) */

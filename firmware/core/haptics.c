@@ -13,6 +13,7 @@ void haptics_init(haptics_t *h)
     h->in_contact = false;
     h->vcp_m = vec3(0, 0, 0);
     h->grabbing = false;
+    h->pushing = false;
     h->grab_pos_m = vec3(0, 0, 0);
     h->grab_density = 0.0f;
 }
@@ -315,9 +316,13 @@ static float first_crossing(const window_buf_t *win, vec3_t p, vec3_t u, float i
 }
 
 /* Penetration of a sphere tool of radius r into the clay and the direction to push it out,
- * from rays along 14 directions (axes and diagonals): the deepest ray gives the depth, the
- * penetration-weighted rays the direction. A tool in a dent feels its floor and walls, where a
- * single gradient at the centre would be ambiguous. False when nothing penetrates. */
+ * from rays along 14 directions (axes and diagonals): the penetration-weighted rays give the
+ * direction n, and the depth is the deepest ray's scaled by how much the rays agree,
+ * |Σ u·pen| / Σ pen·|u·n|. A tool in a dent feels its floor and walls, where a single
+ * gradient at the centre would be ambiguous; and in a bore its own size the walls on either side cancel, so a
+ * sideways shift δ is felt as about K·δ instead of flipping the full force from one wall to
+ * the other (the 55 Hz buzz of the default session's push). Continuous in the tool's position
+ * while its centre is outside the clay. False when nothing penetrates. */
 static bool sphere_penetration(const window_buf_t *win, vec3_t p, float r, float iso,
                                float *pen_m, vec3_t *normal)
 {
@@ -337,23 +342,31 @@ static bool sphere_penetration(const window_buf_t *win, vec3_t p, float r, float
         *pen_m = dist + r;
         return *pen_m > 0.0f;
     }
-    float best = 0.0f;
+    float best = 0.0f, pens[14];
     vec3_t dir = vec3(0, 0, 0);
     for (int k = 0; k < 14; k++) {
         const vec3_t u = vec3(DIRS[k][0], DIRS[k][1], DIRS[k][2]);
-        const float pen = r - first_crossing(win, p, u, iso, r, d0 - iso);
-        if (pen <= 0.0f)
+        pens[k] = r - first_crossing(win, p, u, iso, r, d0 - iso);
+        if (pens[k] <= 0.0f)
             continue;
-        dir = vec3_sub(dir, vec3_scale(u, pen));
-        if (pen > best)
-            best = pen;
+        dir = vec3_sub(dir, vec3_scale(u, pens[k]));
+        if (pens[k] > best)
+            best = pens[k];
     }
     const float dn = vec3_norm(dir);
     if (!(best > 0.0f) || !(dn > 0.0f))
         return false;
-    *pen_m = best;
-    *normal = vec3_scale(dir, 1.0f / dn);
-    return true;
+    const vec3_t n = vec3_scale(dir, 1.0f / dn);
+    /* How much the rays agree: |Σ u·pen| over Σ pen·|u·n|. 1 when every ray meets clay on the
+     * same side (a floor, a wall, a cup: the deepest ray's depth as it is), less when walls face
+     * each other, 0 in a bore whose walls balance. */
+    float spread = 0.0f;
+    for (int k = 0; k < 14; k++)
+        if (pens[k] > 0.0f)
+            spread += pens[k] * fabsf(vec3_dot(vec3(DIRS[k][0], DIRS[k][1], DIRS[k][2]), n));
+    *pen_m = spread > 0.0f ? best * fminf(1.0f, dn / spread) : 0.0f;
+    *normal = n;
+    return *pen_m > 0.0f;
 }
 
 /* Contact of the tool sphere with the iso-surface, through a virtual contact point whose
@@ -442,6 +455,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
     out->contact = false;
     out->sculpting = false;
     out->yielding = false;
+    out->hold_edge = false;
     out->work_m = pos_m;
     out->work_radius_m = 0.0f;
     for (int k = 0; k < 3; k++) {
@@ -451,6 +465,7 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
     if (!win) {
         h->prev_valid = false;
         h->grabbing = false;
+    h->pushing = false;
         h->in_contact = false;
         return;
     }
@@ -466,7 +481,11 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
         if (h->grab_density < win->iso)
             h->grab_density = win->iso;
     }
-    h->grabbing = hold && (tool->kind == TOOL_PULL || tool->kind == TOOL_ROPE);
+    const bool grabbing = hold && (tool->kind == TOOL_PULL || tool->kind == TOOL_ROPE);
+    const bool pushing = tool->kind == TOOL_PUSH && hold;
+    out->hold_edge = h->grabbing != grabbing || h->pushing != pushing;
+    h->grabbing = grabbing;
+    h->pushing = pushing;
 
     switch (tool->kind) {
     case TOOL_CARVE:
@@ -523,7 +542,6 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
 
     /* Clay that is being pushed flows: the contact point slides freely while the push tool
      * works it, so the yield is not felt as stick-slip. */
-    const bool pushing = tool->kind == TOOL_PUSH && hold;
     out->force_n = contact_force(h, tool, win, pos_m, pushing ? 0.0f : tool->friction,
                                  &out->potential_j, &out->contact);
     if (tool->kind == TOOL_PUSH && hold && out->contact) {

@@ -25,6 +25,7 @@ typedef struct {
     bool in_contact;
     vec3_t vcp_m;              /* virtual contact point: where the tool centre rests on the surface */
     bool grabbing;             /* button held with pull or rope */
+    bool pushing;              /* button held with push (the clay may flow) */
     vec3_t grab_pos_m;         /* reference point where the button went down */
     float grab_density;
 } haptics_t;
@@ -39,6 +40,10 @@ typedef struct {
     float work_radius_m;       /* … and how far from there */
     int32_t touched_lo[3];     /* node box [lo, hi] that received impulses this tick; */
     int32_t touched_hi[3];     /* … empty when lo > hi on any axis */
+    bool hold_edge;            /* the button went down or up this tick with a tool whose force
+                                  law it changes (push: the contact slides freely while the
+                                  clay may flow; pull, rope: the spring to the grab point), so
+                                  the force may step */
 } haptics_out_t;
 
 void haptics_init(haptics_t *h);
