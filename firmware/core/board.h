@@ -14,6 +14,7 @@
 #include "host_session.h"
 #include "passivity.h"
 #include "rt_stats.h"
+#include "velocity.h"
 #include "safety.h"
 #include "shared/arm_kin.h"
 #include "shared/canopen.h"
@@ -42,8 +43,8 @@ typedef struct {
                                         * many ticks: Guo et al.'s exponential weighted average
                                         * with α = 1 − 1/ticks (0: no fade) */
     float contact_damping_n_s_per_m;   /* velocity damping while in contact, b0 */
-    float contact_damping_s;           /* … plus this many seconds × the contact stiffness (0:
-                                          it costs passivity margin, board.c shape_force) */
+    float contact_damping_s;           /* … plus this many seconds × the contact stiffness
+                                          (board.c shape_force) */
     uint32_t io_delay_ticks;           /* ticks from a force to the motion it acts on (2: CiA 402) */
     float slew_n_per_s;                /* largest change of the force per second */
     bool passivity;                    /* passivity observer + controller (Hannaford & Ryu) */
@@ -53,6 +54,9 @@ typedef struct {
     float joint_limit_stiffness_nm_per_rad;
     float accel_limit;                 /* density-spring |acceleration| (1/s²) that halves the step */
     float velocity_filter;             /* 0…1: weight of the newest velocity sample */
+    float velocity_tolerance_m;        /* > 0: the velocity by adaptive windowing (velocity.h),
+                                          positions trusted to this; 0: the backward
+                                          difference over the last new position */
     float max_velocity_m_s;            /* tool speed (device space) that is a fault; 0 = none */
     bool refuse_arm;                   /* the link cannot tell who sent a frame (UDP without a
                                         * key): ARM commands are refused and counted */
@@ -153,6 +157,8 @@ typedef struct {
     uint32_t stale_ticks;              /* ticks since then without a new position */
     vec3_t pos_m;                      /* tool, model space */
     vec3_t vel_m_s;
+    velocity_window_t vel_window;      /* the positions the velocity is fitted to */
+    uint32_t sense_ticks;              /* ticks sense_tool has seen (the window's clock) */
     vec3_t force_n;                    /* rendered this tick, model space */
     vec3_t swap_offset_n;              /* force step of the last window swap, decaying */
     bool swapped;                      /* a window was swapped in this tick */

@@ -52,10 +52,21 @@ static const float throw_speeds_m_s[] = {0.025f, 0.05f, 0.1f, 0.2f, 0.4f};
 typedef struct {
     float k_n_per_mm;
     float b_n_s_per_m;           /* virtual contact damping (when !shipped) */
-    bool shipped;                /* the board's default instead: 0.5 N·s/m + K · 2.5 ms */
+    bool shipped;                /* the board's default damping instead, b0 + K·τ */
     bool passivity;              /* board.cfg.passivity */
     uint32_t tick_us;            /* loop period; the device steps by the same dt */
+    bool one_tick_velocity;      /* the velocity before 2026-12-04: a one-tick backward
+                                    difference (velocity_tolerance_m = 0), not the window */
 } wall_cfg_t;
+
+/* The wall's virtual contact damping, N·s/m. */
+static float wall_damping(const wall_cfg_t *c)
+{
+    board_cfg_t def;
+    board_cfg_default(&def);
+    return c->shipped ? def.contact_damping_n_s_per_m + c->k_n_per_mm * 1e3f * def.contact_damping_s
+                      : c->b_n_s_per_m;
+}
 
 /* A manual-host rig whose window is a flat wall below the stylus (material at model z < wall_z,
  * normal +z), gap_m from the tool's surface, with the hand's grip set; NULL if never ACTIVE. */
@@ -70,6 +81,8 @@ static rig_t *wall_rig_new(const wall_cfg_t *c, float gap_m, float grip_n_per_m,
         bc->contact_damping_n_s_per_m = c->b_n_s_per_m;
         bc->contact_damping_s = 0.0f;
     }
+    if (c->one_tick_velocity)
+        bc->velocity_tolerance_m = 0.0f;
     r->rig.dev.p.hand.stiffness_n_per_m = grip_n_per_m;
     r->rig.dev.p.hand.damping_n_s_per_m = grip_n_s_per_m;
     const vec3_t tip = rig_tip_model(r);
@@ -536,8 +549,8 @@ static const uint32_t sweep_tick_us[] = {1000u, 500u, 250u};
 
 /* What the sweep keeps for the summary. */
 typedef struct {
-    wall_result_t shipped_1khz[N_K]; /* the shipped damping, passivity controller on, 1 kHz */
-    float shipped_felt_1khz[N_K];
+    wall_result_t shipped_1khz[N_K]; /* board_cfg_default's rendering, controller on, 1 kHz */
+    wall_result_t before_1khz[N_K];  /* the same with the one-tick velocity of before */
     wall_result_t worst;             /* the wall whose bounce gained the most energy (J) */
     bool have_worst;
     wall_cfg_t worst_cfg;
@@ -596,8 +609,8 @@ static float sweep_row(const wall_cfg_t *base, size_t rate, sweep_t *sw)
             sw->worst_cfg = c;
             sw->have_worst = true;
         }
-        if (rate == 0 && base->shipped && base->passivity)
-            sw->shipped_1khz[i] = w;
+        if (rate == 0 && base->passivity && base->shipped)
+            *(base->one_tick_velocity ? &sw->before_1khz[i] : &sw->shipped_1khz[i]) = w;
     }
     return best;
 }
@@ -612,13 +625,15 @@ static void sweep(sweep_t *sw)
             for (size_t i = 0; i < N_K; i++)
                 printf(" %5g", (double)sweep_k_n_per_mm[i]);
             printf("  | largest passing K, felt stiffness there\n");
-            for (size_t b = 0; b <= N_B; b++) {
-                wall_cfg_t c = {0.0f, b < N_B ? sweep_b_n_s_per_m[b] : 0.0f, b == N_B, pc != 0,
-                                sweep_tick_us[rate]};
+            for (size_t b = 0; b <= N_B + 1; b++) {
+                wall_cfg_t c = {0.0f, b < N_B ? sweep_b_n_s_per_m[b] : 0.0f, b >= N_B, pc != 0,
+                                sweep_tick_us[rate], b == N_B + 1};
                 if (b < N_B)
                     printf("    B = %-18g:", (double)c.b_n_s_per_m);
+                else if (b == N_B)
+                    printf("    shipped (b0 + K*tau) :");
                 else
-                    printf("    shipped 0.5+K*2.5ms:");
+                    printf("    .. 1-tick velocity   :");
                 fflush(stdout);
                 const float k = sweep_row(&c, rate, sw);
                 c.k_n_per_mm = k;
@@ -656,13 +671,15 @@ static void print_bounces(const wall_result_t *w)
     }
 }
 
-/* Today's rendering wall by wall: the shipped damping with the controller on at 1 kHz. */
-static void print_shipped(const sweep_t *sw)
+/* One rendering wall by wall, at 1 kHz with the controller on: the shipped damping
+ * (board_cfg_default) and, beside it, the damping before 2026-12-04. */
+static void print_walls(const char *what, const wall_result_t walls[N_K])
 {
-    printf("  Shipped rendering (B = 0.5 + K*2.5 ms, passivity controller on, 1 kHz), wall by wall:\n"
-           "    K [N/mm] | worst E_out/E_in | largest W per bounce | grip: W+dU, osc | held p-p (mean) | cell\n");
+    printf("  %s, passivity controller on, 1 kHz, wall by wall:\n"
+           "    K [N/mm] | worst E_out/E_in | largest W per bounce | grip: W+dU, osc | held p-p (mean) | cell\n",
+           what);
     for (size_t i = 0; i < N_K; i++) {
-        const wall_result_t *w = &sw->shipped_1khz[i];
+        const wall_result_t *w = &walls[i];
         char cell[8];
         wall_cell(w, cell);
         printf("    %8g | %16.3f | %+17.4f mJ | %+10.4f mJ, %-3s | %.3f N (%.2f N) | %s\n",
@@ -676,7 +693,7 @@ static void print_shipped(const sweep_t *sw)
  * velocity) must come out non-passive. */
 static void self_check_active_wall(void)
 {
-    const wall_cfg_t c = {1.0f, -1.0f, false, false, 1000u};
+    const wall_cfg_t c = {1.0f, -1.0f, false, false, 1000u, false};
     static wall_result_t w;
     wall_evaluate(&c, &w);
     printf("  Check of the check: K = 1 N/mm, B = -1 N.s/m (an active wall), controller off, 1 kHz:\n");
@@ -693,11 +710,18 @@ static void zwidth(void)
     print_definitions();
     static sweep_t sw;
     sweep(&sw);
-    print_shipped(&sw);
+    board_cfg_t def;
+    board_cfg_default(&def);
+    char what[160];
+    snprintf(what, sizeof(what), "Shipped rendering (board_cfg_default: B = %g N.s/m + K * %g ms, "
+             "velocity window %g um)", (double)def.contact_damping_n_s_per_m,
+             (double)(def.contact_damping_s * 1e3f), (double)(def.velocity_tolerance_m * 1e6f));
+    print_walls(what, sw.shipped_1khz);
+    print_walls("The same with the velocity before 2026-12-04 (a one-tick backward difference)",
+                sw.before_1khz);
     printf("  Worst bounce of the sweep (largest E_out - E_in): K = %g N/mm, B = %s%g N.s/m, controller %s, %u Hz:\n",
            (double)sw.worst_cfg.k_n_per_mm, sw.worst_cfg.shipped ? "shipped " : "",
-           (double)(sw.worst_cfg.shipped ? 0.5f + sw.worst_cfg.k_n_per_mm * 2.5f
-                                         : sw.worst_cfg.b_n_s_per_m),
+           (double)wall_damping(&sw.worst_cfg),
            sw.worst_cfg.passivity ? "on" : "off", 1000000u / (sw.worst_cfg.tick_us ? sw.worst_cfg.tick_us : 1000u));
     print_bounces(&sw.worst);
     printf("  Goals (issue 17): felt stiffness in the stable region >= 3 N/mm at 1 kHz: %.2f N/mm (K = %g) %s;\n"
@@ -745,7 +769,7 @@ static void wall_detail(const wall_cfg_t *c)
     char cell[8];
     wall_cell(&w, cell);
     printf("  K = %g N/mm, B = %s%g N.s/m, controller %s, %u Hz: %s\n", (double)c->k_n_per_mm,
-           c->shipped ? "shipped " : "", (double)(c->shipped ? 0.5f + c->k_n_per_mm * 2.5f : c->b_n_s_per_m),
+           c->shipped ? "shipped " : "", (double)wall_damping(c),
            c->passivity ? "on" : "off", 1000000u / c->tick_us, cell);
     print_bounces(&w);
     printf("    grip: %d contacts, end penetration %.3f mm, largest W + dU %+.4f mJ, "
@@ -758,8 +782,10 @@ static void wall_detail(const wall_cfg_t *c)
 int main(int argc, char **argv)
 {
     if (argc >= 6 && strcmp(argv[1], "wall") == 0) {
-        const wall_cfg_t c = {(float)atof(argv[2]), (float)atof(argv[3]), strcmp(argv[3], "shipped") == 0,
-                              atoi(argv[4]) != 0, (uint32_t)atoi(argv[5])};
+        const bool shipped = strcmp(argv[3], "shipped") == 0 || strcmp(argv[3], "before") == 0;
+        const wall_cfg_t c = {(float)atof(argv[2]), (float)atof(argv[3]), shipped,
+                              atoi(argv[4]) != 0, (uint32_t)atoi(argv[5]),
+                              strcmp(argv[3], "before") == 0};
         wall_detail(&c);
         return 0;
     }
@@ -771,7 +797,7 @@ int main(int argc, char **argv)
         tick_workload(argv[2], atoi(argv[3]));
         return 0;
     }
-    fprintf(stderr, "usage: bench_haptics zwidth | wall K_N_PER_MM B_N_S_PER_M|shipped PC(0|1) TICK_US |\n"
+    fprintf(stderr, "usage: bench_haptics zwidth | wall K_N_PER_MM B_N_S_PER_M|shipped|before PC(0|1) TICK_US |\n"
                     "       tick point|curve|area 16|32\n");
     return 2;
 }
