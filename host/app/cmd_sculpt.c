@@ -419,6 +419,8 @@ static void print_result(const sculpt_args_t *sa, const session_summary_t *s)
         printf("  undo                %s\n", s->undo_note);
     printf("  peak force          %.3f N (limit %.2f N)\n", (double)s->peak_force_n,
            (double)s->force_limit_n);
+    printf("  delivered force     %.3f N at most (the simulated arm's motor torques through "
+           "its Jacobian)\n", (double)s->peak_delivered_force_n);
     printf("  clay volume         %.3f cm3 -> %.3f cm3 (%+.2f %%)\n", vb, va,
            vb > 0 ? (va - vb) / vb * 100.0 : 0.0);
     printf("  mesh                %zu triangles, %zu vertices, %s\n", s->triangles, s->vertices,

@@ -661,6 +661,7 @@ static void summarise_run(const session_t *s, const lockstep_t *lp, session_summ
     sum->median_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.5) * 1000u;
     sum->p99_compute_ns = hist_quantile_bin(s->compute_hist_us, COMPUTE_HIST_BINS, 0.99) * 1000u;
     sum->peak_force_n = board.peak_force_n;
+    sum->peak_delivered_force_n = board.peak_delivered_force_n;
     sum->force_limit_n = board.max_force_n;
     sum->final_state = board.state;
     sum->fault_code = board.fault;

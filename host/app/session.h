@@ -78,7 +78,8 @@ typedef struct {
     uint32_t preempted_over_tick[SESSION_PREEMPTED_KEPT];
     uint32_t rt_stats_frames;     /* RT_STATS reports the host received from the board */
     msg_rt_stats_t rt;            /* the newest one (wake-up latency, compute, overruns) */
-    float peak_force_n;
+    float peak_force_n;            /* the board's command (clamped by the board itself) */
+    float peak_delivered_force_n;  /* what the simulated arm's motors delivered at the tip */
     float force_limit_n;
     double volume_before_m3;
     double volume_after_m3;

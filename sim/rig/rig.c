@@ -20,6 +20,7 @@ argil_err_t sim_rig_init(sim_rig_t *r, const sim_rig_cfg_t *cfg)
         return ARGIL_ERR_ARG;
     board_io_init(&r->io);
     r->from_board.n = 0;
+    r->peak_delivered_force_n = 0.0f;
     return ARGIL_OK;
 }
 
@@ -44,6 +45,9 @@ void sim_rig_step_device_frames(sim_rig_t *r, uint32_t dt_us, can_batch_t *to_bo
     hal_sim_take_from_board(&r->hal, &r->from_board);
     sim_device_step(&r->dev, &r->from_board, hal_sim_gpio_out(&r->hal), to_board, dt_us);
     hal_sim_set_gpio_in(&r->hal, sim_device_gpio_in(&r->dev));
+    const float delivered = vec3_norm(sim_device_delivered_force_n(&r->dev));
+    if (delivered > r->peak_delivered_force_n)
+        r->peak_delivered_force_n = delivered;
 }
 
 void sim_rig_step_device(sim_rig_t *r, uint32_t dt_us)
@@ -87,6 +91,7 @@ void sim_rig_board_stats(const sim_rig_t *r, sim_rig_board_stats_t *out)
            sizeof(out->preempted_over_tick));
     out->link_errors = r->board.stats.link_errors;
     out->peak_force_n = r->board.stats.peak_force_n;
+    out->peak_delivered_force_n = r->peak_delivered_force_n;
     out->max_force_n = r->board.cfg.max_force_n;
     out->state = r->board.safety.state;
     out->fault = r->board.safety.fault;

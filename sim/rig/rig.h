@@ -29,6 +29,8 @@ typedef struct {
     board_t board;
     board_io_t io;
     can_batch_t from_board;        /* the frames the board sent in the last step */
+    float peak_delivered_force_n;  /* the largest force the arm delivered at the tip
+                                      (sim_device_delivered_force_n after each step) */
 } sim_rig_t;
 
 /* What the board reports of itself, for a session's summary. */
@@ -41,7 +43,8 @@ typedef struct {
     uint32_t preempted_over_period;
     uint32_t preempted_over_tick[BOARD_PREEMPTED_KEPT];
     uint32_t link_errors;          /* frames the board's decoder refused */
-    float peak_force_n;
+    float peak_force_n;            /* the board's command, which the board clamps itself */
+    float peak_delivered_force_n;  /* the simulated arm's truth: what the motors delivered */
     float max_force_n;             /* the board's configured limit */
     safety_state_t state;
     fault_code_t fault;

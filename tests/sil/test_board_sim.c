@@ -48,7 +48,9 @@ static void test_touching_the_clay_pushes_back(void **st)
     assert_true(fabsf(f.x) < 0.1f && fabsf(f.y) < 0.1f);
     const vec3_t tip = vec3_add(sim_device_tip_m(&r->rig.dev), r->offset_m);
     assert_true(tip.z > 0.028f + 0.0005f);       /* the tip is held off the hand's target */
-    assert_true(r->rig.board.stats.peak_force_n <= r->rig.board.cfg.max_force_n + 1e-6f);
+    /* what the arm delivered, not the command the board clamps itself (0.01 N: the drives'
+     * per-mille torque rounding) */
+    assert_true(r->rig.peak_delivered_force_n <= r->rig.board.cfg.max_force_n + 0.01f);
     rig_free(r);
 }
 
@@ -62,12 +64,14 @@ static void test_force_never_exceeds_limit(void **st)
     float peak = 0.0f;
     for (int i = 0; i < 500; i++) {
         rig_tick(r);
-        const float n = vec3_norm(r->rig.board.force_n);
+        /* the force the motors deliver at the tip, not the board's (clamped) command */
+        const float n = vec3_norm(sim_device_delivered_force_n(&r->rig.dev));
         if (n > peak)
             peak = n;
     }
     assert_true(peak > 3.0f);                    /* it did push hard */
-    assert_true(peak <= 3.3f + 1e-5f);           /* and never past the 3.3 N limit */
+    assert_true(peak <= 3.3f + 0.01f);           /* and never past the 3.3 N limit (0.01 N:
+                                                    the drives' per-mille torque rounding) */
     rig_free(r);
 }
 

@@ -35,7 +35,7 @@ typedef struct {
     double force_2_3mm_n;           /* mean force felt while the tool's bottom is 2-3 mm under
                                      * the original surface */
     uint32_t force_2_3mm_ticks;
-    float peak_force_n;
+    float peak_force_n;             /* delivered by the arm (sim_device_delivered_force_n) */
     uint8_t channels;               /* of the board's window at the end */
     float stiffness_at_pole;        /* board's node stiffness at the pole */
 } press_t;
@@ -107,8 +107,10 @@ static void press(float paint_scale, uint32_t window_period_us, press_t *out)
         const float depth_m = SURFACE_Z_M - (rig_tip_model(r).z - TOOL_R_M);
         const float *f = r->peer.last_tm.force_n;
         const float fn = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-        if (fn > out->peak_force_n)
-            out->peak_force_n = fn;
+        /* the limit is checked on what the arm delivered, not on the board's clamped command */
+        const float delivered_n = vec3_norm(sim_device_delivered_force_n(&r->rig.dev));
+        if (delivered_n > out->peak_force_n)
+            out->peak_force_n = delivered_n;
         if (depth_m >= 0.002f && depth_m < 0.003f) {
             out->force_2_3mm_n += fn;
             out->force_2_3mm_ticks++;
@@ -162,7 +164,7 @@ static void compare(const press_t *plain, const press_t *painted)
     assert_true(plain->host_dent_mm > 1.0 && plain->board_dent_mm > 1.0);
     /* Both reached 2-3 mm deep; nobody beyond the tool's force limit. */
     assert_true(plain->force_2_3mm_ticks > 50 && painted->force_2_3mm_ticks > 50);
-    assert_true(painted->peak_force_n <= 3.3f + 1e-4f && plain->peak_force_n <= 3.3f + 1e-4f);
+    assert_true(painted->peak_force_n <= 3.3f + 0.01f && plain->peak_force_n <= 3.3f + 0.01f);
 }
 
 /* The session's host (a new window at most every 20 ms). Measured: mean dent host 1.900 →
