@@ -10,6 +10,12 @@ void hal_sim_init(hal_t *h)
 {
     memset(h, 0, sizeof(*h));
     link_bind_init(&h->bind);
+    h->tick_us = 1000u;
+}
+
+void hal_sim_set_tick_us(hal_t *h, uint32_t tick_us)
+{
+    h->tick_us = tick_us;
 }
 
 static uint32_t fifo_used(const hal_sim_fifo_t *q)
@@ -140,7 +146,7 @@ uint32_t hal_sim_gpio_out(const hal_t *h)
 
 void hal_link_session(hal_t *h, hal_session_state_t state, uint32_t epoch)
 {
-    h->link_now_us += 1000u;
+    h->link_now_us += h->tick_us;
     link_bind_session(&h->bind, state, epoch, h->link_now_us);
 }
 

@@ -25,12 +25,16 @@ struct hal {
     hal_sim_fifo_t link_from_board;
     uint32_t link_dropped;         /* frames refused because a FIFO was full */
     link_bind_t bind;              /* which sender reaches the board, as over UDP */
-    uint64_t link_now_us;          /* the binding's clock: 1 ms per board tick */
+    uint64_t link_now_us;          /* the binding's clock: one board tick per board tick */
+    uint32_t tick_us;              /* … of this length (1000 until hal_sim_set_tick_us) */
 };
 
 #define HAL_SIM_HOST 1u            /* the sender key of hal_sim_host_send */
 
 void hal_sim_init(hal_t *h);
+
+/* The board's loop period, so the link binding's clock keeps real time at 2 and 4 kHz. */
+void hal_sim_set_tick_us(hal_t *h, uint32_t tick_us);
 
 /* Device side: the frames the board sent this tick (cleared by the call) and those to deliver. */
 void hal_sim_take_from_board(hal_t *h, can_batch_t *out);

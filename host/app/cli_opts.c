@@ -20,6 +20,14 @@ bool cli_knot_ratio(const char *v, int *out)
     return true;
 }
 
+bool cli_rate_hz(const char *v, uint32_t *tick_us)
+{
+    if (!v || (strcmp(v, "1000") != 0 && strcmp(v, "2000") != 0 && strcmp(v, "4000") != 0))
+        return false;
+    *tick_us = 1000000u / (uint32_t)atoi(v);
+    return true;
+}
+
 bool cli_autosave_s(const char *v, float *out)
 {
     char *end = NULL;

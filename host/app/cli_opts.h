@@ -5,6 +5,7 @@
 #define ARGIL_CLI_OPTS_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "host/app/peer.h"
 
@@ -17,6 +18,10 @@ bool cli_global_solve(const char *v, peer_global_solve_t *out);
 
 /* --knot-ratio: "1", "2" or "4". */
 bool cli_knot_ratio(const char *v, int *out);
+
+#define CLI_RATE_HZ_EXPECTS "1000, 2000 or 4000 (the board's loop rate, Hz)"
+/* --rate-hz: "1000", "2000" or "4000"; *out the loop period in microseconds. */
+bool cli_rate_hz(const char *v, uint32_t *tick_us);
 
 /* --autosave-s, --checkpoint-s: a number of seconds in 0.001 … 3600. */
 bool cli_autosave_s(const char *v, float *out);

@@ -65,6 +65,9 @@ static void usage_sculpt(FILE *f)
             "                  the host's global solve: the implicit B-spline model or the\n"
             "                  explicit density springs on the grid (default bspline;\n"
             "                  docs/model.md)\n"
+            "  --rate-hz 1000|2000|4000\n"
+            "                  the simulated board's loop rate (default 1000, as argil-board's\n"
+            "                  [loop] rate_hz); telemetry.csv gets a row per tick\n"
             "  --knot-ratio 1|2|4\n"
             "                  B-spline: grid samples per knot span at the start (default 1,\n"
             "                  one coefficient per sample); 2 or 4 solve fewer coefficients and\n"
@@ -157,6 +160,12 @@ static sculpt_opt_t parse_session_option(sculpt_args_t *sa, int argc, char **arg
         }
         (*i)++;
         sa->o.undo_mb = (uint32_t)mb;
+    } else if (strcmp(a, "--rate-hz") == 0) {
+        if (!cli_rate_hz(v, &sa->o.tick_us)) {
+            fprintf(stderr, "argil sculpt: --rate-hz needs " CLI_RATE_HZ_EXPECTS "\n");
+            return SCULPT_OPT_BAD;
+        }
+        (*i)++;
     } else if (strcmp(a, "--knot-ratio") == 0) {
         if (!cli_knot_ratio(v, &sa->o.knot_ratio)) {
             fprintf(stderr, "argil sculpt: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");

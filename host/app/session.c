@@ -37,6 +37,7 @@ void session_opts_default(session_opts_t *o)
     o->script_path = "scripts/default.scn";
     o->out_dir = "out";
     o->window_edge = 16;
+    o->tick_us = 1000u;
     o->global_solve = PEER_SOLVE_BSPLINE;
     o->knot_ratio = 1;
     o->progress = false;
@@ -335,6 +336,8 @@ static argil_err_t open_rig(session_t *s, const session_opts_t *opts, uint32_t *
 {
     sim_rig_cfg_t rcfg;
     sim_rig_cfg_default(&rcfg);
+    if (opts->tick_us)
+        rcfg.board.tick_us = opts->tick_us;
     if (!opts->deadline_faults)
         rcfg.board.safety.overrun_streak = 0;
     if (sim_rig_init(&s->rig, &rcfg) != ARGIL_OK) {

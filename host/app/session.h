@@ -40,6 +40,7 @@ typedef struct {
     const char *script_path;      /* NULL: no script (the hook drives the hand) */
     const char *out_dir;          /* NULL: write nothing */
     int window_edge;              /* 16 or 32 */
+    uint32_t tick_us;             /* the board's loop period: 1000, 500 or 250 (--rate-hz) */
     peer_global_solve_t global_solve; /* what the host's global solve steps (docs/model.md) */
     int knot_ratio;               /* B-spline: grid samples per knot span at the start, 1, 2 or
                                    * 4 (--knot-ratio; each script 'refine' halves it) */

@@ -18,6 +18,7 @@ argil_err_t sim_rig_init(sim_rig_t *r, const sim_rig_cfg_t *cfg)
     bc.arm = r->sim_params.arm.desc;
     if (board_init(&r->board, &bc) != ARGIL_OK)
         return ARGIL_ERR_ARG;
+    hal_sim_set_tick_us(&r->hal, bc.tick_us);
     board_io_init(&r->io);
     r->from_board.n = 0;
     r->peak_delivered_force_n = 0.0f;

@@ -30,6 +30,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int r = 0;
     if (cli_knot_ratio(s, &r))
         check(r == 1 || r == 2 || r == 4);
+    uint32_t tick_us = 0;
+    if (cli_rate_hz(s, &tick_us))
+        check(tick_us == 1000u || tick_us == 500u || tick_us == 250u);
     float sec = 0.0f;
     if (cli_autosave_s(s, &sec))
         check(isfinite(sec) && sec >= 0.0009f && sec <= 3600.0f);

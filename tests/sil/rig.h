@@ -222,6 +222,7 @@ static inline void rig_set_tick_us(rig_t *r, uint32_t tick_us)
 {
     r->tick_us = tick_us;
     r->rig.board.cfg.tick_us = tick_us;
+    hal_sim_set_tick_us(&r->rig.hal, tick_us);
 }
 
 /* One board tick of the whole system (one millisecond unless rig_set_tick_us said otherwise). */
