@@ -475,7 +475,9 @@ static vec3_t shape_force(board_t *b, const haptics_out_t *h, float scale, float
      * spring to the grab point; letting go of a pull inside the bump it raised met the clay
      * 3 mm deep and threw the stylus out at the 3.3 N limit). */
     if (b->swapped || h->hold_edge) {
-        b->swap_offset_n = vec3_add(b->swap_offset_n, vec3_sub(b->force_n, f));
+        /* the offset that makes this tick feel like the last (which already held the old
+         * offset: adding to it counted that twice, a step each swap during a fade) */
+        b->swap_offset_n = vec3_sub(b->force_n, f);
         b->swapped = false;
     }
     f = vec3_add(f, b->swap_offset_n);

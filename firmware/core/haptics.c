@@ -14,6 +14,8 @@ void haptics_init(haptics_t *h)
     h->vcp_m = vec3(0, 0, 0);
     h->grabbing = false;
     h->pushing = false;
+    h->let_go = false;
+    h->embedded_m = 0.0f;
     h->grab_pos_m = vec3(0, 0, 0);
     h->grab_density = 0.0f;
 }
@@ -392,6 +394,20 @@ static vec3_t contact_force(haptics_t *h, const msg_tool_t *tool, const window_b
     }
     if (!hit) {
         h->in_contact = false;
+        h->let_go = false;
+        h->embedded_m = 0.0f;
+        return vec3(0, 0, 0);
+    }
+    /* Let go inside the clay a pull raised around the tool: that depth is where contact
+     * starts, and coming out lowers it. */
+    if (h->let_go) {
+        h->embedded_m = pen;
+        h->let_go = false;
+    }
+    h->embedded_m = fminf(h->embedded_m, pen);
+    pen -= h->embedded_m;
+    if (!(pen > 0.0f)) {
+        h->in_contact = false;
         return vec3(0, 0, 0);
     }
     vec3_t vcp = vec3_add(p, vec3_scale(n, pen));
@@ -484,6 +500,8 @@ void haptics_process(haptics_t *h, const msg_tool_t *tool, window_buf_t *win, ve
     const bool grabbing = hold && (tool->kind == TOOL_PULL || tool->kind == TOOL_ROPE);
     const bool pushing = tool->kind == TOOL_PUSH && hold;
     out->hold_edge = h->grabbing != grabbing || h->pushing != pushing;
+    if (h->grabbing && !grabbing)
+        h->let_go = true;
     h->grabbing = grabbing;
     h->pushing = pushing;
 

@@ -26,6 +26,10 @@ typedef struct {
     vec3_t vcp_m;              /* virtual contact point: where the tool centre rests on the surface */
     bool grabbing;             /* button held with pull or rope */
     bool pushing;              /* button held with push (the clay may flow) */
+    bool let_go;               /* a pull or rope let go: the next contact starts embedded */
+    float embedded_m;          /* how deep the tool sat in the clay when it let go; contact
+                                  counts only the penetration beyond it, and it shrinks as the
+                                  tool comes out, so the bump it raised does not throw it */
     vec3_t grab_pos_m;         /* reference point where the button went down */
     float grab_density;
 } haptics_t;

@@ -51,7 +51,10 @@ static void test_session_figures(void **st)
     /* one solve per 10 ms of simulated time */
     assert_true(runs.sum[0].solves >= (uint32_t)(runs.sum[0].sim_seconds * 100.0) - 2u);
     assert_int_equal(runs.sum[0].solve_errors, 0);
-    assert_true(runs.sum[0].peak_force_n > 1.0f);
+    /* the clay was felt: the touch holds the tool 2 mm into the top with the 800 N/m grip in
+     * series with the 0.8 N/mm tool, about 0.8 N (until 2026-12-04 the peak was the 3.3 N of
+     * the pull's release throwing the stylus, docs/haptics.md "Chatter") */
+    assert_true(runs.sum[0].peak_delivered_force_n > 0.6f);
     assert_true(runs.sum[0].peak_delivered_force_n <= runs.sum[0].force_limit_n + 0.01f);
     assert_int_equal(runs.sum[0].final_state, SAFETY_ACTIVE);
     assert_int_equal(runs.sum[0].link_errors, 0);

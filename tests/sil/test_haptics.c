@@ -332,6 +332,58 @@ static void test_push_into_the_clay_does_not_buzz(void **st)
     rig_free(r);
 }
 
+/* Where the host's clay surface crosses the +x axis, coming in from x = 45 mm. */
+static float surface_x(const rig_t *r)
+{
+    float prev = grid_density_at(&r->grid, vec3(0.045f, 0, 0));
+    for (int k = 1; k <= 4500; k++) {
+        const float x = 0.045f - 1e-5f * (float)k;
+        const float d = grid_density_at(&r->grid, vec3(x, 0, 0));
+        if (prev < r->grid.iso && d >= r->grid.iso)
+            return x + 1e-5f * (d - r->grid.iso) / (d - prev);
+        prev = d;
+    }
+    return -1.0f;
+}
+
+/* The default session's pull (out/session.scn): the pull tool grabs the clay at the +x side,
+ * draws a bump out 9 mm in 1 s and lets go with the tool still inside the clay it raised, then
+ * withdraws. Letting go must not throw the stylus: contact starts from the depth the tool sat
+ * at, so the force stays near the spring's at the release (below 1 N), with no step above
+ * 0.2 N. Before: the contact met the clay ~3 mm deep and ran to the 3.3 N limit in 3 ticks. */
+static void test_letting_go_of_a_pull_does_not_throw(void **st)
+{
+    (void)st;
+    rig_t *r = rig_new(0.8f);
+    assert_true(rig_until_active(r, 1000) > 0);
+    rig_move(r, vec3(0.045f, 0, 0.045f), 600);
+    rig_move(r, vec3(0.045f, 0, 0), 600);
+    rig_move(r, vec3(0.033f, 0, 0), 400);
+    msg_tool_t t = rig_tool(r, TOOL_PULL, 0.8f);
+    rig_set_tool(r, &t);
+    r->btn1 = true;
+    rig_move(r, vec3(0.031f, 0, 0), 300);
+    rig_move(r, vec3(0.040f, 0, 0), 1000);
+    const float bump = surface_x(r);
+    r->btn1 = false;
+    chatter_t c;
+    memset(&c, 0, sizeof(c));
+    float peak = 0.0f;
+    const vec3_t from = r->hand_model_m;
+    for (int i = 1; i <= 400; i++) {
+        r->hand_model_m = vec3_add(from, vec3(0.010f * (float)i / 400.0f, 0, 0));
+        chatter_tick(r, &c);
+        peak = fmaxf(peak, vec3_norm(sim_device_delivered_force_n(&r->rig.dev)));
+    }
+    printf("# pull let go inside its bump (surface at x = %.1f mm, tool centre at %.1f mm): "
+           "delivered force at most %.3f N after, %u steps > 0.2 N\n", bump * 1e3,
+           from.x * 1e3, peak, c.steps);
+    assert_true(bump > 0.031f);              /* the pull did raise a bump */
+    assert_true(peak < 1.0f);
+    assert_int_equal(c.steps, 0);
+    rig_free(r);
+}
+
 /* A late bus (the drives' frames reach the board 8 ticks at a time, as under emulation) while
  * the hand swings the stylus at about 0.45 m/s through free space: the board's velocity is the
  * motion over the ticks it took, never several ticks' motion read as one, so the velocity limit
@@ -385,16 +437,29 @@ static void test_window_swap_under_3N_is_not_felt(void **st)
     const uint32_t swaps = r->rig.board.stats.windows_swapped;
     send_wall(r, wall - 0.0004f, vec3_add(rig_tip_model(r), vec3(0.002f, 0.0f, 0.001f)), 0.0f,
               0.0f);
-    float prev = r->rig.board.force_n.z, worst = 0.0f;
+    float prev = r->rig.board.force_n.z, worst = 0.0f, offset_at_second = 0.0f;
+    int since_first = -1;
     for (int i = 0; i < 200; i++) {
+        /* … and 8 ticks after the first swap, while its step is still fading, another 0.4 mm
+         * (a host sends a window every 20 ms or sooner; the second swap must not count the
+         * first's offset twice) */
+        if (since_first < 0 && r->rig.board.stats.windows_swapped == swaps + 1)
+            since_first = 0;
+        if (since_first >= 0 && since_first++ == 8) {
+            offset_at_second = fabsf(r->rig.board.swap_offset_n.z);
+            send_wall(r, wall - 0.0008f, vec3_add(rig_tip_model(r), vec3(0.002f, 0.0f, 0.001f)),
+                      0.0f, 0.0f);
+        }
         rig_tick(r);
         const float dz = fabsf(r->rig.board.force_n.z - prev);
         if (dz > worst)
             worst = dz;
         prev = r->rig.board.force_n.z;
     }
-    assert_int_equal(r->rig.board.stats.windows_swapped, swaps + 1);
-    printf("# swap at %.2f N: largest tick-to-tick change %.4f N\n", prev, worst);
+    assert_int_equal(r->rig.board.stats.windows_swapped, swaps + 2);
+    printf("# two swaps at %.2f N, the second while %.3f N of the first's step was fading: "
+           "largest tick-to-tick change %.4f N\n", prev, offset_at_second, worst);
+    assert_true(offset_at_second > 0.1f); /* the second came while the first still faded */
     assert_true(worst < 0.1f);
     rig_free(r);
 }
@@ -559,6 +624,7 @@ int main(void)
         cmocka_unit_test(test_stiff_wall_settles_and_stays_passive),
         cmocka_unit_test(test_held_wall_force_is_steady),
         cmocka_unit_test(test_push_into_the_clay_does_not_buzz),
+        cmocka_unit_test(test_letting_go_of_a_pull_does_not_throw),
         cmocka_unit_test(test_late_bus_reads_the_true_velocity),
         cmocka_unit_test(test_window_swap_under_3N_is_not_felt),
         cmocka_unit_test(test_probe_feels_four_times_the_stiffness),

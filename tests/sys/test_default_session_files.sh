@@ -56,8 +56,9 @@ grep -q 'NOT watertight' "$tmp/summary" && fail "the mesh is not watertight"
 peak=$(sed -n 's/^ *peak force *\([0-9.]*\) N (limit \([0-9.]*\) N).*/\1 \2/p' "$tmp/summary")
 delivered=$(sed -n 's/^ *delivered force *\([0-9.]*\) N at most.*/\1/p' "$tmp/summary")
 [ -n "$peak" ] && [ -n "$delivered" ] || fail "the summary has no peak or delivered force line"
-echo "$peak $delivered" | awk '{ exit !($1 > 1.0 && $1 <= $2 + 1e-6 && $3 > 1.0 && $3 <= $2 + 0.01) }' ||
-    fail "peak force $peak (commanded, limit) / delivered $delivered N: outside 1 N .. the limit"
+# Felt at all: the touch holds the tool 2 mm into the top, grip and tool in series: ~0.8 N.
+echo "$peak $delivered" | awk '{ exit !($1 > 0.6 && $1 <= $2 + 1e-6 && $3 > 0.6 && $3 <= $2 + 0.01) }' ||
+    fail "peak force $peak (commanded, limit) / delivered $delivered N: outside 0.6 N .. the limit"
 
 # The telemetry CSV: header, one row per tick, forces bounded.
 head -n 1 "$tmp/a/telemetry.csv" | grep -q '^time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state' ||
