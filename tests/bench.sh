@@ -55,6 +55,10 @@ echo "  loop rate 1/2/4 kHz; the stable region is the largest K where all three 
 zw_start=$(date +%s)
 "$hb" zwidth
 echo "  (Z-width sweep: $(($(date +%s) - zw_start)) s wall clock)"
+echo "  The same sweep on the Premium arm profile (docs/arm.md), side by side with the default's:"
+zw_start=$(date +%s)
+"$hb" zwidth premium
+echo "  (Z-width sweep, Premium arm: $(($(date +%s) - zw_start)) s wall clock)"
 if command -v valgrind >/dev/null 2>&1 && command -v callgrind_annotate >/dev/null 2>&1; then
     echo "  tick cost while sculpting (push tool, 2 s stroke), board_tick inclusive:"
     for shape in point curve area; do

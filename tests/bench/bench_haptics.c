@@ -70,10 +70,20 @@ static float wall_damping(const wall_cfg_t *c)
 
 /* A manual-host rig whose window is a flat wall below the stylus (material at model z < wall_z,
  * normal +z), gap_m from the tool's surface, with the hand's grip set; NULL if never ACTIVE. */
+/* The simulated arm every wall runs on: the default (rigid) arm, or arm_params_premium's
+ * (cable mode, current loop, 12-bit DAC: docs/arm.md) with `zwidth premium`. */
+static bool premium_arm;
+
 static rig_t *wall_rig_new(const wall_cfg_t *c, float gap_m, float grip_n_per_m,
                            float grip_n_s_per_m, float *wall_z)
 {
     rig_t *r = rig_new_mode(c->k_n_per_mm, true);
+    if (premium_arm) {
+        /* the same geometry, gears and encoders (the board's arm is unchanged), the
+         * Premium dynamics: the device starts over with them before its first step */
+        arm_params_premium(&r->rig.sim_params.arm);
+        sim_device_init(&r->rig.dev, &r->rig.sim_params);
+    }
     rig_set_tick_us(r, c->tick_us);
     board_cfg_t *bc = &r->rig.board.cfg; /* after board_init: a negative B is allowed here */
     bc->passivity = c->passivity;
@@ -790,6 +800,10 @@ int main(int argc, char **argv)
         return 0;
     }
     if (argc >= 2 && strcmp(argv[1], "zwidth") == 0) {
+        premium_arm = argc >= 3 && strcmp(argv[2], "premium") == 0;
+        printf("  Arm: %s\n", premium_arm ? "arm_params_premium (cable mode 800 N m/rad, 1 kHz "
+               "current loop, 12-bit torque DAC; docs/arm.md)" : "arm_params_default (rigid links, "
+               "no current-loop lag, no DAC)");
         zwidth();
         return 0;
     }
@@ -797,7 +811,7 @@ int main(int argc, char **argv)
         tick_workload(argv[2], atoi(argv[3]));
         return 0;
     }
-    fprintf(stderr, "usage: bench_haptics zwidth | wall K_N_PER_MM B_N_S_PER_M|shipped|before PC(0|1) TICK_US |\n"
+    fprintf(stderr, "usage: bench_haptics zwidth [premium] | wall K_N_PER_MM B_N_S_PER_M|shipped|before PC(0|1) TICK_US |\n"
                     "       tick point|curve|area 16|32\n");
     return 2;
 }
