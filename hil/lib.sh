@@ -125,6 +125,14 @@ board_wait() {
     return 1
 }
 board_alive() { [ -n "$BOARD_PID" ] && kill -0 "$BOARD_PID" 2>/dev/null; }
+# The board's account of its last host-lost fault ("host lost at tick N: its last frame taken
+# in … ms before; the link thread last ran … ms before and last queued a datagram … ms before"),
+# for a failure message: whether hil-host fell silent, the link thread was held off, or the
+# datagrams reached the link thread and not the loop. Empty when it had none.
+board_host_lost() {
+    sed -n 's/^[0-9.]* argil-board: \(host lost at tick .*\)$/; board: \1/p' "$OUT/$CHECK.board.log" 2>/dev/null | tail -n 1
+}
+
 board_tail() { tail -n "${1:-3}" "$OUT/$CHECK.board.log" 2>/dev/null | cut -d' ' -f2- | tr '\n' '|'; }
 # SIGTERM, then the exit status (0 = clean stop with statistics).
 board_stop() {
@@ -668,7 +676,7 @@ check_scenario() {
     if [ "$st" != 0 ]; then
         # what the board went through, as hil-host saw it ("tick=714 state IDLE|…")
         hstates=$(sed -n 's/^[0-9.]* \(tick=[0-9]* state [A-Z_]*\)$/\1/p; s/^[0-9.]* \(tick=[0-9]* ready\):.*/\1/p' "$OUT/$CHECK.host.log" | tail -n 4 | tr '\n' '|')
-        fail "argil-sim exit $st: $(tail -n 2 "$OUT/$CHECK.sim.out" | tr '\n' '|') [host saw: ${hstates:-no telemetry}]"
+        fail "argil-sim exit $st: $(tail -n 2 "$OUT/$CHECK.sim.out" | tr '\n' '|') [host saw: ${hstates:-no telemetry}$(board_host_lost)]"
         return
     fi
     [ "$hst" = 0 ] || [ "$hst" = 3 ] || { fail "hil-host exit $hst: $(tail -n 2 "$OUT/$CHECK.host.log" | tr '\n' '|')"; return; }
@@ -715,7 +723,7 @@ check_scenario() {
     states=$(sed -n 's/^[0-9.]* argil-board: state \([A-Z]*\)\( — \(.*\)\)*$/\1(\3)/p' "$OUT/$CHECK.board.log" | sed 's/()//' | tr '\n' ' ')
     # and its last word (a daemon that gave up says why: "CAN bus-off not recovered ...").
     last=$(tail -n 1 "$OUT/$CHECK.board.log" | cut -d' ' -f2-)
-    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag$late$hgap; board: $states; last: $last]"; return; }
+    [ "$cst" = 0 ] || { fail "$res: $bad [$pre$lag$late$hgap; board: $states; last: $last$(board_host_lost)]"; return; }
     # A stranger on the network (`stranger KIND for D`): the board refused its frames by reason,
     # as its RT_STATS told hil-host, and served one host session throughout.
     if grep -q '^at .* stranger ' "$scn"; then

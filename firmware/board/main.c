@@ -179,6 +179,19 @@ static int parse_args(board_daemon_cfg_t *c, int argc, char **argv)
 
 /* ---- shared state between the threads ---- */
 
+/* What the fast loop saw at the tick its host session lapsed (FAULT "host heartbeat lost"),
+ * for the log: whether the host fell silent, the link thread was held off, or datagrams
+ * reached the link thread and not the loop (hil/plan.txt: rt-scenario-link-nan). */
+typedef struct {
+    uint32_t seq;                  /* 0: none yet; +1 at each host-lost fault */
+    uint32_t tick;
+    uint32_t silence_us;           /* since the last host frame the core took in */
+    uint64_t at_ns;                /* CLOCK_MONOTONIC at that tick */
+    uint64_t link_turn_ns;         /* the link thread's latest turn then (0: no UDP thread) */
+    uint64_t link_rx_ns;           /* … when it last queued a datagram for the loop */
+    uint32_t link_rx_count;        /* datagrams it had queued so far */
+} host_lost_t;
+
 typedef struct {
     _Atomic uint32_t seq;          /* odd while the fast loop writes the snapshot */
     rt_stats_t stats;
@@ -193,6 +206,7 @@ typedef struct {
     uint8_t bus;
     bool window;
     bool tool;
+    host_lost_t lost;              /* the latest host-lost fault, as the fast loop saw it */
 } snapshot_t;
 
 typedef struct {
@@ -205,6 +219,10 @@ typedef struct {
     _Atomic bool stop;
     _Atomic bool ffs_enabled;
     _Atomic int loop_status;       /* 0 running/clean, else the exit status */
+    _Atomic uint64_t link_turn_ns; /* the UDP link thread's latest turn */
+    _Atomic uint64_t link_rx_ns;   /* … when it last queued a datagram for the loop */
+    _Atomic uint32_t link_rx_count;
+    host_lost_t lost;              /* fast loop only; published in the snapshot */
     snapshot_t snap;
     rt_stats_t rt;                 /* fast loop only */
     char loop_err[160];
@@ -241,6 +259,7 @@ static void publish(daemon_t *d)
     s->bus = (uint8_t)d->board->drives.bus;
     s->window = window_active(&d->board->window) != NULL;
     s->tool = d->board->tool_valid;
+    s->lost = d->lost;
     atomic_fetch_add_explicit(&s->seq, 1u, memory_order_release);
 }
 
@@ -258,6 +277,7 @@ static void read_snapshot(daemon_t *d, snapshot_t *out)
         out->can_tx_errors = d->snap.can_tx_errors;
         out->link_tx_dropped = d->snap.link_tx_dropped;
         out->link = d->snap.link;
+        out->lost = d->snap.lost;
         memcpy(out->nmt, d->snap.nmt, sizeof(out->nmt));
         memcpy(out->power, d->snap.power, sizeof(out->power));
         out->bus = d->snap.bus;
@@ -278,6 +298,19 @@ static void prefault_stack(void)
         buf[i] = 0;
 }
 
+/* Latches what the link looked like at the tick the host session lapsed. */
+static void note_host_lost(daemon_t *d, uint64_t now)
+{
+    d->lost.seq++;
+    d->lost.tick = d->board->stats.ticks;
+    d->lost.silence_us = d->board->session.silence_us;
+    d->lost.at_ns = now;
+    d->lost.link_turn_ns = atomic_load_explicit(&d->link_turn_ns, memory_order_relaxed);
+    d->lost.link_rx_ns = atomic_load_explicit(&d->link_rx_ns, memory_order_relaxed);
+    d->lost.link_rx_count = atomic_load_explicit(&d->link_rx_count, memory_order_relaxed);
+    publish(d);
+}
+
 static void *fast_loop(void *arg)
 {
     daemon_t *d = arg;
@@ -296,7 +329,12 @@ static void *fast_loop(void *arg)
         const uint32_t wake_ns = woke > next ? (uint32_t)(woke - next < 0xFFFFFFFFu ? woke - next
                                                                                     : 0xFFFFFFFFu)
                                              : 0u;
+        const bool was_lost = d->board->safety.state == SAFETY_FAULT &&
+                              d->board->safety.fault == FAULT_HOST_LOST;
         const uint32_t compute_ns = board_run_tick(d->board, &d->io, d->hal);
+        if (!was_lost && d->board->safety.state == SAFETY_FAULT &&
+            d->board->safety.fault == FAULT_HOST_LOST)
+            note_host_lost(d, woke);
         /* The core sees the whole tick, release to done (wake-up latency + compute), so a late
          * wake counts as overrun; it records both in its RT_STATS for the host. */
         d->io.prev_wake_ns = wake_ns;
@@ -363,9 +401,14 @@ static void *udp_thread(void *arg)
     const struct timespec nap = {0, 250000};
     while (!atomic_load(&d->stop)) {
         size_t n;
-        const uint64_t now_us = now_ns() / 1000u;
-        while ((n = link_udp_receive(&d->udp, rx, sizeof(rx), now_us)) > 0)
+        const uint64_t turn_ns = now_ns();
+        const uint64_t now_us = turn_ns / 1000u;
+        atomic_store_explicit(&d->link_turn_ns, turn_ns, memory_order_relaxed);
+        while ((n = link_udp_receive(&d->udp, rx, sizeof(rx), now_us)) > 0) {
             (void)spsc_push(&d->hal->link_rx, rx, n);
+            atomic_store_explicit(&d->link_rx_ns, now_ns(), memory_order_relaxed);
+            atomic_fetch_add_explicit(&d->link_rx_count, 1u, memory_order_relaxed);
+        }
         const hal_link_refusals_t refused = {d->udp.bind.refused_source,
                                              d->udp.bind.refused_no_session, d->udp.bad_mac,
                                              d->udp.bad_nonce};
@@ -551,6 +594,28 @@ static bool burst_starts(refusal_burst_t *b, uint32_t count, uint64_t now)
     return starts;
 }
 
+/* One line per host-lost fault: who went quiet, the host, the link thread or the hand-over. */
+static void log_host_lost(const host_lost_t *l)
+{
+    const double ms_before = (double)l->silence_us / 1e3;
+    if (l->link_turn_ns == 0) {
+        fprintf(stderr, PROG ": host lost at tick %u: its last frame taken in %.1f ms before\n",
+                l->tick, ms_before);
+        return;
+    }
+    const double turn_ms = (double)(l->at_ns - l->link_turn_ns) / 1e6;
+    if (l->link_rx_ns == 0) {
+        fprintf(stderr, PROG ": host lost at tick %u: its last frame taken in %.1f ms before; "
+                "the link thread last ran %.1f ms before and has queued no datagram\n",
+                l->tick, ms_before, turn_ms);
+        return;
+    }
+    fprintf(stderr, PROG ": host lost at tick %u: its last frame taken in %.1f ms before; the "
+            "link thread last ran %.1f ms before and last queued a datagram %.1f ms before "
+            "(%u so far)\n", l->tick, ms_before, turn_ms,
+            (double)(int64_t)(l->at_ns - l->link_rx_ns) / 1e6, l->link_rx_count);
+}
+
 static void log_refusal_bursts(const snapshot_t *s, refusal_bursts_t *b, uint64_t now)
 {
     if (burst_starts(&b->bad_mac, s->link.bad_mac, now))
@@ -663,6 +728,7 @@ int main(int argc, char **argv)
 
     /* Main thread: signals, state changes and periodic statistics; never touches the loop. */
     uint32_t last_state = 0xFFFFFFFFu;
+    uint32_t lost_seen = 0;
     uint64_t next_stats = now_ns() + (uint64_t)c->stats_period_s * 1000000000u;
     const struct timespec wait = {0, 20000000};
     snapshot_t s;
@@ -682,6 +748,10 @@ int main(int argc, char **argv)
                     s.state == SAFETY_FAULT || s.state == SAFETY_ESTOP
                         ? safety_fault_name((fault_code_t)s.fault) : "");
             last_state = s.state;
+        }
+        if (s.lost.seq != lost_seen) {
+            log_host_lost(&s.lost);
+            lost_seen = s.lost.seq;
         }
         log_refusal_bursts(&s, &bursts, now_ns());
         if (c->stats_period_s > 0 && now_ns() >= next_stats) {
