@@ -303,7 +303,7 @@ static void test_plot_draws_axes_and_series(void **state)
     canvas_t c;
     const rgb8_t white = {255, 255, 255};
     assert_int_equal(canvas_init(&c, 800, 500, white), ARGIL_OK);
-    assert_int_equal(plot_telemetry(&log, &c, "test"), ARGIL_OK);
+    assert_int_equal(plot_telemetry(&log, &c, "test", NULL, NULL), ARGIL_OK);
     size_t red = 0, blue = 0, dark = 0;
     for (size_t i = 0; i < (size_t)800 * 500; i++) {
         const uint8_t *p = c.rgb + 3 * i;
@@ -316,7 +316,7 @@ static void test_plot_draws_axes_and_series(void **state)
     assert_true(dark > 2000); /* frames, ticks, labels */
     canvas_t small;
     assert_int_equal(canvas_init(&small, 100, 100, white), ARGIL_OK);
-    assert_int_equal(plot_telemetry(&log, &small, NULL), ARGIL_ERR_ARG);
+    assert_int_equal(plot_telemetry(&log, &small, NULL, NULL, NULL), ARGIL_ERR_ARG);
     canvas_free(&small);
     canvas_free(&c);
     telemetry_log_free(&log);
