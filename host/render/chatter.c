@@ -6,13 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* CHATTER_WINDOW_S / the mean row interval, at least 1 row. */
+/* span_s / the mean row interval, 1 to log->n rows. */
 static size_t rows_for(const telemetry_log_t *log, double span_s)
 {
     const double dur = log->time_s[log->n - 1] - log->time_s[0];
-    if (log->n < 2 || dur <= 0.0)
+    if (log->n < 2 || !(dur > 0.0))
         return 1;
     const double rows = span_s / (dur / (double)(log->n - 1));
+    if (!(rows < (double)log->n))
+        return log->n; /* also a duration too short to divide by */
     return rows < 1.5 ? 1 : (size_t)lround(rows);
 }
 
