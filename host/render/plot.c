@@ -49,7 +49,9 @@ static void format_tick(char *buf, size_t len, double v, double step)
 /* Frame, horizontal grid with y tick labels, and the rotated axis name. */
 static void draw_y_axis(canvas_t *c, const panel_t *p, const char *name, int s)
 {
-    const double step = plot_nice_step(p->v1 - p->v0, 4);
+    /* About 4 labelled ticks, fewer when the panel is too short to keep them apart. */
+    const int fit = (p->y1 - p->y0) / (3 * FONT_H * s);
+    const double step = plot_nice_step(p->v1 - p->v0, fit < 1 ? 1 : (fit > 4 ? 4 : fit));
     char buf[32];
     for (double v = ceil(p->v0 / step - 1e-9) * step; v <= p->v1 + step * 1e-9; v += step) {
         const int y = px_y(p, v);
