@@ -4,10 +4,12 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const rgb8_t BG = {255, 255, 255}, INK = {30, 30, 35}, GRID = {225, 228, 232},
-                    FORCE = {200, 40, 40}, HEIGHT = {30, 90, 190};
+                    FORCE = {200, 40, 40}, HEIGHT = {30, 90, 190}, HIGH_PASS = {150, 60, 20},
+                    GOAL = {0, 160, 70}, STEP = {235, 120, 0};
 static const rgb8_t STATE_COLORS[TELEMETRY_STATES_MAX] = {
     {150, 150, 150}, {240, 190, 60}, {70, 170, 90}, {200, 60, 60},
     {120, 90, 200}, {60, 170, 200}, {220, 120, 180}, {110, 110, 60}};
@@ -47,7 +49,9 @@ static void format_tick(char *buf, size_t len, double v, double step)
 /* Frame, horizontal grid with y tick labels, and the rotated axis name. */
 static void draw_y_axis(canvas_t *c, const panel_t *p, const char *name, int s)
 {
-    const double step = plot_nice_step(p->v1 - p->v0, 4);
+    /* About 4 labelled ticks, fewer when the panel is too short to keep them apart. */
+    const int fit = (p->y1 - p->y0) / (3 * FONT_H * s);
+    const double step = plot_nice_step(p->v1 - p->v0, fit < 1 ? 1 : (fit > 4 ? 4 : fit));
     char buf[32];
     for (double v = ceil(p->v0 / step - 1e-9) * step; v <= p->v1 + step * 1e-9; v += step) {
         const int y = px_y(p, v);
@@ -114,6 +118,40 @@ static void draw_series(canvas_t *c, const panel_t *p, const telemetry_log_t *lo
     }
 }
 
+/* The chatter panel: the high-passed force clipped to the panel's top, the goal as a line,
+ * each counted step as a mark on the top edge, and the figure as the heading inside. */
+static void draw_chatter(canvas_t *c, const panel_t *p, const telemetry_log_t *log,
+                         const chatter_t *ch, const chatter_trace_t *tr, int s)
+{
+    draw_x_axis(c, p, false, s);
+    draw_y_axis(c, p, "> 50 HZ (N)", s);
+    float *clipped = malloc(log->n * sizeof(*clipped));
+    if (clipped != NULL) {
+        for (size_t i = 0; i < log->n; i++)
+            clipped[i] = fminf(tr->high_pass_n[i], (float)p->v1);
+        draw_series(c, p, log, clipped, 1, HIGH_PASS, 1);
+        free(clipped);
+    }
+    const int yg = px_y(p, CHATTER_GOAL_RMS_N);
+    canvas_line(c, p->x0, yg, p->x1, yg, s, GOAL);
+    if (tr->step != NULL)
+        for (size_t i = 0; i < log->n; i++)
+            if (tr->step[i])
+                canvas_fill_rect(c, px_x(p, log->time_s[i]) - s, p->y0,
+                                 px_x(p, log->time_s[i]) + s, p->y0 + 5 * s, STEP);
+    draw_frame(c, p);
+    char head[256];
+    chatter_format(ch, head, sizeof(head));
+    if (canvas_text_width(head, s) > p->x1 - p->x0 - 8 * s)
+        snprintf(head, sizeof(head), "%.3f N RMS, %zu STEPS (GOAL %.2f N, 0)", ch->rms_n,
+                 ch->steps, CHATTER_GOAL_RMS_N);
+    /* The heading in the gap above the panel; the goal's name over its line at the right. */
+    canvas_text(c, p->x0, p->y0 - (FONT_H + 2) * s, head, s, chatter_goal_met(ch) ? GOAL : INK);
+    const char *goal = "GOAL";
+    canvas_text(c, p->x1 - canvas_text_width(goal, s) - 4 * s, yg - (FONT_H + 2) * s, goal, s,
+                GOAL);
+}
+
 static void value_range(const telemetry_log_t *log, const float *v, size_t stride, double *lo,
                         double *hi)
 {
@@ -128,7 +166,8 @@ static void value_range(const telemetry_log_t *log, const float *v, size_t strid
     *hi += pad;
 }
 
-argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *title)
+argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *title,
+                           const chatter_t *ch, const chatter_trace_t *tr)
 {
     if (log->n == 0 || c->width < 320 || c->height < 240)
         return ARGIL_ERR_ARG;
@@ -138,7 +177,11 @@ argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *
     const int top = 30 * s, bottom = c->height - 50 * s;
     const int gap = 14 * s;
     const int h_state = 26 * s;
-    const int h_main = (bottom - top - h_state - 2 * gap) / 2;
+    const bool with_chatter = ch != NULL && tr != NULL && tr->high_pass_n != NULL;
+    const int h_panels = bottom - top - h_state - (with_chatter ? 3 : 2) * gap;
+    /* With the chatter panel: force and z 3/8 each, the chatter panel 1/4. */
+    const int h_main = with_chatter ? h_panels * 3 / 8 : h_panels / 2;
+    const int h_chatter = with_chatter ? h_panels - 2 * h_main : -gap;
     double t0 = log->time_s[0], t1 = log->time_s[log->n - 1];
     if (t1 - t0 < 1e-9)
         t1 = t0 + 1.0;
@@ -148,7 +191,12 @@ argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *
     value_range(log, log->force_mag_n, 1, &lo, &hi);
     pf.v0 = fmin(0.0, lo);
     pf.v1 = hi;
-    panel_t pz = {left, pf.y1 + gap, right, pf.y1 + gap + h_main, t0, t1, 0, 0};
+    /* 0 to a little over the trace's peak, at least 3 goals and at most 10 (spikes clip). */
+    panel_t ph = {left, pf.y1 + gap, right, pf.y1 + gap + h_chatter, t0, t1, 0,
+                  3 * CHATTER_GOAL_RMS_N};
+    for (size_t i = 0; with_chatter && i < log->n; i++)
+        ph.v1 = fmax(ph.v1, fmin(1.06 * tr->high_pass_n[i], 10 * CHATTER_GOAL_RMS_N));
+    panel_t pz = {left, ph.y1 + gap, right, ph.y1 + gap + h_main, t0, t1, 0, 0};
     value_range(log, log->pos_mm + 2, 3, &pz.v0, &pz.v1);
     panel_t ps = {left, pz.y1 + gap, right, pz.y1 + gap + h_state, t0, t1, 0, 1};
 
@@ -158,6 +206,8 @@ argil_err_t plot_telemetry(const telemetry_log_t *log, canvas_t *c, const char *
     draw_y_axis(c, &pf, "FORCE (N)", s);
     draw_series(c, &pf, log, log->force_mag_n, 1, FORCE, s);
     draw_frame(c, &pf);
+    if (with_chatter)
+        draw_chatter(c, &ph, log, ch, tr, s);
     draw_x_axis(c, &pz, false, s);
     draw_y_axis(c, &pz, "TOOL Z (MM)", s);
     draw_series(c, &pz, log, log->pos_mm + 2, 3, HEIGHT, s);

@@ -4,15 +4,19 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { COL_T, COL_X, COL_Y, COL_Z, COL_FX, COL_FY, COL_FZ, COL_F, COL_STATE, COL_COUNT };
+/* Required columns, then the optional ones (COL_REQUIRED..COL_COUNT-1: -1 when absent). */
+enum { COL_T, COL_X, COL_Y, COL_Z, COL_FX, COL_FY, COL_FZ, COL_F, COL_STATE, COL_CONTACT,
+       COL_COUNT, COL_REQUIRED = COL_CONTACT };
 enum { LINE_MAX_CHARS = 1024, FIELDS_MAX = 64 };
 
 static const char *const COL_NAMES[COL_COUNT] = {"time_s", "x_mm", "y_mm", "z_mm", "fx_n",
-                                                  "fy_n", "fz_n", "force_n", "state"};
+                                                  "fy_n", "fz_n", "force_n", "state",
+                                                  "contact"};
 
 void telemetry_log_free(telemetry_log_t *log)
 {
@@ -21,6 +25,7 @@ void telemetry_log_free(telemetry_log_t *log)
     free(log->force_n);
     free(log->force_mag_n);
     free(log->state);
+    free(log->contact);
     memset(log, 0, sizeof(*log));
 }
 
@@ -43,7 +48,7 @@ static int split(char *line, char *fields[FIELDS_MAX])
     }
 }
 
-static argil_err_t grow(telemetry_log_t *log, size_t *cap)
+static argil_err_t grow(telemetry_log_t *log, size_t *cap, bool with_contact)
 {
     const size_t nc = *cap ? *cap * 2 : 4096;
     double *t = realloc(log->time_s, nc * sizeof(*t));
@@ -56,7 +61,9 @@ static argil_err_t grow(telemetry_log_t *log, size_t *cap)
     if (m) log->force_mag_n = m;
     uint8_t *s = realloc(log->state, nc);
     if (s) log->state = s;
-    if (!t || !p || !f || !m || !s)
+    uint8_t *k = with_contact ? realloc(log->contact, nc) : NULL;
+    if (k) log->contact = k;
+    if (!t || !p || !f || !m || !s || (with_contact && !k))
         return ARGIL_ERR_NOMEM;
     *cap = nc;
     return ARGIL_OK;
@@ -105,6 +112,14 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
         snprintf(log->state_name[si], sizeof(log->state_name[si]), "%s", st);
         log->n_states++;
     }
+    if (log->contact != NULL) {
+        const char *k = fields[col[COL_CONTACT]];
+        if ((k[0] != '0' && k[0] != '1') || k[1] != '\0') {
+            snprintf(err, err_len, "%s: line %u: contact is not 0 or 1: '%.32s'", path, line_no,
+                     k);
+            return ARGIL_ERR_PARSE;
+        }
+    }
     const size_t i = log->n++;
     log->time_s[i] = t;
     for (int k = 0; k < 3; k++) {
@@ -113,6 +128,8 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
     }
     log->force_mag_n[i] = v[COL_F];
     log->state[i] = (uint8_t)si;
+    if (log->contact != NULL)
+        log->contact[i] = (uint8_t)(fields[col[COL_CONTACT]][0] - '0');
     return ARGIL_OK;
 }
 
@@ -147,7 +164,7 @@ argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err
                 for (int k = 0; k < n && col[c] < 0; k++)
                     if (strcmp(fields[k], COL_NAMES[c]) == 0)
                         col[c] = k;
-                if (col[c] < 0) {
+                if (col[c] < 0 && c < COL_REQUIRED) {
                     snprintf(err, err_len, "%s: line 1: the header has no '%s' column (is this "
                                            "a telemetry.csv?)", path, COL_NAMES[c]);
                     rc = ARGIL_ERR_PARSE;
@@ -165,7 +182,7 @@ argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err
             rc = ARGIL_ERR_PARSE;
             break;
         }
-        if (log->n == cap && (rc = grow(log, &cap)) != ARGIL_OK) {
+        if (log->n == cap && (rc = grow(log, &cap, col[COL_CONTACT] >= 0)) != ARGIL_OK) {
             snprintf(err, err_len, "%s: out of memory at line %u", path, line_no);
             break;
         }

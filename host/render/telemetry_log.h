@@ -17,12 +17,13 @@ typedef struct {
     float *force_n;             /* fx fy fz per row */
     float *force_mag_n;
     uint8_t *state;             /* index into state_name */
+    uint8_t *contact;           /* the tool's contact flag, 0 or 1; NULL without the column */
     char state_name[TELEMETRY_STATES_MAX][16];
     int n_states;
 } telemetry_log_t;
 
 /* Reads path. Columns are found by the header's names (time_s x_mm y_mm z_mm fx_n fy_n fz_n
- * force_n state are required; others are skipped). ARGIL_ERR_PARSE with "<path>: line N: why",
+ * force_n state are required; contact is read when present, as 0 or 1; others are skipped). ARGIL_ERR_PARSE with "<path>: line N: why",
  * ARGIL_ERR_IO, ARGIL_ERR_NOMEM; log is empty on error. */
 argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err, size_t err_len);
 

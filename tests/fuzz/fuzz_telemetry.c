@@ -1,10 +1,12 @@
 /* libFuzzer target for the telemetry CSV reader behind `argil plot`: any bytes as a file; a
- * refusal is one line naming the file, an accepted log holds finite, time-ordered rows. */
+ * refusal is one line naming the file, an accepted log holds finite, time-ordered rows whose
+ * contact flags, when the column is there, are 0 or 1, and whose chatter figure is finite. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "host/render/chatter.h"
 #include "host/render/telemetry_log.h"
 #include "tests/fuzz/fuzz_file.h"
 
@@ -27,7 +29,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                         abort();
                 if (log.state[i] >= log.n_states)
                     abort();
+                if (log.contact != NULL && log.contact[i] > 1)
+                    abort();
             }
+            /* The chatter figure of any accepted log is finite and counts within the log. */
+            chatter_t ch;
+            if (chatter_measure(&log, &ch, NULL) == ARGIL_OK &&
+                (!isfinite(ch.rms_n) || ch.contact_ticks > log.n ||
+                 ch.steps + ch.first_contact_steps >= log.n ||
+                 ch.rows_per_window < 1 || ch.rows_per_window > log.n))
+                abort();
             telemetry_log_free(&log);
         }
         else if (!fuzz_error_names_file(err, path))

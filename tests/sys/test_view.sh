@@ -86,11 +86,22 @@ if command -v xvfb-run >/dev/null 2>&1; then
 fi
 
 # The chart (no GL: the sanitizer build).
-"$san" plot "$tmp/out/telemetry.csv" -o "$tmp/plot.png" --width 900 --height 500 ||
-    fail "plot failed"
+"$san" plot "$tmp/out/telemetry.csv" -o "$tmp/plot.png" --width 900 --height 500 \
+    >"$tmp/plot.out" || fail "plot failed"
 set -- $(png_stats "$tmp/plot.png")
 echo "plot: $1 x $2, $3 colours, $4 not background"
 [ "$1" = 900 ] && [ "$2" = 500 ] && [ "$3" -gt 5 ] || fail "plot.png: $*"
+# The session's chatter figure (docs/haptics.md), the same line from the chart and from
+# --chatter, whose status says whether it meets the goal (tests/sys/test_plot_chatter.sh
+# checks both outcomes; whether the default session meets it is the haptics' to assert).
+st=0
+"$san" plot "$tmp/out/telemetry.csv" --chatter >"$tmp/chatter.out" || st=$?
+echo "plot --chatter (exit $st): $(cat "$tmp/chatter.out")"
+[ "$st" = 0 ] || [ "$st" = 1 ] || fail "plot --chatter on the session's log: exit $st"
+grep -q "^force above 50 Hz: [0-9.]* N RMS over [1-9][0-9]* ticks in contact" "$tmp/chatter.out" ||
+    fail "no chatter figure for the session"
+[ "$(head -n 1 "$tmp/plot.out")" = "$(cat "$tmp/chatter.out")" ] ||
+    fail "the chart and --chatter disagree: $(head -n 1 "$tmp/plot.out")"
 
 # Errors: one line, naming the file and the line.
 head -n 50 "$tmp/out/telemetry.csv" >"$tmp/bad.csv"

@@ -1,6 +1,7 @@
 /* The renderer, headless (EGL surfaceless on Mesa llvmpipe): a sphere covers a plausible share
  * of the frame, the lights shade it, the tool is visible, clear-coat looks different from
- * plain; and the telemetry chart: its reader names the bad line, the chart is not blank. */
+ * plain; and the telemetry chart: its reader names the bad line and keeps the contact flag,
+ * the chart is not blank and draws the chatter panel's goal line when given the figure. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,6 +21,7 @@ extern void __lsan_enable(void) __attribute__((weak));
 
 #include "host/mesh/mesh.h"
 #include "host/render/camera.h"
+#include "host/render/chatter.h"
 #include "host/render/offscreen.h"
 #include "host/render/plot.h"
 #include "host/render/telemetry_log.h"
@@ -267,6 +269,10 @@ static void test_telemetry_errors_name_the_line(void **state)
     expect_csv_error(HEADER "0.002,0,0,1,0,0,0,0,IDLE,0,0,0,0\n0.001,0,0,1,0,0,0,0,IDLE,0,0,0,0\n",
                      "line 3: time_s goes backwards");
     expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,,0,0,0,0\n", "line 2: state '' is empty");
+    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,1,0\n0.002,0,0,1,0,0,0,0,A,0,0,2,0\n",
+                     "line 3: contact is not 0 or 1: '2'");
+    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,,0\n", "line 2: contact is not 0 or 1");
+    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,10,0\n", "line 2: contact is not 0 or 1");
     expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,0,0\n0.002,0,0,1,0,0,0,0,B,0,0,0,0\n"
                             "0.003,0,0,1,0,0,0,0,C,0,0,0,0\n0.004,0,0,1,0,0,0,0,D,0,0,0,0\n"
                             "0.005,0,0,1,0,0,0,0,E,0,0,0,0\n0.006,0,0,1,0,0,0,0,F,0,0,0,0\n"
@@ -277,6 +283,46 @@ static void test_telemetry_errors_name_the_line(void **state)
     char err[256];
     assert_int_equal(telemetry_log_read("/nonexistent/telemetry.csv", &log, err, sizeof(err)),
                      ARGIL_ERR_IO);
+}
+
+/* The contact column is kept when the header has it (chatter's first-contact rule), and a log
+ * without it still reads, with no contact flags. */
+static void test_telemetry_contact_column(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/argil-test-render-XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    write_file(path, HEADER "0.001,0,0,1,0,0,0,0,A,0,0,0,0\n0.002,0,0,1,0,0,1,1,A,0,0,1,0\n");
+    telemetry_log_t log;
+    char err[256] = "";
+    assert_int_equal(telemetry_log_read(path, &log, err, sizeof(err)), ARGIL_OK);
+    assert_non_null(log.contact);
+    assert_int_equal(log.contact[0], 0);
+    assert_int_equal(log.contact[1], 1);
+    telemetry_log_free(&log);
+    write_file(path, "time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state\n0.001,0,0,1,0,0,0,0,A\n");
+    assert_int_equal(telemetry_log_read(path, &log, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(log.n, 1);
+    assert_null(log.contact);
+    telemetry_log_free(&log);
+    remove(path);
+}
+
+/* The longest horizontal run of pixels of colour r g b: a line across the plot. */
+static int longest_run(const canvas_t *c, uint8_t r, uint8_t g, uint8_t b)
+{
+    int best = 0;
+    for (int y = 0; y < c->height; y++) {
+        int run = 0;
+        for (int x = 0; x < c->width; x++) {
+            const uint8_t *p = c->rgb + 3 * ((size_t)y * (size_t)c->width + (size_t)x);
+            run = (p[0] == r && p[1] == g && p[2] == b) ? run + 1 : 0;
+            best = run > best ? run : best;
+        }
+    }
+    return best;
 }
 
 static void test_plot_draws_axes_and_series(void **state)
@@ -303,7 +349,7 @@ static void test_plot_draws_axes_and_series(void **state)
     canvas_t c;
     const rgb8_t white = {255, 255, 255};
     assert_int_equal(canvas_init(&c, 800, 500, white), ARGIL_OK);
-    assert_int_equal(plot_telemetry(&log, &c, "test"), ARGIL_OK);
+    assert_int_equal(plot_telemetry(&log, &c, "test", NULL, NULL), ARGIL_OK);
     size_t red = 0, blue = 0, dark = 0;
     for (size_t i = 0; i < (size_t)800 * 500; i++) {
         const uint8_t *p = c.rgb + 3 * i;
@@ -314,9 +360,22 @@ static void test_plot_draws_axes_and_series(void **state)
     assert_true(red > 500);   /* the force curve */
     assert_true(blue > 500);  /* the z curve */
     assert_true(dark > 2000); /* frames, ticks, labels */
+    /* With the chatter figure: its panel's goal line (green, 0 160 70) across the plot. */
+    const int goal_before = longest_run(&c, 0, 160, 70);
+    chatter_t ch;
+    float *hp = calloc(log.n, sizeof(float));
+    assert_non_null(hp);
+    const chatter_trace_t tr = {hp, NULL};
+    assert_int_equal(chatter_measure(&log, &ch, &tr), ARGIL_OK);
+    assert_int_equal(plot_telemetry(&log, &c, "test", &ch, &tr), ARGIL_OK);
+    free(hp);
+    const int goal_after = longest_run(&c, 0, 160, 70);
+    if (goal_before != 0 || goal_after < 600)
+        fail_msg("goal line: %d pixels long without the chatter panel, %d with", goal_before,
+                 goal_after);
     canvas_t small;
     assert_int_equal(canvas_init(&small, 100, 100, white), ARGIL_OK);
-    assert_int_equal(plot_telemetry(&log, &small, NULL), ARGIL_ERR_ARG);
+    assert_int_equal(plot_telemetry(&log, &small, NULL, NULL, NULL), ARGIL_ERR_ARG);
     canvas_free(&small);
     canvas_free(&c);
     telemetry_log_free(&log);
@@ -339,6 +398,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_telemetry_errors_name_the_line),
+        cmocka_unit_test(test_telemetry_contact_column),
         cmocka_unit_test(test_plot_draws_axes_and_series),
         cmocka_unit_test(test_offscreen_rejects_bad_size),
         cmocka_unit_test(test_sphere_covers_plausible_share),
