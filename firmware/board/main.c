@@ -186,7 +186,7 @@ typedef struct {
     uint32_t seq;                  /* 0: none yet; +1 at each host-lost fault */
     uint32_t tick;
     uint32_t silence_us;           /* since the last host frame the core took in */
-    uint64_t at_ns;                /* CLOCK_MONOTONIC at that tick */
+    uint64_t at_ns;                /* CLOCK_MONOTONIC when the tick noted it */
     uint64_t link_turn_ns;         /* the link thread's latest turn then (0: no UDP thread) */
     uint64_t link_rx_ns;           /* … when it last queued a datagram for the loop */
     uint32_t link_rx_count;        /* datagrams it had queued so far */
@@ -299,15 +299,17 @@ static void prefault_stack(void)
 }
 
 /* Latches what the link looked like at the tick the host session lapsed. */
-static void note_host_lost(daemon_t *d, uint64_t now)
+static void note_host_lost(daemon_t *d)
 {
     d->lost.seq++;
     d->lost.tick = d->board->stats.ticks;
     d->lost.silence_us = d->board->session.silence_us;
-    d->lost.at_ns = now;
-    d->lost.link_turn_ns = atomic_load_explicit(&d->link_turn_ns, memory_order_relaxed);
-    d->lost.link_rx_ns = atomic_load_explicit(&d->link_rx_ns, memory_order_relaxed);
+    /* The link thread's times first, then the clock: each was read from the clock before it
+     * was stored, so neither is later than at_ns (the link thread may run while this tick does) */
+    d->lost.link_turn_ns = atomic_load_explicit(&d->link_turn_ns, memory_order_acquire);
+    d->lost.link_rx_ns = atomic_load_explicit(&d->link_rx_ns, memory_order_acquire);
     d->lost.link_rx_count = atomic_load_explicit(&d->link_rx_count, memory_order_relaxed);
+    d->lost.at_ns = now_ns();
     publish(d);
 }
 
@@ -334,7 +336,7 @@ static void *fast_loop(void *arg)
         const uint32_t compute_ns = board_run_tick(d->board, &d->io, d->hal);
         if (!was_lost && d->board->safety.state == SAFETY_FAULT &&
             d->board->safety.fault == FAULT_HOST_LOST)
-            note_host_lost(d, woke);
+            note_host_lost(d);
         /* The core sees the whole tick, release to done (wake-up latency + compute), so a late
          * wake counts as overrun; it records both in its RT_STATS for the host. */
         d->io.prev_wake_ns = wake_ns;
@@ -403,10 +405,10 @@ static void *udp_thread(void *arg)
         size_t n;
         const uint64_t turn_ns = now_ns();
         const uint64_t now_us = turn_ns / 1000u;
-        atomic_store_explicit(&d->link_turn_ns, turn_ns, memory_order_relaxed);
+        atomic_store_explicit(&d->link_turn_ns, turn_ns, memory_order_release);
         while ((n = link_udp_receive(&d->udp, rx, sizeof(rx), now_us)) > 0) {
             (void)spsc_push(&d->hal->link_rx, rx, n);
-            atomic_store_explicit(&d->link_rx_ns, now_ns(), memory_order_relaxed);
+            atomic_store_explicit(&d->link_rx_ns, now_ns(), memory_order_release);
             atomic_fetch_add_explicit(&d->link_rx_count, 1u, memory_order_relaxed);
         }
         const hal_link_refusals_t refused = {d->udp.bind.refused_source,
@@ -613,7 +615,7 @@ static void log_host_lost(const host_lost_t *l)
     fprintf(stderr, PROG ": host lost at tick %u: its last frame taken in %.1f ms before; the "
             "link thread last ran %.1f ms before and last queued a datagram %.1f ms before "
             "(%u so far)\n", l->tick, ms_before, turn_ms,
-            (double)(int64_t)(l->at_ns - l->link_rx_ns) / 1e6, l->link_rx_count);
+            (double)(l->at_ns - l->link_rx_ns) / 1e6, l->link_rx_count);
 }
 
 static void log_refusal_bursts(const snapshot_t *s, refusal_bursts_t *b, uint64_t now)
