@@ -5,6 +5,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "wire.h"
+
 #define CANOPEN_NODE_MAX 127u
 
 argil_err_t can_batch_push(can_batch_t *b, const can_frame_t *f)
@@ -73,32 +75,6 @@ uint16_t cia402_statusword(cia402_state_t s)
     }
 }
 
-/* Little-endian field writers and readers. */
-static void put_u16(uint8_t *p, uint16_t v)
-{
-    p[0] = (uint8_t)(v & 0xFFu);
-    p[1] = (uint8_t)(v >> 8);
-}
-
-static void put_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)(v & 0xFFu);
-    p[1] = (uint8_t)((v >> 8) & 0xFFu);
-    p[2] = (uint8_t)((v >> 16) & 0xFFu);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-static uint16_t get_u16(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | ((uint16_t)p[1] << 8));
-}
-
-static uint32_t get_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
-}
-
 /* Two's-complement reinterpretations without implementation-defined conversions. */
 static int16_t as_i16(uint16_t v)
 {
@@ -142,17 +118,17 @@ void canopen_rpdo_encode(can_frame_t *f, uint8_t node, uint16_t controlword,
                          int16_t target_torque_permille)
 {
     frame_begin(f, CANOPEN_COB_RPDO1 + (node & 0x7Fu), 4);
-    put_u16(&f->data[0], controlword);
-    put_u16(&f->data[2], (uint16_t)target_torque_permille);
+    le_put_u16(&f->data[0], controlword);
+    le_put_u16(&f->data[2], (uint16_t)target_torque_permille);
 }
 
 void canopen_tpdo_encode(can_frame_t *f, uint8_t node, uint16_t statusword,
                          int32_t position_counts, int16_t torque_permille)
 {
     frame_begin(f, CANOPEN_COB_TPDO1 + (node & 0x7Fu), 8);
-    put_u16(&f->data[0], statusword);
-    put_u32(&f->data[2], (uint32_t)position_counts);
-    put_u16(&f->data[6], (uint16_t)torque_permille);
+    le_put_u16(&f->data[0], statusword);
+    le_put_u32(&f->data[2], (uint32_t)position_counts);
+    le_put_u16(&f->data[6], (uint16_t)torque_permille);
 }
 
 void canopen_heartbeat_encode(can_frame_t *f, uint8_t node, nmt_state_t state)
@@ -165,7 +141,7 @@ void canopen_emcy_encode(can_frame_t *f, uint8_t node, uint16_t error_code,
                          uint8_t error_register)
 {
     frame_begin(f, CANOPEN_COB_EMCY + (node & 0x7Fu), 8);
-    put_u16(&f->data[0], error_code);
+    le_put_u16(&f->data[0], error_code);
     f->data[2] = error_register;
 }
 
@@ -200,8 +176,8 @@ bool canopen_rpdo_decode(const can_frame_t *f, uint8_t *node, uint16_t *controlw
     if (n == 0 || f->len != 4)
         return false;
     *node = n;
-    *controlword = get_u16(&f->data[0]);
-    *target_torque_permille = as_i16(get_u16(&f->data[2]));
+    *controlword = le_get_u16(&f->data[0]);
+    *target_torque_permille = as_i16(le_get_u16(&f->data[2]));
     return true;
 }
 
@@ -212,9 +188,9 @@ bool canopen_tpdo_decode(const can_frame_t *f, uint8_t *node, uint16_t *statuswo
     if (n == 0 || f->len != 8)
         return false;
     *node = n;
-    *statusword = get_u16(&f->data[0]);
-    *position_counts = as_i32(get_u32(&f->data[2]));
-    *torque_permille = as_i16(get_u16(&f->data[6]));
+    *statusword = le_get_u16(&f->data[0]);
+    *position_counts = as_i32(le_get_u32(&f->data[2]));
+    *torque_permille = as_i16(le_get_u16(&f->data[6]));
     return true;
 }
 
@@ -245,7 +221,7 @@ bool canopen_emcy_decode(const can_frame_t *f, uint8_t *node, uint16_t *error_co
     if (n == 0 || f->len != 8)
         return false;
     *node = n;
-    *error_code = get_u16(&f->data[0]);
+    *error_code = le_get_u16(&f->data[0]);
     *error_register = f->data[2];
     return true;
 }

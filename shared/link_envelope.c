@@ -58,8 +58,7 @@ link_auth_err_t link_auth_open(link_auth_mac_fn mac, const link_key_t *key, uint
 {
     if (len < PROTO_HEADER_SIZE + PROTO_CRC_SIZE + LINK_AUTH_TRAILER_BYTES)
         return LINK_AUTH_ERR_SIZE;
-    const size_t flen =
-        PROTO_HEADER_SIZE + PROTO_CRC_SIZE + ((size_t)dgram[6] | (size_t)dgram[7] << 8);
+    const size_t flen = PROTO_HEADER_SIZE + PROTO_CRC_SIZE + le_get_u16(dgram + 6);
     if (flen > PROTO_FRAME_MAX || len != flen + LINK_AUTH_TRAILER_BYTES)
         return LINK_AUTH_ERR_SIZE;
     uint8_t tag[LINK_AUTH_TAG_BYTES];

@@ -2,16 +2,15 @@
 #include <string.h>
 
 #include "link_framer.h"
+#include "wire.h"
 
 size_t link_frame_size(const uint8_t *buf, size_t len)
 {
     if (len < PROTO_HEADER_SIZE)
         return 0;
-    const uint32_t magic = (uint32_t)buf[0] | ((uint32_t)buf[1] << 8) | ((uint32_t)buf[2] << 16) |
-                           ((uint32_t)buf[3] << 24);
-    if (magic != PROTO_MAGIC)
+    if (le_get_u32(buf) != PROTO_MAGIC)
         return 0;
-    const size_t payload = (size_t)buf[6] | ((size_t)buf[7] << 8);
+    const size_t payload = le_get_u16(buf + 6);
     const size_t total = PROTO_HEADER_SIZE + payload + PROTO_CRC_SIZE;
     return total <= PROTO_FRAME_MAX ? total : 0;
 }

@@ -276,8 +276,7 @@ static void get_f32s_span(wire_reader_t *r, float *v, size_t n)
         return;
     }
     for (size_t i = 0; i < n; i++, p += 4) {
-        const uint32_t bits = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-                              (uint32_t)p[3] << 24;
+        const uint32_t bits = le_get_u32(p);
         memcpy(&v[i], &bits, sizeof bits);
     }
 }

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "wire.h"
+
 argil_err_t spsc_init(spsc_ring_t *r, uint8_t *storage, uint32_t capacity_bytes)
 {
     if (r == NULL || storage == NULL || capacity_bytes < 16u ||
@@ -44,7 +46,8 @@ argil_err_t spsc_push(spsc_ring_t *r, const uint8_t *data, size_t len)
         atomic_fetch_add_explicit(&r->dropped, 1u, memory_order_relaxed);
         return ARGIL_ERR_FULL;
     }
-    const uint8_t hdr[2] = {(uint8_t)(len & 0xFFu), (uint8_t)(len >> 8)};
+    uint8_t hdr[2];
+    le_put_u16(hdr, (uint16_t)len);
     copy_in(r, tail, hdr, 2u);
     if (len > 0)
         copy_in(r, tail + 2u, data, (uint32_t)len);
@@ -60,7 +63,7 @@ size_t spsc_peek_len(spsc_ring_t *r)
         return 0;
     uint8_t hdr[2];
     copy_out(r, head, hdr, 2u);
-    return (size_t)hdr[0] | ((size_t)hdr[1] << 8);
+    return le_get_u16(hdr);
 }
 
 argil_err_t spsc_pop(spsc_ring_t *r, uint8_t *buf, size_t cap, size_t *len)
@@ -71,7 +74,7 @@ argil_err_t spsc_pop(spsc_ring_t *r, uint8_t *buf, size_t cap, size_t *len)
         return ARGIL_ERR_EMPTY;
     uint8_t hdr[2];
     copy_out(r, head, hdr, 2u);
-    const uint32_t n = (uint32_t)hdr[0] | ((uint32_t)hdr[1] << 8);
+    const uint32_t n = le_get_u16(hdr);
     if (n > cap)
         return ARGIL_ERR_FULL;
     if (n > 0)
@@ -89,7 +92,7 @@ bool spsc_skip(spsc_ring_t *r)
         return false;
     uint8_t hdr[2];
     copy_out(r, head, hdr, 2u);
-    const uint32_t n = (uint32_t)hdr[0] | ((uint32_t)hdr[1] << 8);
+    const uint32_t n = le_get_u16(hdr);
     atomic_store_explicit(&r->head, head + 2u + n, memory_order_release);
     return true;
 }

@@ -1,5 +1,6 @@
-/* Little-endian field-by-field writing and reading with bounds, for the wire protocol.
- * A cursor that would run past its end stops moving and latches ok = false. */
+/* The one little-endian codec: loads and stores at a pointer (le_*: the wire protocol, CANopen
+ * frames, USB descriptors and the host's files), and bounded cursors over them (wire_*) for the
+ * wire protocol. A cursor that would run past its end stops moving and latches ok = false. */
 #ifndef ARGIL_WIRE_H
 #define ARGIL_WIRE_H
 
@@ -7,6 +8,80 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
+
+/* Stores the low n bytes of v at p, least significant first (n <= 8). */
+static inline void le_put(uint8_t *p, uint64_t v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        p[i] = (uint8_t)(v >> (8u * i));
+}
+
+/* The n-byte little-endian value at p (n <= 8). */
+static inline uint64_t le_get(const uint8_t *p, size_t n)
+{
+    uint64_t v = 0u;
+    for (size_t i = 0; i < n; i++)
+        v |= (uint64_t)p[i] << (8u * i);
+    return v;
+}
+
+/* Stores v at p as a little-endian u16. */
+static inline void le_put_u16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+}
+
+/* Stores v at p as a little-endian u32. */
+static inline void le_put_u32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    p[2] = (uint8_t)(v >> 16);
+    p[3] = (uint8_t)(v >> 24);
+}
+
+/* Stores v at p as a little-endian u64. */
+static inline void le_put_u64(uint8_t *p, uint64_t v)
+{
+    le_put_u32(p, (uint32_t)v);
+    le_put_u32(p + 4, (uint32_t)(v >> 32));
+}
+
+/* Stores v at p as its IEEE-754 bit pattern, little-endian. */
+static inline void le_put_f32(uint8_t *p, float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    le_put_u32(p, bits);
+}
+
+/* The little-endian u16 at p. */
+static inline uint16_t le_get_u16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (uint16_t)p[1] << 8);
+}
+
+/* The little-endian u32 at p. */
+static inline uint32_t le_get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* The little-endian u64 at p. */
+static inline uint64_t le_get_u64(const uint8_t *p)
+{
+    return (uint64_t)le_get_u32(p) | (uint64_t)le_get_u32(p + 4) << 32;
+}
+
+/* The float whose little-endian IEEE-754 bit pattern is at p. */
+static inline float le_get_f32(const uint8_t *p)
+{
+    const uint32_t bits = le_get_u32(p);
+    float v;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
 
 typedef struct {
     uint8_t *buf;
@@ -52,10 +127,8 @@ static inline uint8_t *wire_put_span(wire_writer_t *w, size_t n)
 static inline void wire_put_le(wire_writer_t *w, uint64_t v, size_t n)
 {
     uint8_t *p = wire_put_span(w, n);
-    if (p == NULL)
-        return;
-    for (size_t i = 0; i < n; i++)
-        p[i] = (uint8_t)(v >> (8u * i));
+    if (p != NULL)
+        le_put(p, v, n);
 }
 
 /* Writes one byte. */
@@ -70,9 +143,9 @@ static inline void wire_put_u64(wire_writer_t *w, uint64_t v) { wire_put_le(w, v
 /* Writes a float as its IEEE-754 bit pattern, little-endian. */
 static inline void wire_put_f32(wire_writer_t *w, float v)
 {
-    uint32_t bits;
-    memcpy(&bits, &v, sizeof bits);
-    wire_put_u32(w, bits);
+    uint8_t *p = wire_put_span(w, 4u);
+    if (p != NULL)
+        le_put_f32(p, v);
 }
 
 /* Writes n raw bytes. */
@@ -99,12 +172,7 @@ static inline const uint8_t *wire_get_span(wire_reader_t *r, size_t n)
 static inline uint64_t wire_get_le(wire_reader_t *r, size_t n)
 {
     const uint8_t *p = wire_get_span(r, n);
-    uint64_t v = 0u;
-    if (p == NULL)
-        return 0u;
-    for (size_t i = 0; i < n; i++)
-        v |= (uint64_t)p[i] << (8u * i);
-    return v;
+    return p == NULL ? 0u : le_get(p, n);
 }
 
 /* Reads one byte. */
@@ -119,10 +187,8 @@ static inline uint64_t wire_get_u64(wire_reader_t *r) { return wire_get_le(r, 8u
 /* Reads a float from its little-endian IEEE-754 bit pattern. */
 static inline float wire_get_f32(wire_reader_t *r)
 {
-    uint32_t bits = wire_get_u32(r);
-    float v;
-    memcpy(&v, &bits, sizeof v);
-    return v;
+    const uint8_t *p = wire_get_span(r, 4u);
+    return p == NULL ? 0.0f : le_get_f32(p);
 }
 
 /* Copies n raw bytes into dst; zeros past the end. */

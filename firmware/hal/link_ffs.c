@@ -9,18 +9,7 @@
 #include <unistd.h>
 
 #include "link_io.h"
-
-static void put_le16(uint8_t *p, uint16_t v)
-{
-    p[0] = (uint8_t)(v & 0xFFu);
-    p[1] = (uint8_t)(v >> 8);
-}
-
-static void put_le32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
+#include "shared/wire.h"
 
 /* One speed's descriptors: interface + bulk OUT + bulk IN; returns 23 bytes. */
 static size_t speed_descs(uint8_t *p, uint16_t max_packet)
@@ -34,7 +23,7 @@ static size_t speed_descs(uint8_t *p, uint16_t max_packet)
         e[1] = 5; /* ENDPOINT */
         e[2] = addrs[i];
         e[3] = 2; /* bulk */
-        put_le16(e + 4, max_packet);
+        le_put_u16(e + 4, max_packet);
         e[6] = 0;
     }
     return 23;
@@ -45,11 +34,11 @@ size_t link_ffs_descriptors(uint8_t *buf, size_t cap)
     const size_t total = 12u + 8u + 2u * 23u;
     if (cap < total)
         return 0;
-    put_le32(buf, FUNCTIONFS_DESCRIPTORS_MAGIC_V2);
-    put_le32(buf + 4, (uint32_t)total);
-    put_le32(buf + 8, FUNCTIONFS_HAS_FS_DESC | FUNCTIONFS_HAS_HS_DESC);
-    put_le32(buf + 12, 3); /* full-speed descriptor count */
-    put_le32(buf + 16, 3); /* high-speed descriptor count */
+    le_put_u32(buf, FUNCTIONFS_DESCRIPTORS_MAGIC_V2);
+    le_put_u32(buf + 4, (uint32_t)total);
+    le_put_u32(buf + 8, FUNCTIONFS_HAS_FS_DESC | FUNCTIONFS_HAS_HS_DESC);
+    le_put_u32(buf + 12, 3); /* full-speed descriptor count */
+    le_put_u32(buf + 16, 3); /* high-speed descriptor count */
     size_t at = 20;
     at += speed_descs(buf + at, 64);
     at += speed_descs(buf + at, 512);
@@ -62,11 +51,11 @@ size_t link_ffs_strings(uint8_t *buf, size_t cap)
     const size_t total = 16u + 2u + sizeof(name);
     if (cap < total)
         return 0;
-    put_le32(buf, FUNCTIONFS_STRINGS_MAGIC);
-    put_le32(buf + 4, (uint32_t)total);
-    put_le32(buf + 8, 1);  /* strings per language */
-    put_le32(buf + 12, 1); /* languages */
-    put_le16(buf + 16, 0x0409);
+    le_put_u32(buf, FUNCTIONFS_STRINGS_MAGIC);
+    le_put_u32(buf + 4, (uint32_t)total);
+    le_put_u32(buf + 8, 1);  /* strings per language */
+    le_put_u32(buf + 12, 1); /* languages */
+    le_put_u16(buf + 16, 0x0409);
     memcpy(buf + 18, name, sizeof(name));
     return total;
 }

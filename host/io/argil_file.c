@@ -9,6 +9,7 @@
 
 #include "host/io/io_util.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 
 static const uint8_t AF_MAGIC[8] = {'A', 'R', 'G', 'I', 'L', '\r', '\n', 0x1a};
 #define AF_SEC_OVERHEAD 16u /* tag 4 + length 8 + crc 4 */
@@ -31,17 +32,6 @@ void argil_doc_free(argil_doc_t *d)
     rbf_free(&d->rbf);
     octfit_free(&d->octree);
     argil_doc_init(d);
-}
-
-static void put_u64(uint8_t *p, uint64_t v)
-{
-    io_put_u32le(p, (uint32_t)v);
-    io_put_u32le(p + 4, (uint32_t)(v >> 32));
-}
-
-static uint64_t get_u64(const uint8_t *p)
-{
-    return (uint64_t)io_get_u32le(p) | (uint64_t)io_get_u32le(p + 4) << 32;
 }
 
 /* ------------------------------------------------------------------ writer */
@@ -136,7 +126,7 @@ static void af_begin(af_out_t *o, const char tag[4], uint64_t len)
 {
     uint8_t h[12];
     memcpy(h, tag, 4);
-    put_u64(h + 4, len);
+    le_put_u64(h + 4, len);
     o->sec_crc = 0;
     af_put(o, h, 12);
 }
@@ -144,7 +134,7 @@ static void af_begin(af_out_t *o, const char tag[4], uint64_t len)
 static void af_end(af_out_t *o)
 {
     uint8_t c[4];
-    io_put_u32le(c, o->sec_crc);
+    le_put_u32(c, o->sec_crc);
     af_put(o, c, 4);
 }
 
@@ -153,7 +143,7 @@ static void af_put_f32s(af_out_t *o, const float *v, size_t n)
     uint8_t buf[4096];
     size_t used = 0;
     for (size_t i = 0; i < n; i++) {
-        io_put_f32le(buf + used, v[i]);
+        le_put_f32(buf + used, v[i]);
         used += 4;
         if (used == sizeof(buf)) {
             af_put(o, buf, used);
@@ -206,20 +196,20 @@ static const char *af_write_body(FILE *f, const void *vctx)
         total += AF_SEC_OVERHEAD + af_mtls_bytes(c);
     uint8_t h[ARGIL_FILE_HEADER_BYTES] = {0};
     memcpy(h, AF_MAGIC, 8);
-    io_put_u32le(h + 8, mtls ? ARGIL_FILE_VERSION_MTLS : 1u);
-    io_put_u32le(h + 12, n_sec);
-    put_u64(h + 16, total);
-    io_put_u32le(h + 28, crc32c(0, h, 28));
+    le_put_u32(h + 8, mtls ? ARGIL_FILE_VERSION_MTLS : 1u);
+    le_put_u32(h + 12, n_sec);
+    le_put_u64(h + 16, total);
+    le_put_u32(h + 28, crc32c(0, h, 28));
     af_put(&o, h, sizeof(h));
 
     uint8_t b[64];
     af_begin(&o, "GRID", af_grid_bytes(c->n));
     for (int a = 0; a < 3; a++)
-        io_put_u32le(b + 4 * a, (uint32_t)c->dims[a]);
+        le_put_u32(b + 4 * a, (uint32_t)c->dims[a]);
     const vec3_t org = grid_box_origin(g, c->lo);
     const float gf[6] = {g->spacing_m, org.x, org.y, org.z, g->iso, g->band_m};
     for (int k = 0; k < 6; k++)
-        io_put_f32le(b + 12 + 4 * k, gf[k]);
+        le_put_f32(b + 12 + 4 * k, gf[k]);
     af_put(&o, b, 36);
     af_put_f32s(&o, c->dens, c->n);
     af_end(&o);
@@ -231,9 +221,9 @@ static const char *af_write_body(FILE *f, const void *vctx)
     af_end(&o);
 
     af_begin(&o, "TOOL", 16);
-    io_put_u32le(b, d->tool.tool_kind);
-    io_put_f32le(b + 4, d->tool.radius_m);
-    io_put_f32le(b + 8, d->tool.strength);
+    le_put_u32(b, d->tool.tool_kind);
+    le_put_f32(b + 4, d->tool.radius_m);
+    le_put_f32(b + 8, d->tool.strength);
     memcpy(b + 12, d->tool.paint_rgb, 3);
     b[15] = 0;
     af_put(&o, b, 16);
@@ -243,14 +233,14 @@ static const char *af_write_body(FILE *f, const void *vctx)
     const float sf[4] = {d->state.device_offset_m.x, d->state.device_offset_m.y,
                          d->state.device_offset_m.z, d->state.device_scale};
     for (int k = 0; k < 4; k++)
-        io_put_f32le(b + 4 * k, sf[k]);
-    io_put_u32le(b + 16, d->state.edits);
+        le_put_f32(b + 4 * k, sf[k]);
+    le_put_u32(b + 16, d->state.edits);
     af_put(&o, b, 20);
     af_end(&o);
 
     if (pnts) { /* the paint settings a session chose (its colour is TOOL's paint rgb) */
         af_begin(&o, "PNTS", 4);
-        io_put_f32le(b, d->tool.soft_paint_per_s);
+        le_put_f32(b, d->tool.soft_paint_per_s);
         af_put(&o, b, 4);
         af_end(&o);
     }
@@ -262,19 +252,19 @@ static const char *af_write_body(FILE *f, const void *vctx)
     }
     if (mtls) {
         af_begin(&o, "MTLS", af_mtls_bytes(c));
-        io_put_u32le(b, af_mtls_channels(c));
+        le_put_u32(b, af_mtls_channels(c));
         af_put(&o, b, 4);
         for (int ch = 0; ch < GRID_MAT_N; ch++) {
             if (c->mat_runs[ch] == 0)
                 continue;
-            io_put_u32le(b, (uint32_t)ch);
-            io_put_u32le(b + 4, c->mat_runs[ch]);
+            le_put_u32(b, (uint32_t)ch);
+            le_put_u32(b + 4, c->mat_runs[ch]);
             af_put(&o, b, 8);
             const float *mv = c->mat[ch], def = grid_mat_default((grid_mat_t)ch);
             size_t pos = 0, r0, r1;
             while (af_next_run(mv, c->n, def, &pos, &r0, &r1)) {
-                io_put_u32le(b, (uint32_t)r0);
-                io_put_u32le(b + 4, (uint32_t)(r1 - r0));
+                le_put_u32(b, (uint32_t)r0);
+                le_put_u32(b + 4, (uint32_t)(r1 - r0));
                 af_put(&o, b, 8);
                 af_put_f32s(&o, mv + r0, r1 - r0);
             }
@@ -284,11 +274,11 @@ static const char *af_write_body(FILE *f, const void *vctx)
     if (d->has_rbf) {
         const rbf_model_t *r = &d->rbf;
         af_begin(&o, "RBF3", 28u + 16u * (uint64_t)r->n);
-        io_put_u32le(b, r->n);
+        le_put_u32(b, r->n);
         const float rf[6] = {r->poly[0], r->poly[1], r->poly[2], r->poly[3], r->rms_err_m,
                              r->max_err_m};
         for (int k = 0; k < 6; k++)
-            io_put_f32le(b + 4 + 4 * k, rf[k]);
+            le_put_f32(b + 4 + 4 * k, rf[k]);
         af_put(&o, b, 28);
         for (uint32_t i = 0; i < r->n; i++) {
             const float cf[4] = {r->centre_m[3 * i], r->centre_m[3 * i + 1], r->centre_m[3 * i + 2],
@@ -300,16 +290,16 @@ static const char *af_write_body(FILE *f, const void *vctx)
     if (d->has_octree) {
         const octfit_model_t *om = &d->octree;
         af_begin(&o, "OCTB", af_octb_bytes(om));
-        io_put_u32le(b, om->n_nodes);
-        io_put_u32le(b + 4, OCTFIT_N);
-        io_put_u32le(b + 8, om->kind);
+        le_put_u32(b, om->n_nodes);
+        le_put_u32(b + 4, OCTFIT_N);
+        le_put_u32(b + 8, om->kind);
         const float of[7] = {om->origin_m[0], om->origin_m[1], om->origin_m[2], om->size_m,
                              om->rms_err, om->max_err, OCTFIT_OVERLAP};
         for (int k = 0; k < 7; k++)
-            io_put_f32le(b + 12 + 4 * k, of[k]);
+            le_put_f32(b + 12 + 4 * k, of[k]);
         af_put(&o, b, 40);
         for (uint32_t i = 0; i < om->n_nodes; i++) {
-            io_put_u32le(b, om->child[i]);
+            le_put_u32(b, om->child[i]);
             af_put(&o, b, 4);
         }
         for (uint32_t i = 0; i < om->n_leaves; i++)
@@ -317,7 +307,7 @@ static const char *af_write_body(FILE *f, const void *vctx)
         af_end(&o);
     }
     uint8_t t[4];
-    io_put_u32le(t, o.file_crc);
+    le_put_u32(t, o.file_crc);
     if (!o.bad && fwrite(t, 1, 4, f) != 4)
         o.bad = true;
     return o.bad ? "fwrite" : NULL;
@@ -428,7 +418,7 @@ static argil_err_t af_fail(const af_rctx_t *c, size_t off, const char *rule)
 static void af_get_f32s(const uint8_t *p, float *v, size_t n)
 {
     for (size_t i = 0; i < n; i++)
-        v[i] = io_get_f32le(p + 4 * i);
+        v[i] = le_get_f32(p + 4 * i);
 }
 
 /* Decodes the GRID section payload (len bytes at p, file offset off). */
@@ -440,7 +430,7 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     int32_t dims[3];
     uint64_t n = 1;
     for (int a = 0; a < 3; a++) {
-        dims[a] = (int32_t)io_get_u32le(p + 4 * a);
+        dims[a] = (int32_t)le_get_u32(p + 4 * a);
         if (dims[a] < 1)
             return af_fail(c, off + 4 * (size_t)a, "GRID dimension below 1");
         n *= (uint64_t)dims[a];
@@ -467,7 +457,7 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         return ARGIL_ERR_NOMEM;
     }
     for (size_t i = 0; i < (size_t)n; i++) {
-        v[i] = io_get_f32le(p + 36 + 4 * i);
+        v[i] = le_get_f32(p + 36 + 4 * i);
         if (!isfinite(v[i]) || v[i] < 0.0f || v[i] > 1.0f) {
             free(v);
             return af_fail(c, off + 36 + 4 * i, "GRID density not a finite number in [0, 1]");
@@ -492,7 +482,7 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
 {
     if (d->has_octree || len < 40)
         return af_fail(c, pos, "OCTB section repeated or shorter than its 40-byte head");
-    const uint32_t n = io_get_u32le(p), per_axis = io_get_u32le(p + 4), kind = io_get_u32le(p + 8);
+    const uint32_t n = le_get_u32(p), per_axis = le_get_u32(p + 4), kind = le_get_u32(p + 8);
     if (n < 1 || n > OCTFIT_NODES_MAX || (uint64_t)len < 40u + 4u * (uint64_t)n)
         return af_fail(c, off, "OCTB node count not in 1..65537 or past the section's end");
     if (per_axis != OCTFIT_N)
@@ -511,7 +501,7 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     }
     uint64_t leaves = 0;
     for (uint32_t i = 0; i < n; i++) {
-        child[i] = io_get_u32le(p + 40 + 4 * (size_t)i);
+        child[i] = le_get_u32(p + 40 + 4 * (size_t)i);
         leaves += child[i] == 0;
     }
     /* The leaves' coefficients must all be in the section before anything is allocated for
@@ -553,7 +543,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
 {
     if (len < 4)
         return af_fail(c, off, "MTLS section shorter than its 4-byte channel count");
-    const uint32_t k = io_get_u32le(p);
+    const uint32_t k = le_get_u32(p);
     if (k < 1 || k > GRID_MAT_N)
         return af_fail(c, off, "MTLS channel count not in 1..4");
     uint64_t at = 4;
@@ -561,7 +551,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     for (uint32_t i = 0; i < k; i++) {
         if (len - at < 8)
             return af_fail(c, off + (size_t)at, "MTLS channel head runs past the section");
-        const uint32_t ch = io_get_u32le(p + at), runs = io_get_u32le(p + at + 4);
+        const uint32_t ch = le_get_u32(p + at), runs = le_get_u32(p + at + 4);
         if (ch >= GRID_MAT_N || (int64_t)ch <= prev_ch)
             return af_fail(c, off + (size_t)at, "MTLS channel id not 0..3 (stiffness, mass, "
                                                 "damping, rest length) in increasing order");
@@ -575,7 +565,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         for (uint32_t r = 0; r < runs; r++) {
             if (len - at < 8)
                 return af_fail(c, off + (size_t)at, "MTLS run head runs past the section");
-            const uint64_t start = io_get_u32le(p + at), count = io_get_u32le(p + at + 4);
+            const uint64_t start = le_get_u32(p + at), count = le_get_u32(p + at + 4);
             if (count < 1 || start < next_start || start + count > (uint64_t)n)
                 return af_fail(c, off + (size_t)at, "MTLS run empty, overlapping or out of order, "
                                                     "or beyond the grid's samples");
@@ -583,7 +573,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
                 return af_fail(c, off + (size_t)at, "MTLS run values run past the section");
             for (uint64_t v = 0; v < count; v++) {
                 const size_t vo = (size_t)(at + 8 + 4 * v);
-                if (!grid_mat_valid((grid_mat_t)ch, io_get_f32le(p + vo)))
+                if (!grid_mat_valid((grid_mat_t)ch, le_get_f32(p + vo)))
                     return af_fail(c, off + vo, "MTLS value out of range (finite; mass scale > 0, "
                                                 "stiffness and damping scales >= 0)");
             }
@@ -598,7 +588,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
             return ARGIL_ERR_NOMEM;
         }
         for (uint64_t q = first, r = 0; r < runs; r++) {
-            const size_t start = io_get_u32le(p + q), count = io_get_u32le(p + q + 4);
+            const size_t start = le_get_u32(p + q), count = le_get_u32(p + q + 4);
             af_get_f32s(p + q + 8, m + start, count);
             q += 8 + 4 * (uint64_t)count;
         }
@@ -617,9 +607,9 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
 /* The 16-byte TOOL section at p (payload offset off in the file) into d->tool. */
 static argil_err_t af_tool(const af_rctx_t *c, const uint8_t *p, size_t off, argil_doc_t *d)
 {
-    d->tool.tool_kind = io_get_u32le(p);
-    d->tool.radius_m = io_get_f32le(p + 4);
-    d->tool.strength = io_get_f32le(p + 8);
+    d->tool.tool_kind = le_get_u32(p);
+    d->tool.radius_m = le_get_f32(p + 4);
+    d->tool.strength = le_get_f32(p + 8);
     memcpy(d->tool.paint_rgb, p + 12, 3);
     if (!isfinite(d->tool.radius_m) || d->tool.radius_m < 0 || !isfinite(d->tool.strength) ||
         d->tool.strength < 0 || d->tool.strength > 1)
@@ -633,7 +623,7 @@ static argil_err_t af_rbf3(const af_rctx_t *c, const uint8_t *p, uint64_t sl, si
 {
     if (d->has_rbf || sl < 28)
         return af_fail(c, pos, "RBF3 section repeated or shorter than 28 bytes");
-    const uint32_t n = io_get_u32le(p);
+    const uint32_t n = le_get_u32(p);
     if (n > RBF_CENTRES_MAX || sl != 28u + 16u * (uint64_t)n)
         return af_fail(c, off, "RBF3 centre count out of range or not matching the "
                                "section length");
@@ -665,21 +655,21 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
         return af_fail(c, len, "file shorter than the 32-byte header and 4-byte checksum");
     if (memcmp(b, AF_MAGIC, 8) != 0)
         return af_fail(c, 0, "not an .argil file (magic \"ARGIL\\r\\n\\x1a\")");
-    if (io_get_u32le(b + 28) != crc32c(0, b, 28))
+    if (le_get_u32(b + 28) != crc32c(0, b, 28))
         return af_fail(c, 28, "header checksum mismatch (file corrupted)");
-    const uint32_t version = io_get_u32le(b + 8);
+    const uint32_t version = le_get_u32(b + 8);
     if (version == 0 || version > ARGIL_FILE_VERSION) {
         io_err(c->err, c->err_len, "%s: byte 8: format version %u; this argil reads 1..%u", c->path,
                version, ARGIL_FILE_VERSION);
         return ARGIL_ERR_PARSE;
     }
-    const uint32_t n_sec = io_get_u32le(b + 12);
+    const uint32_t n_sec = le_get_u32(b + 12);
     if (n_sec < 1 || n_sec > ARGIL_FILE_SECTIONS_MAX)
         return af_fail(c, 12, "section count not in 1..64");
-    if (get_u64(b + 16) != (uint64_t)len)
+    if (le_get_u64(b + 16) != (uint64_t)len)
         return af_fail(c, 16, "declared file length differs from the real size (truncated or "
                               "extended)");
-    if (io_get_u32le(b + len - 4) != crc32c(0, b, len - 4))
+    if (le_get_u32(b + len - 4) != crc32c(0, b, len - 4))
         return af_fail(c, len - 4, "file checksum mismatch (file corrupted)");
     size_t pos = ARGIL_FILE_HEADER_BYTES;
     bool seen_grid = false, seen_matl = false, seen_tool = false, seen_stat = false;
@@ -692,12 +682,12 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
         const size_t end = len - 4;
         if (end - pos < AF_SEC_OVERHEAD)
             return af_fail(c, pos, "section head runs past the end of the file");
-        const uint64_t sl = get_u64(b + pos + 4);
+        const uint64_t sl = le_get_u64(b + pos + 4);
         if (sl > (uint64_t)(end - pos - AF_SEC_OVERHEAD))
             return af_fail(c, pos + 4, "section length runs past the end of the file");
         const uint8_t *p = b + pos + 12;
         const size_t crc_off = pos + 12 + (size_t)sl;
-        if (io_get_u32le(b + crc_off) != crc32c(0, b + pos, 12 + (size_t)sl))
+        if (le_get_u32(b + crc_off) != crc32c(0, b + pos, 12 + (size_t)sl))
             return af_fail(c, crc_off, "section checksum mismatch (file corrupted)");
         const size_t off = pos + 12;
         char tag[5] = {0};
@@ -733,11 +723,11 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
                 return af_fail(c, off, "STAT transform not finite (or scale not > 0)");
             d->state.device_offset_m = vec3(sf[0], sf[1], sf[2]);
             d->state.device_scale = sf[3];
-            d->state.edits = io_get_u32le(p + 16);
+            d->state.edits = le_get_u32(p + 16);
         } else if (strcmp(tag, "PNTS") == 0) {
             if (d->tool.paint_chosen || sl != 4)
                 return af_fail(c, pos, "PNTS section repeated or not 4 bytes");
-            const float rate = io_get_f32le(p);
+            const float rate = le_get_f32(p);
             if (!isfinite(rate) || rate < 0 || rate > ARGIL_FILE_PAINT_RATE_MAX)
                 return af_fail(c, off, "PNTS soft-paint rate not in 0..100 per second");
             d->tool.paint_chosen = true;

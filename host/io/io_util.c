@@ -194,36 +194,3 @@ int io_tokens(char *line, char **tok, int max)
             *p++ = '\0';
     }
 }
-
-uint32_t io_get_u32le(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-uint16_t io_get_u16le(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | p[1] << 8);
-}
-
-void io_put_u32le(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-void io_put_f32le(uint8_t *p, float f)
-{
-    uint32_t v;
-    memcpy(&v, &f, sizeof(v));
-    io_put_u32le(p, v);
-}
-
-float io_get_f32le(const uint8_t *p)
-{
-    const uint32_t v = io_get_u32le(p);
-    float f;
-    memcpy(&f, &v, sizeof(f));
-    return f;
-}

@@ -51,11 +51,4 @@ long io_next_line(io_lines_t *it, char *line, size_t cap);
 /* Splits line (modified) at blanks into at most max tokens; returns the count, max + 1 if more. */
 int io_tokens(char *line, char **tok, int max);
 
-/* Little/big-endian scalar loads and stores. */
-uint32_t io_get_u32le(const uint8_t *p);
-uint16_t io_get_u16le(const uint8_t *p);
-void io_put_u32le(uint8_t *p, uint32_t v);
-void io_put_f32le(uint8_t *p, float f);
-float io_get_f32le(const uint8_t *p);
-
 #endif

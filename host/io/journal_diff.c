@@ -147,8 +147,8 @@ static bool put_run(emit_t *e, size_t start, size_t end)
     if (!journal_buf_reserve(j, 8 + es * count))
         return false;
     uint8_t *p = j->buf + j->buf_len;
-    io_put_u32le(p, (uint32_t)start);
-    io_put_u32le(p + 4, (uint32_t)count);
+    le_put_u32(p, (uint32_t)start);
+    le_put_u32(p + 4, (uint32_t)count);
     const size_t nx = (size_t)j->dims[0], ny = (size_t)j->dims[1];
     for (size_t i = start; i < end; i++) {
         const int32_t x = j->lo[0] + (int32_t)(i % nx), y = j->lo[1] + (int32_t)(i / nx % ny),
@@ -166,7 +166,7 @@ static bool put_run(emit_t *e, size_t start, size_t end)
         if (es == 4) {
             float f;
             memcpy(&f, val, 4);
-            io_put_f32le(out, f);
+            le_put_f32(out, f);
         } else {
             memcpy(out, val, es);
         }

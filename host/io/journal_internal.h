@@ -10,6 +10,7 @@
 
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
+#include "shared/wire.h"
 
 #define JOURNAL_MAGIC "ARGJRNL\x1a" /* the 8 bytes journal.log starts with */
 
@@ -26,37 +27,24 @@ static inline size_t journal_kind_bytes(int kind)
     return kind == JOURNAL_KIND_RGB ? 3u : 4u;
 }
 
-/* Stores v at p as little-endian uint64. */
-static inline void journal_put_u64(uint8_t *p, uint64_t v)
-{
-    io_put_u32le(p, (uint32_t)v);
-    io_put_u32le(p + 4, (uint32_t)(v >> 32));
-}
-
-/* The little-endian uint64 at p. */
-static inline uint64_t journal_get_u64(const uint8_t *p)
-{
-    return (uint64_t)io_get_u32le(p) | (uint64_t)io_get_u32le(p + 4) << 32;
-}
-
 /* Stores m at p as five little-endian binary32 (20 bytes). */
 static inline void journal_put_material(uint8_t *p, const spring_material_t *m)
 {
-    io_put_f32le(p, m->node_mass);
-    io_put_f32le(p + 4, m->stiffness);
-    io_put_f32le(p + 8, m->coupling);
-    io_put_f32le(p + 12, m->damping);
-    io_put_f32le(p + 16, m->plastic_rate_hz);
+    le_put_f32(p, m->node_mass);
+    le_put_f32(p + 4, m->stiffness);
+    le_put_f32(p + 8, m->coupling);
+    le_put_f32(p + 12, m->damping);
+    le_put_f32(p + 16, m->plastic_rate_hz);
 }
 
 /* Loads the 20-byte material at p into m. */
 static inline void journal_get_material(const uint8_t *p, spring_material_t *m)
 {
-    m->node_mass = io_get_f32le(p);
-    m->stiffness = io_get_f32le(p + 4);
-    m->coupling = io_get_f32le(p + 8);
-    m->damping = io_get_f32le(p + 12);
-    m->plastic_rate_hz = io_get_f32le(p + 16);
+    m->node_mass = le_get_f32(p);
+    m->stiffness = le_get_f32(p + 4);
+    m->coupling = le_get_f32(p + 8);
+    m->damping = le_get_f32(p + 12);
+    m->plastic_rate_hz = le_get_f32(p + 16);
 }
 
 /* True when the n bytes at a and b are the same. */

@@ -15,7 +15,7 @@ static uint32_t f32s_crc(uint32_t crc, const float *v, size_t n)
     while (i < n) {
         size_t k = 0;
         for (; k < sizeof(chunk) / 4 && i < n; k++, i++)
-            io_put_f32le(chunk + 4 * k, v[i]);
+            le_put_f32(chunk + 4 * k, v[i]);
         crc = crc32c(crc, chunk, 4 * k);
     }
     return crc;
@@ -55,13 +55,13 @@ uint32_t journal_model_crc(const float *density, float *const mat[GRID_MAT_N], c
         if (!mat_painted(mat[ch], n, (grid_mat_t)ch))
             continue;
         uint8_t id[4];
-        io_put_u32le(id, (uint32_t)ch);
+        le_put_u32(id, (uint32_t)ch);
         crc = crc32c(crc, id, 4);
         crc = f32s_crc(crc, mat[ch], n);
     }
     if (rgb_painted(rgb, n)) { /* then the colour as id 4 and 3 bytes per sample */
         uint8_t id[4];
-        io_put_u32le(id, JOURNAL_RGB_CRC_ID);
+        le_put_u32(id, JOURNAL_RGB_CRC_ID);
         crc = crc32c(crc, id, 4);
         crc = crc32c(crc, rgb, 3 * n);
     }

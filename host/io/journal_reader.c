@@ -25,41 +25,41 @@ argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *n
         return fail(err, err_len, name, len, "file shorter than the journal header");
     if (memcmp(data, JOURNAL_MAGIC, 8) != 0)
         return fail(err, err_len, name, 0, "not an argil journal");
-    if (io_get_u32le(data + JOURNAL_HEADER_BYTES - 4) !=
+    if (le_get_u32(data + JOURNAL_HEADER_BYTES - 4) !=
         crc32c(0, data, JOURNAL_HEADER_BYTES - 4))
         return fail(err, err_len, name, JOURNAL_HEADER_BYTES - 4, "header checksum mismatch");
-    info->version = io_get_u32le(data + 8);
+    info->version = le_get_u32(data + 8);
     if (info->version < 1 || info->version > JOURNAL_VERSION)
         return fail(err, err_len, name, 8, "journal version (this argil reads 1..2)");
-    if (io_get_u32le(data + 12) != JOURNAL_HEADER_BYTES)
+    if (le_get_u32(data + 12) != JOURNAL_HEADER_BYTES)
         return fail(err, err_len, name, 12, "header size");
     int64_t n = 1;
     for (int a = 0; a < 3; a++) {
-        const int32_t d = (int32_t)io_get_u32le(data + 16 + 4 * a);
+        const int32_t d = (int32_t)le_get_u32(data + 16 + 4 * a);
         if (d < 1 || (n *= d) > GRID_SAMPLES_MAX)
             return fail(err, err_len, name, 16 + 4 * (size_t)a, "grid dimension below 1 or "
                                                                "more than 2^30 samples");
         info->dims[a] = d;
     }
-    info->spacing_m = io_get_f32le(data + 28);
-    info->origin_m = vec3(io_get_f32le(data + 32), io_get_f32le(data + 36),
-                          io_get_f32le(data + 40));
-    info->iso = io_get_f32le(data + 44);
-    info->band_m = io_get_f32le(data + 48);
+    info->spacing_m = le_get_f32(data + 28);
+    info->origin_m = vec3(le_get_f32(data + 32), le_get_f32(data + 36),
+                          le_get_f32(data + 40));
+    info->iso = le_get_f32(data + 44);
+    info->band_m = le_get_f32(data + 48);
     if (!isfinite(info->spacing_m) || !(info->spacing_m > 0.0f) || !vec3_isfinite(info->origin_m) ||
         !isfinite(info->iso) || !isfinite(info->band_m))
         return fail(err, err_len, name, 28, "grid spacing, origin, iso or band not finite");
     journal_get_material(data + 52, &info->material);
     if (!spring_material_valid(&info->material))
         return fail(err, err_len, name, 52, "material out of range");
-    info->checkpoint = io_get_u32le(data + 72);
-    info->first_seq = io_get_u32le(data + 76);
+    info->checkpoint = le_get_u32(data + 72);
+    info->first_seq = le_get_u32(data + 76);
     if (info->first_seq == 0)
         return fail(err, err_len, name, 76, "first record number 0");
     info->last_seq = info->first_seq - 1u;
-    info->base_len = journal_get_u64(data + 80);
-    info->base_crc = io_get_u32le(data + 88);
-    info->edits = io_get_u32le(data + 92);
+    info->base_len = le_get_u64(data + 80);
+    info->base_crc = le_get_u32(data + 88);
+    info->edits = le_get_u32(data + 92);
     const uint8_t *bn = data + 96;
     size_t bl = 0;
     while (bl < JOURNAL_BASE_NAME_MAX && bn[bl] != 0)
@@ -90,7 +90,7 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
         snprintf(why, sizeof(why), "record %u: material block count runs past the record", rec);
         return fail(err, err_len, name, at + 4 + o, why);
     }
-    const uint32_t blocks = io_get_u32le(p + o);
+    const uint32_t blocks = le_get_u32(p + o);
     if (blocks < min_blocks || blocks > GRID_MAT_N) {
         snprintf(why, sizeof(why), "record %u: material block count %u not in %u..4", rec, blocks,
                  min_blocks);
@@ -104,7 +104,7 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
                      rec, k);
             return fail(err, err_len, name, at + 4 + o, why);
         }
-        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        const uint32_t ch = le_get_u32(p + o), runs = le_get_u32(p + o + 4);
         if (ch >= GRID_MAT_N || (int64_t)ch <= prev || runs < 1) {
             snprintf(why, sizeof(why), "record %u: material block %u: channel %u not 0..3 in "
                      "increasing order, or no runs", rec, k, ch);
@@ -118,7 +118,7 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
                          rec, r);
                 return fail(err, err_len, name, at + 4 + o, why);
             }
-            const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            const uint64_t start = le_get_u32(p + o), count = le_get_u32(p + o + 4);
             if (count == 0 || start + count > (uint64_t)n || count > (payload - o - 8) / 4) {
                 snprintf(why, sizeof(why), "record %u: material run %u (%llu samples from %llu) "
                          "empty, beyond the grid or past the record", rec, r,
@@ -126,7 +126,7 @@ static argil_err_t check_mat_blocks(const uint8_t *p, size_t payload, size_t *of
                 return fail(err, err_len, name, at + 4 + o, why);
             }
             for (uint64_t i = 0; i < count; i++)
-                if (!grid_mat_valid((grid_mat_t)ch, io_get_f32le(p + o + 8 + 4 * i))) {
+                if (!grid_mat_valid((grid_mat_t)ch, le_get_f32(p + o + 8 + 4 * i))) {
                     snprintf(why, sizeof(why), "record %u: painted material value out of range "
                              "(finite; mass scale > 0, stiffness and damping scales >= 0)", rec);
                     return fail(err, err_len, name, at + 4 + o + 8 + 4 * (size_t)i, why);
@@ -152,7 +152,7 @@ static argil_err_t check_rgb_runs(const uint8_t *p, size_t payload, size_t *off,
         snprintf(why, sizeof(why), "record %u: colour run count runs past the record", rec);
         return fail(err, err_len, name, at + 4 + o, why);
     }
-    const uint32_t runs = io_get_u32le(p + o);
+    const uint32_t runs = le_get_u32(p + o);
     if (runs < 1) {
         snprintf(why, sizeof(why), "record %u: colour run count 0", rec);
         return fail(err, err_len, name, at + 4 + o, why);
@@ -165,7 +165,7 @@ static argil_err_t check_rgb_runs(const uint8_t *p, size_t payload, size_t *off,
                      r);
             return fail(err, err_len, name, at + 4 + o, why);
         }
-        const uint64_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        const uint64_t start = le_get_u32(p + o), count = le_get_u32(p + o + 4);
         if (count == 0 || start < next || start + count > (uint64_t)n ||
             count > (payload - o - 8) / 3) {
             snprintf(why, sizeof(why), "record %u: colour run %u (%llu samples from %llu) empty, "
@@ -194,10 +194,10 @@ static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, uint8_t **rgb, s
         }
         memset(*rgb, (int)GRID_RGB_DEFAULT, 3 * n);
     }
-    const uint32_t runs = io_get_u32le(p + off);
+    const uint32_t runs = le_get_u32(p + off);
     size_t o = off + 4;
     for (uint32_t r = 0; r < runs; r++) {
-        const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+        const size_t start = le_get_u32(p + o), count = le_get_u32(p + o + 4);
         memcpy(*rgb + 3 * start, p + o + 8, 3 * count);
         o += 8 + 3 * count;
     }
@@ -209,11 +209,11 @@ static argil_err_t apply_rgb_runs(const uint8_t *p, size_t off, uint8_t **rgb, s
 static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, float *mat[GRID_MAT_N],
                                     size_t n, const char *name, char *err, size_t err_len)
 {
-    const uint32_t blocks = io_get_u32le(p + off);
+    const uint32_t blocks = le_get_u32(p + off);
     size_t o = off + 4;
     /* Every channel the record touches exists before anything is written. */
     for (uint32_t k = 0; k < blocks; k++) {
-        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        const uint32_t ch = le_get_u32(p + o), runs = le_get_u32(p + o + 4);
         if (mat[ch] == NULL) {
             mat[ch] = malloc(n * sizeof(float));
             if (mat[ch] == NULL) {
@@ -226,17 +226,17 @@ static argil_err_t apply_mat_blocks(const uint8_t *p, size_t off, float *mat[GRI
         }
         o += 8;
         for (uint32_t r = 0; r < runs; r++)
-            o += 8 + 4 * (size_t)io_get_u32le(p + o + 4);
+            o += 8 + 4 * (size_t)le_get_u32(p + o + 4);
     }
     o = off + 4;
     for (uint32_t k = 0; k < blocks; k++) {
-        const uint32_t ch = io_get_u32le(p + o), runs = io_get_u32le(p + o + 4);
+        const uint32_t ch = le_get_u32(p + o), runs = le_get_u32(p + o + 4);
         float *m = mat[ch];
         o += 8;
         for (uint32_t r = 0; r < runs; r++) {
-            const size_t start = io_get_u32le(p + o), count = io_get_u32le(p + o + 4);
+            const size_t start = le_get_u32(p + o), count = le_get_u32(p + o + 4);
             for (size_t i = 0; i < count; i++)
-                m[start + i] = io_get_f32le(p + o + 8 + 4 * i);
+                m[start + i] = le_get_f32(p + o + 8 + 4 * i);
             o += 8 + 4 * count;
         }
     }
@@ -254,12 +254,12 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: shorter than a record head", rec);
         return fail(err, err_len, name, at, why);
     }
-    const uint32_t type = io_get_u32le(p);
+    const uint32_t type = le_get_u32(p);
     if (type != 1u && ((type != 2u && type != 3u) || info->version < 2u)) {
         snprintf(why, sizeof(why), "record %u: unknown record type %u", rec, type);
         return fail(err, err_len, name, at + 4, why);
     }
-    const uint32_t seq = io_get_u32le(p + 4);
+    const uint32_t seq = le_get_u32(p + 4);
     if (seq != info->last_seq + 1u) {
         snprintf(why, sizeof(why), "record %u: number %u, expected %u", rec, seq,
                  info->last_seq + 1u);
@@ -271,7 +271,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: material out of range", rec);
         return fail(err, err_len, name, at + 32, why);
     }
-    const uint32_t runs = io_get_u32le(p + 48);
+    const uint32_t runs = le_get_u32(p + 48);
     /* Check every run before changing anything. */
     size_t off = JOURNAL_RECORD_HEAD_BYTES;
     uint64_t samples = 0, mat_samples = 0;
@@ -280,7 +280,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
             snprintf(why, sizeof(why), "record %u: run %u head runs past the record", rec, r);
             return fail(err, err_len, name, at + 4 + off, why);
         }
-        const uint64_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+        const uint64_t start = le_get_u32(p + off), count = le_get_u32(p + off + 4);
         if (count == 0 || start + count > (uint64_t)n || count > (payload - off - 8) / 4) {
             snprintf(why, sizeof(why),
                      "record %u: run %u (%llu samples from %llu) empty, beyond the grid or "
@@ -289,7 +289,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
             return fail(err, err_len, name, at + 4 + off, why);
         }
         for (uint64_t i = 0; i < count; i++) {
-            const float v = io_get_f32le(p + off + 8 + 4 * i);
+            const float v = le_get_f32(p + off + 8 + 4 * i);
             if (!isfinite(v) || v < 0.0f || v > 1.0f) {
                 snprintf(why, sizeof(why), "record %u: density not a finite number in [0, 1]",
                          rec);
@@ -315,7 +315,7 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
         snprintf(why, sizeof(why), "record %u: %zu bytes after the last run", rec, payload - off);
         return fail(err, err_len, name, at + 4 + off, why);
     }
-    if (type >= 2u && mat != NULL && io_get_u32le(p + mat_off) > 0) {
+    if (type >= 2u && mat != NULL && le_get_u32(p + mat_off) > 0) {
         const argil_err_t e = apply_mat_blocks(p, mat_off, mat, n, name, err, err_len);
         if (e != ARGIL_OK)
             return e;
@@ -328,17 +328,17 @@ static argil_err_t apply_record(const uint8_t *p, size_t payload, size_t at, con
     if (density != NULL) {
         off = JOURNAL_RECORD_HEAD_BYTES;
         for (uint32_t r = 0; r < runs; r++) {
-            const size_t start = io_get_u32le(p + off), count = io_get_u32le(p + off + 4);
+            const size_t start = le_get_u32(p + off), count = le_get_u32(p + off + 4);
             for (size_t i = 0; i < count; i++)
-                density[start + i] = io_get_f32le(p + off + 8 + 4 * i);
+                density[start + i] = le_get_f32(p + off + 8 + 4 * i);
             off += 8 + 4 * count;
         }
     }
     info->records++;
     info->last_seq = seq;
-    info->last_sim_s = (double)journal_get_u64(p + 8) * 1e-6;
-    info->last_wall_ms = journal_get_u64(p + 16);
-    info->edits = io_get_u32le(p + 24);
+    info->last_sim_s = (double)le_get_u64(p + 8) * 1e-6;
+    info->last_wall_ms = le_get_u64(p + 16);
+    info->edits = le_get_u32(p + 24);
     info->material = m;
     info->samples += samples;
     info->mat_samples += mat_samples;
@@ -368,12 +368,12 @@ argil_err_t journal_replay_channels(const uint8_t *data, size_t len, const char 
             info->torn_bytes = left;
             break;
         }
-        const uint64_t payload = io_get_u32le(data + at);
+        const uint64_t payload = le_get_u32(data + at);
         if (payload + 8 > left) {
             info->torn_bytes = left; /* declared length runs past the end: a cut-short write */
             break;
         }
-        const uint32_t crc = io_get_u32le(data + at + 4 + payload);
+        const uint32_t crc = le_get_u32(data + at + 4 + payload);
         if (crc != crc32c(0, data + at, 4 + (size_t)payload)) {
             if (payload + 8 == left) {
                 info->torn_bytes = left; /* the very last record, partly written */

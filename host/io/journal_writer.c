@@ -165,24 +165,24 @@ static void encode_header(const journal_t *j, const char *base, uint64_t base_le
 {
     memset(h, 0, JOURNAL_HEADER_BYTES);
     memcpy(h, JOURNAL_MAGIC, 8);
-    io_put_u32le(h + 8, JOURNAL_VERSION);
-    io_put_u32le(h + 12, JOURNAL_HEADER_BYTES);
+    le_put_u32(h + 8, JOURNAL_VERSION);
+    le_put_u32(h + 12, JOURNAL_HEADER_BYTES);
     for (int a = 0; a < 3; a++)
-        io_put_u32le(h + 16 + 4 * a, (uint32_t)j->dims[a]);
-    io_put_f32le(h + 28, j->spacing_m);
-    io_put_f32le(h + 32, j->origin_m.x);
-    io_put_f32le(h + 36, j->origin_m.y);
-    io_put_f32le(h + 40, j->origin_m.z);
-    io_put_f32le(h + 44, j->iso);
-    io_put_f32le(h + 48, j->band_m);
+        le_put_u32(h + 16 + 4 * a, (uint32_t)j->dims[a]);
+    le_put_f32(h + 28, j->spacing_m);
+    le_put_f32(h + 32, j->origin_m.x);
+    le_put_f32(h + 36, j->origin_m.y);
+    le_put_f32(h + 40, j->origin_m.z);
+    le_put_f32(h + 44, j->iso);
+    le_put_f32(h + 48, j->band_m);
     journal_put_material(h + 52, &j->material);
-    io_put_u32le(h + 72, j->checkpoint);
-    io_put_u32le(h + 76, j->seq + 1u);
-    journal_put_u64(h + 80, base_len);
-    io_put_u32le(h + 88, base_crc);
-    io_put_u32le(h + 92, base_edits);
+    le_put_u32(h + 72, j->checkpoint);
+    le_put_u32(h + 76, j->seq + 1u);
+    le_put_u64(h + 80, base_len);
+    le_put_u32(h + 88, base_crc);
+    le_put_u32(h + 92, base_edits);
     memcpy(h + 96, base, strlen(base));
-    io_put_u32le(h + JOURNAL_HEADER_BYTES - 4, crc32c(0, h, JOURNAL_HEADER_BYTES - 4));
+    le_put_u32(h + JOURNAL_HEADER_BYTES - 4, crc32c(0, h, JOURNAL_HEADER_BYTES - 4));
 }
 
 /* Writes base snapshot number j->checkpoint from the shadow, then a new journal.log (via
@@ -419,8 +419,8 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
             j->buf_len = at;
             continue;
         }
-        io_put_u32le(j->buf + at, (uint32_t)ch);
-        io_put_u32le(j->buf + at + 4, mruns);
+        le_put_u32(j->buf + at, (uint32_t)ch);
+        le_put_u32(j->buf + at + 4, mruns);
         blocks++;
     }
     if (look_mat)
@@ -438,13 +438,13 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
         if (rgb_runs == 0)
             j->buf_len = rgb_at;
         else
-            io_put_u32le(j->buf + rgb_at, rgb_runs);
+            le_put_u32(j->buf + rgb_at, rgb_runs);
         j->rgb_writes = g->rgb_writes;
     }
     if (blocks == 0 && rgb_runs == 0)
         j->buf_len = blocks_at;
     else
-        io_put_u32le(j->buf + blocks_at, blocks);
+        le_put_u32(j->buf + blocks_at, blocks);
     if (runs == 0 && !material_changed && blocks == 0 && rgb_runs == 0) {
         j->buf_len = rec_at;
         return ARGIL_OK;
@@ -456,18 +456,18 @@ argil_err_t journal_record(journal_t *j, const grid_t *g, const journal_box_t *b
     j->edits = edits;
     j->seq++;
     uint8_t *p = j->buf + rec_at;
-    io_put_u32le(p, (uint32_t)payload);
+    le_put_u32(p, (uint32_t)payload);
     uint8_t *h = p + 4;
     /* record type: edit step (2: with painted material, 3: with painted colour) */
-    io_put_u32le(h, rgb_runs > 0 ? 3u : (blocks > 0 ? 2u : 1u));
-    io_put_u32le(h + 4, j->seq);
+    le_put_u32(h, rgb_runs > 0 ? 3u : (blocks > 0 ? 2u : 1u));
+    le_put_u32(h + 4, j->seq);
     const double sim_us = sim_s > 0.0 ? sim_s * 1e6 + 0.5 : 0.0;
-    journal_put_u64(h + 8, (uint64_t)sim_us);
-    journal_put_u64(h + 16, wall_ms);
-    io_put_u32le(h + 24, edits);
+    le_put_u64(h + 8, (uint64_t)sim_us);
+    le_put_u64(h + 16, wall_ms);
+    le_put_u32(h + 24, edits);
     journal_put_material(h + 28, &j->material);
-    io_put_u32le(h + 48, runs);
-    io_put_u32le(j->buf + j->buf_len, crc32c(0, p, 4 + payload));
+    le_put_u32(h + 48, runs);
+    le_put_u32(j->buf + j->buf_len, crc32c(0, p, 4 + payload));
     j->buf_len += 4;
     const size_t rec_bytes = j->buf_len - rec_at;
     if (rec_at == 0) {

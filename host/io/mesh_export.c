@@ -8,6 +8,7 @@
 #include <strings.h>
 
 #include "host/io/io_util.h"
+#include "shared/wire.h"
 
 typedef struct {
     const mesh_t *m;
@@ -68,7 +69,7 @@ static const char *ex_ply(FILE *f, const mesh_t *m, bool ascii)
         } else {
             const float val[6] = {p.x, p.y, p.z, n.x, n.y, n.z};
             for (int k = 0; k < 6; k++)
-                io_put_f32le(rec + 4 * k, val[k]);
+                le_put_f32(rec + 4 * k, val[k]);
             size_t len = 24;
             if (rgb) {
                 memcpy(rec + 24, m->rgb + 3 * v, 3);
@@ -86,7 +87,7 @@ static const char *ex_ply(FILE *f, const mesh_t *m, bool ascii)
         } else {
             rec[0] = 3;
             for (int k = 0; k < 3; k++)
-                io_put_u32le(rec + 1 + 4 * k, i[k]);
+                le_put_u32(rec + 1 + 4 * k, i[k]);
             if (fwrite(rec, 1, 13, f) != 13)
                 return "fwrite";
         }
@@ -99,7 +100,7 @@ static const char *ex_stl(FILE *f, const mesh_t *m)
     uint8_t head[84] = {0};
     const char title[] = "argil mesh, binary STL, model space in metres";
     memcpy(head, title, sizeof(title) - 1);
-    io_put_u32le(head + 80, (uint32_t)m->n_tri);
+    le_put_u32(head + 80, (uint32_t)m->n_tri);
     if (fwrite(head, 1, 84, f) != 84)
         return "fwrite";
     uint8_t rec[50];
@@ -111,9 +112,9 @@ static const char *ex_stl(FILE *f, const mesh_t *m)
         n = len > 0.0f ? vec3_scale(n, 1.0f / len) : vec3(0, 0, 0);
         const vec3_t v[4] = {n, a, b, c};
         for (int k = 0; k < 4; k++) {
-            io_put_f32le(rec + 12 * k, v[k].x);
-            io_put_f32le(rec + 12 * k + 4, v[k].y);
-            io_put_f32le(rec + 12 * k + 8, v[k].z);
+            le_put_f32(rec + 12 * k, v[k].x);
+            le_put_f32(rec + 12 * k + 4, v[k].y);
+            le_put_f32(rec + 12 * k + 8, v[k].z);
         }
         rec[48] = rec[49] = 0;
         if (fwrite(rec, 1, 50, f) != 50)

@@ -8,6 +8,7 @@
 #include <strings.h>
 
 #include "host/io/io_util.h"
+#include "shared/wire.h"
 
 /* ------------------------------------------------------------------ STL */
 
@@ -87,7 +88,7 @@ static argil_err_t stl_binary(const char *path, const uint8_t *b, size_t len, ui
         const size_t off = 84 + 50 * (size_t)t;
         float c[9];
         for (int k = 0; k < 9; k++) {
-            c[k] = io_get_f32le(b + off + 12 + 4 * (size_t)k);
+            c[k] = le_get_f32(b + off + 12 + 4 * (size_t)k);
             if (!isfinite(c[k])) {
                 io_err(err, err_len, "%s: byte %zu: facet %u has a non-finite coordinate", path,
                        off + 12 + 4 * (size_t)k, t);
@@ -220,7 +221,7 @@ argil_err_t stl_read(const char *path, mesh_t *out, char *err, size_t err_len)
     if (e != ARGIL_OK)
         return e;
     weld_t wd = {NULL, 0};
-    const uint32_t n_bin = len >= 84 ? io_get_u32le(b + 80) : 0;
+    const uint32_t n_bin = len >= 84 ? le_get_u32(b + 80) : 0;
     const bool binary = len >= 84 && (uint64_t)len == 84 + 50 * (uint64_t)n_bin;
     const bool ascii = !binary && len >= 5 && memcmp(b, "solid", 5) == 0;
     if (binary) {

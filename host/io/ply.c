@@ -15,6 +15,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "shared/wire.h"
+
 #define PLY_VERT_BYTES 24u  /* 6 floats */
 #define PLY_VERT_RGB_BYTES 27u /* 6 floats + uchar red green blue */
 #define PLY_FACE_BYTES 13u  /* uchar count + 3 int32 */
@@ -35,19 +37,6 @@ static void ply_err(char *err, size_t err_len, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(err, err_len, fmt, ap);
     va_end(ap);
-}
-
-static uint32_t get_u32_le(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static float get_f32_le(const uint8_t *p)
-{
-    const uint32_t v = get_u32_le(p);
-    float f;
-    memcpy(&f, &v, sizeof(f));
-    return f;
 }
 
 /* ---------------------------------------------------------------- writer */
@@ -292,7 +281,7 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
             const uint8_t *r = buf + i * c->vert_bytes;
             float v[6];
             for (int k = 0; k < 6; k++) {
-                v[k] = get_f32_le(r + 4 * (size_t)k);
+                v[k] = le_get_f32(r + 4 * (size_t)k);
                 if (!isfinite(v[k])) {
                     ply_err(c->err, c->err_len,
                             "ply_read_mesh: %s: byte %llu: vertex %llu has a non-finite %s",
@@ -329,7 +318,7 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
             }
             uint32_t idx[3];
             for (int k = 0; k < 3; k++) {
-                const int32_t s = (int32_t)get_u32_le(r + 1 + 4 * k);
+                const int32_t s = (int32_t)le_get_u32(r + 1 + 4 * k);
                 if (s < 0 || (uint64_t)s >= n_vert) {
                     ply_err(c->err, c->err_len,
                             "ply_read_mesh: %s: byte %llu: face %llu names vertex %ld of %llu",

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "host/io/io_util.h"
+#include "shared/wire.h"
 
 #define PLY_ELEMENTS_MAX 16
 #define PLY_PROPS_MAX 32
@@ -237,9 +238,7 @@ static argil_err_t ply_value(ply_in_t *in, ply_type_t t, const ply_elem_t *e, ui
     uint8_t b[8];
     for (int k = 0; k < sz; k++)
         b[k] = in->buf[in->pos + (size_t)(in->fmt == 1 ? k : sz - 1 - k)];
-    uint64_t u = 0;
-    for (int k = sz - 1; k >= 0; k--)
-        u = u << 8 | b[k];
+    const uint64_t u = le_get(b, (size_t)sz);
     switch (t) {
     case PT_I8: *out = (double)(int8_t)u; break;
     case PT_U8: *out = (double)(uint8_t)u; break;

@@ -15,6 +15,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/io_util.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 #include "tests/fuzz/fuzz_file.h"
 #include "tests/unit/grid_view.h"
 
@@ -82,27 +83,25 @@ static bool fix_checksums(uint8_t *b, size_t n)
         return false;
     uint8_t before[ARGIL_FILE_HEADER_BYTES];
     memcpy(before, b, sizeof(before));
-    const uint32_t old_file_crc = io_get_u32le(b + n - 4);
-    io_put_u32le(b + 16, (uint32_t)n);
-    io_put_u32le(b + 20, (uint32_t)((uint64_t)n >> 32));
-    io_put_u32le(b + 28, crc32c(0, b, 28));
+    const uint32_t old_file_crc = le_get_u32(b + n - 4);
+    le_put_u64(b + 16, (uint64_t)n);
+    le_put_u32(b + 28, crc32c(0, b, 28));
     bool changed = memcmp(before, b, sizeof(before)) != 0;
-    const uint32_t n_sec = io_get_u32le(b + 12);
+    const uint32_t n_sec = le_get_u32(b + 12);
     const size_t end = n - 4;
     size_t pos = ARGIL_FILE_HEADER_BYTES;
     for (uint32_t s = 0; s < n_sec && s < ARGIL_FILE_SECTIONS_MAX && end - pos >= 16; s++) {
-        const uint64_t sl = (uint64_t)io_get_u32le(b + pos + 4) |
-                            (uint64_t)io_get_u32le(b + pos + 8) << 32;
+        const uint64_t sl = le_get_u64(b + pos + 4);
         if (sl > (uint64_t)(end - pos - 16))
             break;
         const size_t crc_off = pos + 12 + (size_t)sl;
         const uint32_t crc = crc32c(0, b + pos, 12 + (size_t)sl);
-        changed = changed || io_get_u32le(b + crc_off) != crc;
-        io_put_u32le(b + crc_off, crc);
+        changed = changed || le_get_u32(b + crc_off) != crc;
+        le_put_u32(b + crc_off, crc);
         pos = crc_off + 4;
     }
     const uint32_t file_crc = crc32c(0, b, n - 4);
-    io_put_u32le(b + n - 4, file_crc);
+    le_put_u32(b + n - 4, file_crc);
     return changed || file_crc != old_file_crc;
 }
 

@@ -15,6 +15,7 @@
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 #include "tests/unit/grid_view.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -86,16 +87,16 @@ static bool fix_checksums(uint8_t *b, size_t n)
         return false;
     bool changed = false;
     const uint32_t hc = crc32c(0, b, JOURNAL_HEADER_BYTES - 4);
-    changed = io_get_u32le(b + JOURNAL_HEADER_BYTES - 4) != hc;
-    io_put_u32le(b + JOURNAL_HEADER_BYTES - 4, hc);
+    changed = le_get_u32(b + JOURNAL_HEADER_BYTES - 4) != hc;
+    le_put_u32(b + JOURNAL_HEADER_BYTES - 4, hc);
     size_t at = JOURNAL_HEADER_BYTES;
     while (n - at >= 8) {
-        const uint64_t payload = io_get_u32le(b + at);
+        const uint64_t payload = le_get_u32(b + at);
         if (payload + 8 > n - at)
             break;
         const uint32_t c = crc32c(0, b + at, 4 + (size_t)payload);
-        changed = changed || io_get_u32le(b + at + 4 + payload) != c;
-        io_put_u32le(b + at + 4 + payload, c);
+        changed = changed || le_get_u32(b + at + 4 + payload) != c;
+        le_put_u32(b + at + 4 + payload, c);
         at += 8 + (size_t)payload;
     }
     return changed;

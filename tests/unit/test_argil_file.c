@@ -16,6 +16,7 @@
 #include "host/io/argil_file.h"
 #include "host/io/io_util.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 
 #include "tests/unit/test_files.h"
 #include "tests/unit/grid_view.h"
@@ -183,10 +184,10 @@ static void b_sec(build_t *f, const char *tag, const void *payload, size_t n)
 {
     uint8_t *s = f->b + f->len;
     memcpy(s, tag, 4);
-    io_put_u32le(s + 4, (uint32_t)n);
-    io_put_u32le(s + 8, 0);
+    le_put_u32(s + 4, (uint32_t)n);
+    le_put_u32(s + 8, 0);
     memcpy(s + 12, payload, n);
-    io_put_u32le(s + 12 + n, crc32c(0, s, 12 + n));
+    le_put_u32(s + 12 + n, crc32c(0, s, 12 + n));
     f->len += 16 + n;
     f->n_sec++;
 }
@@ -195,28 +196,28 @@ static void b_end(build_t *f, const char *path, uint32_t version)
 {
     static const uint8_t magic[8] = {'A', 'R', 'G', 'I', 'L', '\r', '\n', 0x1a};
     memcpy(f->b, magic, 8);
-    io_put_u32le(f->b + 8, version);
-    io_put_u32le(f->b + 12, f->n_sec);
-    io_put_u32le(f->b + 16, (uint32_t)(f->len + 4));
-    io_put_u32le(f->b + 20, 0);
-    io_put_u32le(f->b + 24, 0);
-    io_put_u32le(f->b + 28, crc32c(0, f->b, 28));
-    io_put_u32le(f->b + f->len, crc32c(0, f->b, f->len));
+    le_put_u32(f->b + 8, version);
+    le_put_u32(f->b + 12, f->n_sec);
+    le_put_u32(f->b + 16, (uint32_t)(f->len + 4));
+    le_put_u32(f->b + 20, 0);
+    le_put_u32(f->b + 24, 0);
+    le_put_u32(f->b + 28, crc32c(0, f->b, 28));
+    le_put_u32(f->b + f->len, crc32c(0, f->b, f->len));
     test_spit(path, f->b, f->len + 4);
 }
 
 /* A 1x1x2 GRID payload with the given density and spacing. */
 static size_t grid_payload(uint8_t *p, int32_t nx, float spacing, float density)
 {
-    io_put_u32le(p, (uint32_t)nx);
-    io_put_u32le(p + 4, 1);
-    io_put_u32le(p + 8, 2);
+    le_put_u32(p, (uint32_t)nx);
+    le_put_u32(p + 4, 1);
+    le_put_u32(p + 8, 2);
     const float f[6] = {spacing, 0, 0, 0, 0.5f, 0.004f};
     for (int k = 0; k < 6; k++)
-        io_put_f32le(p + 12 + 4 * k, f[k]);
+        le_put_f32(p + 12 + 4 * k, f[k]);
     const size_t n = nx > 0 ? 2u * (size_t)nx : 0;
     for (size_t i = 0; i < n && i < 64; i++)
-        io_put_f32le(p + 36 + 4 * i, density);
+        le_put_f32(p + 36 + 4 * i, density);
     return 36 + 4 * (n < 64 ? n : 64);
 }
 
@@ -281,7 +282,7 @@ static void test_each_rule(void **state)
     expect_rule(p, at, "section head runs past the end");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
-    io_put_u32le(f.b + 36, 100000); /* length beyond the file, crc not even reached */
+    le_put_u32(f.b + 36, 100000); /* length beyond the file, crc not even reached */
     b_end(&f, p, 1);
     expect_rule(p, "byte 36", "section length runs past the end");
     b_begin(&f);
@@ -314,14 +315,14 @@ static void test_each_rule(void **state)
     }
     /* values inside sections */
     uint8_t t[64] = {0};
-    io_put_f32le(t + 4, -1.0f);
+    le_put_f32(t + 4, -1.0f);
     b_begin(&f);
     b_sec(&f, "TOOL", t, 16);
     b_end(&f, p, 1);
     expect_rule(p, "byte 48", "TOOL radius or strength out of range");
     memset(t, 0, sizeof(t));
-    io_put_u32le(t, 1);
-    io_put_f32le(t + 8, NAN);
+    le_put_u32(t, 1);
+    le_put_f32(t + 8, NAN);
     b_begin(&f);
     b_sec(&f, "RBF3", t, 44);
     b_end(&f, p, 1);
@@ -333,8 +334,8 @@ static void test_each_rule(void **state)
     b_end(&f, p, 1);
     expect_rule(p, "byte 44", "GRID dimension below 1");
     g2l = grid_payload(g2, 1, 0.001f, 0.5f);
-    io_put_u32le(g2 + 4, 1u << 20);
-    io_put_u32le(g2 + 8, 1u << 20);
+    le_put_u32(g2 + 4, 1u << 20);
+    le_put_u32(g2 + 8, 1u << 20);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l);
     b_end(&f, p, 1);
@@ -379,7 +380,7 @@ static void test_each_rule(void **state)
     uint8_t m[20];
     const float mf[5] = {2.0f, 1.0f, 1.0f, 1.0f, 0.0f};
     for (int k = 0; k < 5; k++)
-        io_put_f32le(m + 4 * k, mf[k]);
+        le_put_f32(m + 4 * k, mf[k]);
     b_begin(&f);
     b_sec(&f, "MATL", m, 20);
     b_sec(&f, "XTRA", x, 8);
@@ -396,14 +397,14 @@ static void test_each_rule(void **state)
 static size_t octb_payload(uint8_t *p, uint32_t n, uint32_t per_axis, uint32_t kind, float size,
                            const uint32_t *links, float coef)
 {
-    io_put_u32le(p, n);
-    io_put_u32le(p + 4, per_axis);
-    io_put_u32le(p + 8, kind);
+    le_put_u32(p, n);
+    le_put_u32(p + 4, per_axis);
+    le_put_u32(p + 8, kind);
     const float f[7] = {0, 0, 0, size, 1e-4f, 2e-4f, 0.25f};
     for (int k = 0; k < 7; k++)
-        io_put_f32le(p + 12 + 4 * k, f[k]);
+        le_put_f32(p + 12 + 4 * k, f[k]);
     for (uint32_t i = 0; i < n; i++)
-        io_put_u32le(p + 40 + 4 * i, links[i]);
+        le_put_u32(p + 40 + 4 * i, links[i]);
     size_t len = 40 + 4 * (size_t)n;
     /* One block of coefficients per leaf (a link of 0), at least one. */
     uint32_t leaves = 0;
@@ -412,7 +413,7 @@ static size_t octb_payload(uint8_t *p, uint32_t n, uint32_t per_axis, uint32_t k
     if (leaves == 0)
         leaves = 1;
     for (uint32_t i = 0; i < leaves * OCTFIT_NCOEF; i++, len += 4)
-        io_put_f32le(p + len, coef);
+        le_put_f32(p + len, coef);
     return len;
 }
 
@@ -523,8 +524,8 @@ static void test_painted_round_trip(void **state)
     assert_int_equal(argil_file_write(q, &d, err, sizeof(err)), ARGIL_OK);
     size_t lp, lq;
     uint8_t *bp = test_slurp(p, &lp), *bq = test_slurp(q, &lq);
-    assert_int_equal(io_get_u32le(bp + 8), 1);
-    assert_int_equal(io_get_u32le(bq + 8), 2);
+    assert_int_equal(le_get_u32(bp + 8), 1);
+    assert_int_equal(le_get_u32(bq + 8), 2);
     /* MTLS = 16 overhead + 4 count + stiffness (8 + 2 runs: 8+4*4, 8+4) + mass (8 + 8+2*4) +
      * rest length (8 + 8+4); damping holds no painted value and is left out. */
     assert_int_equal(lq - lp, 16 + 4 + (8 + 24 + 12) + (8 + 16) + (8 + 12));
@@ -629,12 +630,12 @@ static void mtls_case(const char *path, uint32_t version, const uint8_t *m, size
 static size_t mtls_one(uint8_t *m, uint32_t k, uint32_t ch, uint32_t runs, uint32_t start,
                        uint32_t count, float v)
 {
-    io_put_u32le(m, k);
-    io_put_u32le(m + 4, ch);
-    io_put_u32le(m + 8, runs);
-    io_put_u32le(m + 12, start);
-    io_put_u32le(m + 16, count);
-    io_put_f32le(m + 20, v);
+    le_put_u32(m, k);
+    le_put_u32(m + 4, ch);
+    le_put_u32(m + 8, runs);
+    le_put_u32(m + 12, start);
+    le_put_u32(m + 16, count);
+    le_put_f32(m + 20, v);
     return 24;
 }
 
@@ -653,18 +654,18 @@ static void test_mtls_rules(void **state)
     argil_doc_free(&r);
     /* Damping (2) then rest length (3): two channels, increasing ids. */
     uint8_t two[64];
-    io_put_u32le(two, 2);
+    le_put_u32(two, 2);
     mtls_one(two, 2, GRID_MAT_DAMPING, 1, 0, 1, 0.0f); /* overwrites the count: fix below */
-    io_put_u32le(two, 2);
+    le_put_u32(two, 2);
     memcpy(two + 24, two + 4, 20);
-    io_put_u32le(two + 24, GRID_MAT_RESTLEN);
-    io_put_f32le(two + 40, -0.25f);
+    le_put_u32(two + 24, GRID_MAT_RESTLEN);
+    le_put_f32(two + 40, -0.25f);
     mtls_case(p, 2, two, 44, 1);
     assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_OK);
     assert_float_equal(gv_mat(&r.grid, GRID_MAT_DAMPING, 0), 0.0f, 0);
     assert_float_equal(gv_mat(&r.grid, GRID_MAT_RESTLEN, 0), -0.25f, 0);
     argil_doc_free(&r);
-    io_put_u32le(two + 24, GRID_MAT_DAMPING);
+    le_put_u32(two + 24, GRID_MAT_DAMPING);
     mtls_case(p, 2, two, 44, 1);
     expect_rule(p, "byte 128", "MTLS channel id not 0..3");
 
@@ -702,10 +703,10 @@ static void test_mtls_rules(void **state)
     expect_rule(p, "byte 128", "MTLS run head runs past the section");
     /* Two runs, the second starting inside the first. */
     ml = mtls_one(m, 1, 0, 2, 0, 2, 4.0f);
-    io_put_f32le(m + 24, 3.0f);
-    io_put_u32le(m + 28, 1);
-    io_put_u32le(m + 32, 1);
-    io_put_f32le(m + 36, 2.0f);
+    le_put_f32(m + 24, 3.0f);
+    le_put_u32(m + 28, 1);
+    le_put_u32(m + 32, 1);
+    le_put_f32(m + 36, 2.0f);
     mtls_case(p, 2, m, 40, 1);
     expect_rule(p, "byte 132", "overlapping or out of order");
     ml = mtls_one(m, 1, GRID_MAT_MASS, 1, 0, 1, 0.0f);
@@ -767,7 +768,7 @@ static void test_paint_settings(void **state)
         build_t f;
         b_begin(&f);
         b_sec(&f, "GRID", g, gl);
-        io_put_f32le(v, rates[k]);
+        le_put_f32(v, rates[k]);
         b_sec(&f, "PNTS", v, 4);
         b_end(&f, p, 1);
         snprintf(where, sizeof(where), "byte %zu", 32 + 16 + gl + 12);
@@ -777,7 +778,7 @@ static void test_paint_settings(void **state)
         build_t f;
         b_begin(&f);
         b_sec(&f, "GRID", g, gl);
-        io_put_f32le(v, 5.0f);
+        le_put_f32(v, 5.0f);
         b_sec(&f, "PNTS", v, k == 0 ? 8 : 4);
         if (k == 1)
             b_sec(&f, "PNTS", v, 4);

@@ -18,6 +18,7 @@
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 
 #include "tests/unit/test_files.h"
 #include "tests/unit/grid_view.h"
@@ -215,7 +216,7 @@ static void test_torn_tail_every_byte(void **state)
     size_t at = JOURNAL_HEADER_BYTES, last = 0;
     while (at < len) {
         last = at;
-        at += 8 + io_get_u32le(full + at);
+        at += 8 + le_get_u32(full + at);
     }
     assert_int_equal(at, len);
     assert_true(len - last > 100);
@@ -251,9 +252,9 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
     test_path(jp, sizeof(jp), JOURNAL_FILE);
     size_t len;
     uint8_t *full = test_slurp(jp, &len);
-    const size_t r1 = JOURNAL_HEADER_BYTES, r2 = r1 + 8 + io_get_u32le(full + r1);
-    const size_t r3 = r2 + 8 + io_get_u32le(full + r2);
-    const size_t r4 = r3 + 8 + io_get_u32le(full + r3);
+    const size_t r1 = JOURNAL_HEADER_BYTES, r2 = r1 + 8 + le_get_u32(full + r1);
+    const size_t r3 = r2 + 8 + le_get_u32(full + r2);
+    const size_t r4 = r3 + 8 + le_get_u32(full + r3);
     /* A flipped bit inside record 2's values. */
     full[r2 + 70] ^= 0x10;
     test_spit(jp, full, len);
@@ -372,9 +373,9 @@ static uint8_t *one_record(size_t *len)
 
 static void fix_record_crc(uint8_t *b, size_t len)
 {
-    const size_t r = JOURNAL_HEADER_BYTES, payload = io_get_u32le(b + r);
+    const size_t r = JOURNAL_HEADER_BYTES, payload = le_get_u32(b + r);
     if (r + 8 + payload <= len)
-        io_put_u32le(b + r + 4 + payload, crc32c(0, b + r, 4 + payload));
+        le_put_u32(b + r + 4 + payload, crc32c(0, b + r, 4 + payload));
 }
 
 static void expect_refusal(const uint8_t *b, size_t len, const char *rule)
@@ -416,29 +417,29 @@ static void test_each_rule(void **state)
     FRESH();
     b[20] ^= 1;
     expect_refusal(b, len, "header checksum mismatch");
-#define HDR_FIX() io_put_u32le(b + h - 4, crc32c(0, b, h - 4))
+#define HDR_FIX() le_put_u32(b + h - 4, crc32c(0, b, h - 4))
     FRESH();
-    io_put_u32le(b + 8, 3);
+    le_put_u32(b + 8, 3);
     HDR_FIX();
     expect_refusal(b, len, "journal version (this argil reads 1..2)");
     FRESH();
-    io_put_u32le(b + 12, 100);
+    le_put_u32(b + 12, 100);
     HDR_FIX();
     expect_refusal(b, len, "header size");
     FRESH();
-    io_put_u32le(b + 16, 0);
+    le_put_u32(b + 16, 0);
     HDR_FIX();
     expect_refusal(b, len, "grid dimension");
     FRESH();
-    io_put_f32le(b + 28, -1.0f);
+    le_put_f32(b + 28, -1.0f);
     HDR_FIX();
     expect_refusal(b, len, "spacing");
     FRESH();
-    io_put_f32le(b + 52, 0.0f); /* node mass */
+    le_put_f32(b + 52, 0.0f); /* node mass */
     HDR_FIX();
     expect_refusal(b, len, "material out of range");
     FRESH();
-    io_put_u32le(b + 76, 0);
+    le_put_u32(b + 76, 0);
     HDR_FIX();
     expect_refusal(b, len, "first record number 0");
     FRESH();
@@ -456,49 +457,49 @@ static void test_each_rule(void **state)
 
     /* Record rules, each with a good CRC. */
     FRESH();
-    io_put_u32le(b + p, 7);
+    le_put_u32(b + p, 7);
     fix_record_crc(b, len);
     expect_refusal(b, len, "unknown record type 7");
     FRESH();
-    io_put_u32le(b + 8, 1); /* a version-1 journal has no painted-material records */
+    le_put_u32(b + 8, 1); /* a version-1 journal has no painted-material records */
     HDR_FIX();
-    io_put_u32le(b + p, 2);
+    le_put_u32(b + p, 2);
     fix_record_crc(b, len);
     expect_refusal(b, len, "unknown record type 2");
     FRESH();
-    io_put_u32le(b + p, 2); /* type 2 without its material blocks */
+    le_put_u32(b + p, 2); /* type 2 without its material blocks */
     fix_record_crc(b, len);
     expect_refusal(b, len, "material block count runs past the record");
     FRESH();
-    io_put_u32le(b + p + 4, 5);
+    le_put_u32(b + p + 4, 5);
     fix_record_crc(b, len);
     expect_refusal(b, len, "record 1: number 5, expected 1");
     FRESH();
-    io_put_f32le(b + p + 28, -1.0f);
+    le_put_f32(b + p + 28, -1.0f);
     fix_record_crc(b, len);
     expect_refusal(b, len, "record 1: material out of range");
     FRESH();
-    io_put_u32le(b + p + 52, N_SAMPLES); /* first run's start: past the last sample */
+    le_put_u32(b + p + 52, N_SAMPLES); /* first run's start: past the last sample */
     fix_record_crc(b, len);
     expect_refusal(b, len, "beyond the grid");
     FRESH();
-    io_put_u32le(b + p + 56, 0); /* first run's count */
+    le_put_u32(b + p + 56, 0); /* first run's count */
     fix_record_crc(b, len);
     expect_refusal(b, len, "empty");
     FRESH();
-    io_put_f32le(b + p + 60, 1.5f);
+    le_put_f32(b + p + 60, 1.5f);
     fix_record_crc(b, len);
     expect_refusal(b, len, "density not a finite number in [0, 1]");
     FRESH();
-    io_put_f32le(b + p + 60, NAN);
+    le_put_f32(b + p + 60, NAN);
     fix_record_crc(b, len);
     expect_refusal(b, len, "density not a finite number in [0, 1]");
     FRESH();
-    io_put_u32le(b + p + 48, io_get_u32le(b + p + 48) + 1u); /* one run more than there is */
+    le_put_u32(b + p + 48, le_get_u32(b + p + 48) + 1u); /* one run more than there is */
     fix_record_crc(b, len);
     expect_refusal(b, len, "head runs past the record");
     FRESH();
-    io_put_u32le(b + p + 48, io_get_u32le(b + p + 48) - 1u); /* one run less */
+    le_put_u32(b + p + 48, le_get_u32(b + p + 48) - 1u); /* one run less */
     fix_record_crc(b, len);
     expect_refusal(b, len, "bytes after the last run");
     /* A record shorter than its head: length 8, its CRC fixed, and a second copy after it so
@@ -506,9 +507,9 @@ static void test_each_rule(void **state)
     {
         uint8_t small[JOURNAL_HEADER_BYTES + 32];
         memcpy(small, good, h);
-        io_put_u32le(small + h, 8);
+        le_put_u32(small + h, 8);
         memset(small + h + 4, 0, 8);
-        io_put_u32le(small + h + 12, crc32c(0, small + h, 12));
+        le_put_u32(small + h + 12, crc32c(0, small + h, 12));
         memcpy(small + h + 16, small + h, 16);
         expect_refusal(small, sizeof(small), "shorter than a record head");
     }
@@ -649,7 +650,7 @@ static void test_painted_material(void **state)
     uint8_t *ba = test_slurp(a, &la), *bb = test_slurp(b, &lb);
     assert_int_equal(la, lb);
     assert_memory_equal(ba, bb, la);
-    assert_int_equal(io_get_u32le(ba + 8), 2);
+    assert_int_equal(le_get_u32(ba + 8), 2);
     free(ba);
     free(bb);
     argil_doc_free(&doc);
@@ -683,10 +684,10 @@ static void test_painted_material(void **state)
 
     /* Record rules for the material blocks (the last record's, its CRC fixed). */
     size_t r = JOURNAL_HEADER_BYTES;
-    const size_t payload = io_get_u32le(full + r);
+    const size_t payload = le_get_u32(full + r);
     const size_t blocks = r + 4 + JOURNAL_RECORD_HEAD_BYTES + 8 + 4; /* one density run of 1 */
-    assert_int_equal(io_get_u32le(full + r + 4), 2);                 /* type 2 */
-    assert_int_equal(io_get_u32le(full + blocks), 2);                /* stiffness, rest length */
+    assert_int_equal(le_get_u32(full + r + 4), 2);                 /* type 2 */
+    assert_int_equal(le_get_u32(full + blocks), 2);                /* stiffness, rest length */
     journal_info_t ji;
     static float density[N_SAMPLES];
 #define MAT_CASE(off, val, rule)                                                            \
@@ -694,8 +695,8 @@ static void test_painted_material(void **state)
         uint8_t *m = malloc(len);                                                           \
         assert_non_null(m);                                                                 \
         memcpy(m, full, len);                                                               \
-        io_put_u32le(m + (off), (val));                                                     \
-        io_put_u32le(m + r + 4 + payload, crc32c(0, m + r, 4 + payload));                  \
+        le_put_u32(m + (off), (val));                                                     \
+        le_put_u32(m + r + 4 + payload, crc32c(0, m + r, 4 + payload));                  \
         const argil_err_t e = journal_replay(m, len, "j.log", density, N_SAMPLES, &ji, err, \
                                              sizeof(err));                                  \
         if (e != ARGIL_ERR_PARSE || strstr(err, rule) == NULL)                              \

@@ -18,6 +18,7 @@
 #include "host/io/io_util.h"
 #include "host/io/journal.h"
 #include "shared/crc32c.h"
+#include "shared/wire.h"
 
 #include "tests/unit/grid_view.h"
 #include "tests/unit/test_files.h"
@@ -167,8 +168,8 @@ static void test_unpainted_has_no_colour_record(void **state)
     test_path(p, sizeof(p), "b/journal.log");
     size_t len = 0;
     uint8_t *data = test_slurp(p, &len);
-    assert_int_equal(io_get_u32le(data + JOURNAL_HEADER_BYTES + 4), 1u); /* type 1 */
-    assert_int_equal(io_get_u32le(data + 8), 2u);                        /* version 2 */
+    assert_int_equal(le_get_u32(data + JOURNAL_HEADER_BYTES + 4), 1u); /* type 1 */
+    assert_int_equal(le_get_u32(data + 8), 2u);                        /* version 2 */
     free(data);
     test_path(p, sizeof(p), "b");
     argil_doc_t d;
@@ -208,7 +209,7 @@ typedef struct {
 
 static void put32(buf_t *b, uint32_t v)
 {
-    io_put_u32le(b->b + b->n, v);
+    le_put_u32(b->b + b->n, v);
     b->n += 4;
 }
 
@@ -219,15 +220,15 @@ static size_t craft(uint8_t *out, uint32_t type, const buf_t *tail)
     memcpy(out, g_header, JOURNAL_HEADER_BYTES);
     uint8_t *r = out + JOURNAL_HEADER_BYTES;
     const size_t payload = JOURNAL_RECORD_HEAD_BYTES + tail->n;
-    io_put_u32le(r, (uint32_t)payload);
+    le_put_u32(r, (uint32_t)payload);
     uint8_t *h = r + 4;
     memset(h, 0, JOURNAL_RECORD_HEAD_BYTES);
-    io_put_u32le(h, type);
-    io_put_u32le(h + 4, io_get_u32le(g_header + 76)); /* the first record's number */
+    le_put_u32(h, type);
+    le_put_u32(h + 4, le_get_u32(g_header + 76)); /* the first record's number */
     memcpy(h + 28, g_header + 52, 20);                  /* the base's material */
-    io_put_u32le(h + 48, 0);                            /* no density runs */
+    le_put_u32(h + 48, 0);                            /* no density runs */
     memcpy(h + JOURNAL_RECORD_HEAD_BYTES, tail->b, tail->n);
-    io_put_u32le(h + payload, crc32c(0, r, 4 + payload));
+    le_put_u32(h + payload, crc32c(0, r, 4 + payload));
     return JOURNAL_HEADER_BYTES + 8 + payload;
 }
 
