@@ -6,12 +6,15 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "shared/tokens.h"
+
 #define WORDS_MAX 12u
 #define WORD_LEN 40u
 
 typedef struct {
     uint32_t n;
-    char w[WORDS_MAX][WORD_LEN];
+    char *w[WORDS_MAX];           /* into line; "" past n */
+    char line[SCN_LINE_MAX + 1u]; /* the line, cut into words in place */
 } words_t;
 
 static const char *const action_names[SCN_ACTION_COUNT] = {
@@ -58,27 +61,24 @@ fail(scn_error_t *err, scn_err_t code, uint32_t line, const char *fmt, ...)
     return code;
 }
 
-/* Splits a line into blank-separated words; false when a word or the count is too large. */
+/* Splits a line (len <= SCN_LINE_MAX) into blank-separated words up to a '#'; false when a word
+ * or the count is too large. */
 static bool split(const char *p, size_t len, words_t *w)
 {
-    w->n = 0;
-    size_t i = 0;
-    while (i < len) {
-        while (i < len && (p[i] == ' ' || p[i] == '\t'))
-            i++;
-        if (i >= len || p[i] == '#')
-            break;
-        if (w->n == WORDS_MAX)
+    memcpy(w->line, p, len);
+    w->line[len] = '\0';
+    char *hash = strchr(w->line, '#');
+    if (hash != NULL)
+        *hash = '\0';
+    const size_t n = tokens_split(w->line, len + 1u, TOKENS_SPACE_TAB, '\0', w->w, WORDS_MAX);
+    w->n = (uint32_t)(n < WORDS_MAX ? n : WORDS_MAX);
+    for (size_t k = w->n; k < WORDS_MAX; k++)
+        w->w[k] = &w->line[len];
+    if (n > WORDS_MAX)
+        return false;
+    for (size_t k = 0; k < n; k++)
+        if (strlen(w->w[k]) >= WORD_LEN)
             return false;
-        size_t k = 0;
-        while (i < len && p[i] != ' ' && p[i] != '\t' && p[i] != '#') {
-            if (k + 1 >= WORD_LEN)
-                return false;
-            w->w[w->n][k++] = p[i++];
-        }
-        w->w[w->n][k] = '\0';
-        w->n++;
-    }
     return true;
 }
 

@@ -1,7 +1,6 @@
 /* Session script parser and player. */
 #include "script.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -9,6 +8,7 @@
 #include <string.h>
 
 #include "shared/proto.h"
+#include "shared/tokens.h"
 
 /* Every tunable with its range and default: one row each (docs/script.md lists them). */
 static const struct {
@@ -65,27 +65,6 @@ void script_free(script_t *s)
 {
     free(s->cmds);
     script_init(s);
-}
-
-/* Splits a line into at most max words; returns the count, or max+1 if there are more. */
-static int split_words(char *line, char **words, int max)
-{
-    int n = 0;
-    char *p = line;
-    for (;;) {
-        while (*p && isspace((unsigned char)*p))
-            p++;
-        if (!*p || *p == '#')
-            break;
-        if (n == max)
-            return max + 1;
-        words[n++] = p;
-        while (*p && !isspace((unsigned char)*p))
-            p++;
-        if (*p)
-            *p++ = '\0';
-    }
-    return n;
 }
 
 static int parse_float(const char *w, float *out)
@@ -366,7 +345,8 @@ argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, s
             FAIL("line %d: contains a NUL byte", lineno);
         at = end + 1;
         char *w[9];
-        const int n = split_words(line, w, 8);
+        /* words at any C-locale space; a word starting with '#' ends the line */
+        const int n = (int)tokens_split(line, sizeof(line), TOKENS_C_SPACE, '#', w, 8);
         if (n == 0)
             continue;
         /* At most 5 words, but `action soft-paint rgb R G B strength S` takes 8. */

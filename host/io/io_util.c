@@ -10,6 +10,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "shared/tokens.h"
+
 void io_err(char *err, size_t err_len, const char *fmt, ...)
 {
     if (err == NULL || err_len == 0)
@@ -178,19 +180,5 @@ long io_next_line(io_lines_t *it, char *line, size_t cap)
 
 int io_tokens(char *line, char **tok, int max)
 {
-    int n = 0;
-    char *p = line;
-    for (;;) {
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (*p == '\0')
-            return n;
-        if (n == max)
-            return max + 1;
-        tok[n++] = p;
-        while (*p != '\0' && *p != ' ' && *p != '\t')
-            p++;
-        if (*p != '\0')
-            *p++ = '\0';
-    }
+    return (int)tokens_split(line, strlen(line) + 1u, TOKENS_SPACE_TAB, '\0', tok, (size_t)max);
 }

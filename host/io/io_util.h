@@ -48,7 +48,8 @@ typedef struct {
  * -1 at the end of the buffer, -2 when the line does not fit in cap bytes, -3 when it holds a NUL. */
 long io_next_line(io_lines_t *it, char *line, size_t cap);
 
-/* Splits line (modified) at blanks into at most max tokens; returns the count, max + 1 if more. */
+/* Splits line (modified) at spaces and tabs into at most max tokens (tokens_split); returns the
+ * count, max + 1 if more. */
 int io_tokens(char *line, char **tok, int max);
 
 #endif

@@ -2,6 +2,7 @@
  * a strict reader of the same layout. Fields are decoded byte by byte, never by copying structs. */
 #include "host/io/ply.h"
 
+#include "host/io/io_util.h"
 #include "host/io/mesh_export.h"
 
 #include <errno.h>
@@ -60,27 +61,6 @@ typedef struct {
     bool rgb;          /* the header declared red green blue after the normal */
     size_t vert_bytes; /* PLY_VERT_BYTES, or PLY_VERT_RGB_BYTES with colour */
 } ply_ctx_t;
-
-/* Splits line (NUL-terminated, modified) at spaces and tabs into at most max tokens; returns
- * the count, or max + 1 when there are more. */
-static int ply_tokens(char *line, char **tok, int max)
-{
-    int n = 0;
-    char *p = line;
-    for (;;) {
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (*p == '\0')
-            return n;
-        if (n == max)
-            return max + 1;
-        tok[n++] = p;
-        while (*p != '\0' && *p != ' ' && *p != '\t')
-            p++;
-        if (*p != '\0')
-            *p++ = '\0';
-    }
-}
 
 /* Parses a decimal count (digits only, no sign); false when not a number or above limit. */
 static bool ply_parse_count(const char *s, uint64_t limit, uint64_t *out)
@@ -142,7 +122,7 @@ static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *s
                                    uint64_t *n_vert, uint64_t *n_face)
 {
     char *tok[6];
-    const int n = ply_tokens(line, tok, 5);
+    const int n = io_tokens(line, tok, 5);
     if (*state != PLY_H_MAGIC && n >= 1 && (ply_is(tok[0], "comment", "obj_info")))
         return ARGIL_OK;
     /* The colour is optional: the face element may follow the normal directly. */

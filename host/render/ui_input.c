@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shared/tokens.h"
+
 static const struct {
     const char *name;
     int code;
@@ -45,25 +47,6 @@ void ui_input_free(ui_input_t *in)
 {
     free(in->ev);
     ui_input_init(in);
-}
-
-/* Splits a line into at most 5 words (in place); returns how many, or 6 when there are more. */
-static int split(char *line, char *w[5])
-{
-    int n = 0;
-    for (char *p = line;;) {
-        while (*p == ' ' || *p == '\t' || *p == '\r')
-            p++;
-        if (*p == '\0')
-            return n;
-        if (n == 5)
-            return 6;
-        w[n++] = p;
-        while (*p && *p != ' ' && *p != '\t' && *p != '\r')
-            p++;
-        if (*p)
-            *p++ = '\0';
-    }
 }
 
 static bool number(const char *s, double lo, double hi, double *out)
@@ -111,7 +94,7 @@ argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *e
         if (hash)
             *hash = '\0';
         char *w[5];
-        const int n = split(buf, w);
+        const int n = (int)tokens_split(buf, sizeof(buf), " \t\r", '\0', w, 5);
         if (n == 0)
             continue;
         if (n > 4)
