@@ -271,6 +271,35 @@ static void test_gpio_errors_name_the_line(void **st)
     assert_non_null(strstr(err, "cannot be requested as input"));
 }
 
+/* Each malformed "ADDR:PORT" is refused with the code of the rule it broke. */
+static void test_udp_address_rules(void **st)
+{
+    (void)st;
+    static const struct {
+        link_udp_addr_err_t want;
+        const char *specs[6]; /* NULL ends */
+    } rules[] = {
+        {LINK_UDP_ADDR_ERR_FORM, {"", "127.0.0.1", ":7700"}},
+        {LINK_UDP_ADDR_ERR_HOST,
+         {"localhost:7700", "127.0.0.256:7700", "::1:7700",
+          "1111111111111111111111111111111111111111111111111111111111111111:7700"}},
+        {LINK_UDP_ADDR_ERR_PORT,
+         {"127.0.0.1:", "127.0.0.1:0", "127.0.0.1:65536", "127.0.0.1:77a",
+          "127.0.0.1:99999999999999999999"}},
+    };
+    struct sockaddr_in a;
+    assert_int_equal(link_udp_parse(NULL, &a), LINK_UDP_ADDR_ERR_FORM);
+    for (size_t r = 0; r < sizeof(rules) / sizeof(rules[0]); r++)
+        for (size_t i = 0; i < 6 && rules[r].specs[i] != NULL; i++) {
+            const link_udp_addr_err_t got = link_udp_parse(rules[r].specs[i], &a);
+            if (got != rules[r].want)
+                fail_msg("'%s': %d, expected %d", rules[r].specs[i], got, rules[r].want);
+        }
+    assert_int_equal(link_udp_parse("10.1.2.3:65535", &a), LINK_UDP_ADDR_OK);
+    assert_int_equal(ntohs(a.sin_port), 65535);
+    assert_int_equal(ntohl(a.sin_addr.s_addr), 0x0a010203u);
+}
+
 static void test_udp_link_loopback(void **st)
 {
     (void)st;
@@ -283,7 +312,7 @@ static void test_udp_link_loopback(void **st)
     assert_int_equal(link_udp_send(&u, frame, 10), ARGIL_ERR_STATE); /* no host yet */
     const int h = socket(AF_INET, SOCK_DGRAM, 0);
     struct sockaddr_in to;
-    assert_int_equal(link_udp_parse("127.0.0.1:47311", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47311", &to), LINK_UDP_ADDR_OK);
     proto_msg_t m;
     memset(&m, 0, sizeof(m));
     m.type = MSG_HELLO;
@@ -368,7 +397,7 @@ static void test_udp_link_serves_its_session_host_only(void **st)
     char err[200];
     assert_int_equal(link_udp_open(&u, "127.0.0.1:47313", err, sizeof(err)), ARGIL_OK);
     struct sockaddr_in to, ha, sa;
-    assert_int_equal(link_udp_parse("127.0.0.1:47313", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47313", &to), LINK_UDP_ADDR_OK);
     const int host = udp_peer(&ha), stranger = udp_peer(&sa);
     uint8_t f[PROTO_FRAME_MAX];
     const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
@@ -552,7 +581,7 @@ static void test_udp_link_with_a_key(void **st)
     other.k[31] ^= 1u;
     link_udp_set_key(&u, &key);
     struct sockaddr_in to, ha;
-    assert_int_equal(link_udp_parse("127.0.0.1:47317", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47317", &to), LINK_UDP_ADDR_OK);
     const int host = udp_peer(&ha);
     uint8_t f[PROTO_FRAME_MAX], g[PROTO_FRAME_MAX];
     const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
@@ -839,6 +868,7 @@ int main(void)
         cmocka_unit_test(test_can_open_errors_are_one_line),
         cmocka_unit_test(test_gpio_mapping_by_name),
         cmocka_unit_test(test_gpio_errors_name_the_line),
+        cmocka_unit_test(test_udp_address_rules),
         cmocka_unit_test(test_udp_link_loopback),
         cmocka_unit_test(test_udp_link_serves_its_session_host_only),
         cmocka_unit_test(test_udp_link_with_a_key),
