@@ -91,43 +91,60 @@ void board_config_default(board_daemon_cfg_t *c)
     c->model_scale = 1.0f;
 }
 
-static argil_err_t parse_long(const char *v, long lo, long hi, long *out)
+/* True when v is a whole decimal number lo..hi, stored in *out. */
+static bool parse_long(const char *v, long lo, long hi, long *out)
 {
     char *end = NULL;
     errno = 0;
     const long x = strtol(v, &end, 10);
     if (errno != 0 || end == v || *end != '\0' || x < lo || x > hi)
-        return ARGIL_ERR_PARSE;
+        return false;
     *out = x;
-    return ARGIL_OK;
+    return true;
 }
 
-static argil_err_t parse_float(const char *v, float lo, float hi, float *out)
+/* True when v is a finite number lo..hi, stored in *out. */
+static bool parse_float(const char *v, float lo, float hi, float *out)
 {
     char *end = NULL;
     errno = 0;
     const float x = strtof(v, &end);
     if (errno != 0 || end == v || *end != '\0' || !isfinite(x) || x < lo || x > hi)
-        return ARGIL_ERR_PARSE;
+        return false;
     *out = x;
-    return ARGIL_OK;
+    return true;
 }
 
-static argil_err_t set_name(char *dst, size_t cap, const char *v)
+/* True when v is a name of 1..cap-1 characters without blanks or control characters, copied
+ * into dst. */
+static bool set_name(char *dst, size_t cap, const char *v)
 {
     if (v[0] == '\0' || strlen(v) >= cap)
-        return ARGIL_ERR_PARSE;
+        return false;
     for (const char *p = v; *p; p++)
         if (*p == ' ' || *p == '\t' || (unsigned char)*p < 0x20)
-            return ARGIL_ERR_PARSE;
+            return false;
     copy_str(dst, cap, v);
-    return ARGIL_OK;
+    return true;
 }
 
-#define BAD(...) (snprintf(why, why_len, __VA_ARGS__), ARGIL_ERR_PARSE)
+argil_err_t board_config_err_argil(board_config_err_t e)
+{
+    switch (e) {
+    case BOARD_CONFIG_OK: return ARGIL_OK;
+    case BOARD_CONFIG_ERR_UNKNOWN:
+    case BOARD_CONFIG_ERR_KEY_INSECURE:
+    case BOARD_CONFIG_ERR_USB_KEY:
+    case BOARD_CONFIG_ERR_FADE:
+    case BOARD_CONFIG_ERR_HEARTBEAT: return ARGIL_ERR_ARG;
+    default: return ARGIL_ERR_PARSE;
+    }
+}
 
-argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
-                             const char *v, char *why, size_t why_len)
+#define BAD(...) (snprintf(why, why_len, __VA_ARGS__), BOARD_CONFIG_ERR_VALUE)
+
+board_config_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
+                                    const char *v, char *why, size_t why_len)
 {
     long x = 0;
     float f = 0.0f;
@@ -141,73 +158,73 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
             c->bus = BOARD_BUS_SIM;
         else
             return BAD("can.bus '%s': expected socketcan or sim", v);
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("can", "interface")) {
-        if (set_name(c->can_if, 16, v) != ARGIL_OK)
+        if (!set_name(c->can_if, 16, v))
             return BAD("can.interface '%s': expected an interface name of 1-15 characters", v);
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("can", "heartbeat_timeout_ms")) {
-        if (parse_long(v, 10, 10000, &x) != ARGIL_OK)
+        if (!parse_long(v, 10, 10000, &x))
             return BAD("can.heartbeat_timeout_ms '%s': expected 10-10000", v);
         c->drive_heartbeat_ms = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("can", "bus_recovery_ms")) {
-        if (parse_long(v, 10, 60000, &x) != ARGIL_OK)
+        if (!parse_long(v, 10, 60000, &x))
             return BAD("can.bus_recovery_ms '%s': expected 10-60000", v);
         c->bus_recovery_ms = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("gpio", "chip")) {
-        if (set_name(c->gpio.chip, GPIO_NAME_LEN, v) != ARGIL_OK)
+        if (!set_name(c->gpio.chip, GPIO_NAME_LEN, v))
             return BAD("gpio.chip '%s': expected a chip name of 1-%u characters", v,
                        GPIO_NAME_LEN - 1u);
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (strcmp(section, "gpio") == 0) {
         for (uint32_t i = 0; i < 7; i++) {
             if (strcmp(key, lines[i]) != 0)
                 continue;
             char *dst = i < GPIO_IN_COUNT ? c->gpio.in[i] : c->gpio.out[i - GPIO_IN_COUNT];
-            if (set_name(dst, GPIO_NAME_LEN, v) != ARGIL_OK)
+            if (!set_name(dst, GPIO_NAME_LEN, v))
                 return BAD("gpio.%s '%s': expected a line name of 1-%u characters", key, v,
                            GPIO_NAME_LEN - 1u);
-            return ARGIL_OK;
+            return BOARD_CONFIG_OK;
         }
     }
     if (IS("link", "host")) {
         if (strncmp(v, "udp:", 4) == 0 && v[4] != '\0' && strlen(v + 4) < BOARD_CFG_STR) {
             c->link = BOARD_LINK_UDP;
             copy_str(c->link_target, sizeof(c->link_target), v + 4);
-            return ARGIL_OK;
+            return BOARD_CONFIG_OK;
         }
         if (strncmp(v, "ffs:", 4) == 0 && v[4] != '\0' && strlen(v + 4) < BOARD_CFG_STR) {
             c->link = BOARD_LINK_FFS;
             copy_str(c->link_target, sizeof(c->link_target), v + 4);
-            return ARGIL_OK;
+            return BOARD_CONFIG_OK;
         }
         return BAD("link.host '%s': expected udp:ADDR:PORT or ffs:DIR", v);
     }
     if (IS("link", "heartbeat_timeout_ms")) {
-        if (parse_long(v, 5, 10000, &x) != ARGIL_OK)
+        if (!parse_long(v, 5, 10000, &x))
             return BAD("link.heartbeat_timeout_ms '%s': expected 5-10000", v);
         c->host_timeout_ms = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("link", "fade_ms")) {
-        if (parse_long(v, 0, 1000, &x) != ARGIL_OK)
+        if (!parse_long(v, 0, 1000, &x))
             return BAD("link.fade_ms '%s': expected 0-1000", v);
         c->host_fade_ms = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("link", "key")) {
         if (v[0] == '\0' || strlen(v) >= BOARD_CFG_STR)
             return BAD("link.key '%s': expected a key file's path of 1-%u characters", v,
                        BOARD_CFG_STR - 1u);
         copy_str(c->link_key, sizeof(c->link_key), v);
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("link", "insecure")) {
         if (strcmp(v, "yes") == 0)
@@ -216,68 +233,68 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
             c->link_insecure = false;
         else
             return BAD("link.insecure '%s': expected yes or no", v);
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "rate_hz")) {
-        if (parse_long(v, 100, 10000, &x) != ARGIL_OK || 1000000L % x != 0)
+        if (!parse_long(v, 100, 10000, &x) || 1000000L % x != 0)
             return BAD("loop.rate_hz '%s': expected 100-10000 Hz dividing 1 s into whole "
                        "microseconds (1000, 2000, 4000)", v);
         c->rate_hz = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "rt_priority")) {
-        if (parse_long(v, 0, 99, &x) != ARGIL_OK)
+        if (!parse_long(v, 0, 99, &x))
             return BAD("loop.rt_priority '%s': expected 0-99", v);
         c->rt_priority = (int32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("link", "rt_priority")) {
-        if (parse_long(v, 0, 99, &x) != ARGIL_OK)
+        if (!parse_long(v, 0, 99, &x))
             return BAD("link.rt_priority '%s': expected 0-99", v);
         c->link_rt_priority = (int32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "cpu")) {
-        if (parse_long(v, -1, 1023, &x) != ARGIL_OK)
+        if (!parse_long(v, -1, 1023, &x))
             return BAD("loop.cpu '%s': expected -1 (any) or a CPU number 0-1023", v);
         c->cpu = (int32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "overrun_streak")) {
-        if (parse_long(v, 0, 1000, &x) != ARGIL_OK)
+        if (!parse_long(v, 0, 1000, &x))
             return BAD("loop.overrun_streak '%s': expected 0-1000", v);
         c->overrun_streak = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "stats_period_s")) {
-        if (parse_long(v, 0, 86400, &x) != ARGIL_OK)
+        if (!parse_long(v, 0, 86400, &x))
             return BAD("loop.stats_period_s '%s': expected 0-86400", v);
         c->stats_period_s = (uint32_t)x;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("loop", "duration_s")) {
-        if (parse_float(v, 0.0f, 1e6f, &f) != ARGIL_OK)
+        if (!parse_float(v, 0.0f, 1e6f, &f))
             return BAD("loop.duration_s '%s': expected 0-1000000 seconds", v);
         c->duration_s = f;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("limits", "max_force_n")) {
-        if (parse_float(v, 0.01f, 20.0f, &f) != ARGIL_OK)
+        if (!parse_float(v, 0.01f, 20.0f, &f))
             return BAD("limits.max_force_n '%s': expected 0.01-20 N", v);
         c->max_force_n = f;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("limits", "max_velocity_m_s")) {
-        if (parse_float(v, 0.0f, 20.0f, &f) != ARGIL_OK)
+        if (!parse_float(v, 0.0f, 20.0f, &f))
             return BAD("limits.max_velocity_m_s '%s': expected 0-20 m/s (0 = no limit)", v);
         c->max_velocity_m_s = f;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("transform", "scale")) {
-        if (parse_float(v, 1e-3f, 1e3f, &f) != ARGIL_OK)
+        if (!parse_float(v, 1e-3f, 1e3f, &f))
             return BAD("transform.scale '%s': expected 0.001-1000", v);
         c->model_scale = f;
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
     if (IS("transform", "offset_m")) {
         float o[3];
@@ -292,17 +309,17 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
                 return BAD("transform.offset_m '%s': expected X,Y,Z in metres", v);
             if (comma)
                 *comma = '\0';
-            if (parse_float(p, -100.0f, 100.0f, &o[i]) != ARGIL_OK)
+            if (!parse_float(p, -100.0f, 100.0f, &o[i]))
                 return BAD("transform.offset_m '%s': expected X,Y,Z in metres, each within "
                            "+-100", v);
             p = comma ? comma + 1 : p;
         }
         memcpy(c->model_offset_m, o, sizeof(o));
-        return ARGIL_OK;
+        return BOARD_CONFIG_OK;
     }
 #undef IS
     snprintf(why, why_len, "unknown setting '%s.%s'", section, key);
-    return ARGIL_ERR_ARG;
+    return BOARD_CONFIG_ERR_UNKNOWN;
 }
 
 /* board_config_parse_ini's state, shared by libinih's line reader and its setting handler:
@@ -314,7 +331,7 @@ typedef struct {
     uint32_t line;              /* 1-based: the line libinih is reading */
     board_daemon_cfg_t *cfg;
     uint32_t refused_line;      /* 0 = nothing refused yet */
-    argil_err_t refused;
+    board_config_err_t refused;
     char *why;
     size_t why_len;
 } ini_text_t;
@@ -325,7 +342,7 @@ static bool is_blank(char ch)
 }
 
 /* Records argil's refusal of the current line; why is the caller's to write. */
-static void ini_refuse(ini_text_t *t, argil_err_t err)
+static void ini_refuse(ini_text_t *t, board_config_err_t err)
 {
     t->refused_line = t->line;
     t->refused = err;
@@ -361,12 +378,12 @@ static char *ini_text_reader(char *buf, int cap, void *stream)
     const size_t max = cap > 3 ? (size_t)cap - 3u : 0u;
     const size_t shown = n > 0 && s[n - 1u] == '\r' ? n - 1u : n;
     if (memchr(s, '\0', n) != NULL) {
-        ini_refuse(t, ARGIL_ERR_PARSE);
+        ini_refuse(t, BOARD_CONFIG_ERR_NUL);
         snprintf(t->why, t->why_len, "NUL byte in the file");
         return NULL;
     }
     if (shown > max) {
-        ini_refuse(t, ARGIL_ERR_PARSE);
+        ini_refuse(t, BOARD_CONFIG_ERR_LINE_LONG);
         snprintf(t->why, t->why_len, "line longer than %zu characters", max);
         return NULL;
     }
@@ -379,7 +396,7 @@ static char *ini_text_reader(char *buf, int cap, void *stream)
         n--;
     }
     if (section_has_trailing_text(s, n)) {
-        ini_refuse(t, ARGIL_ERR_PARSE);
+        ini_refuse(t, BOARD_CONFIG_ERR_AFTER_SECTION);
         snprintf(t->why, t->why_len, "text after the section's ']': a setting goes on a line "
                  "of its own");
         return NULL;
@@ -394,12 +411,13 @@ static int ini_text_setting(void *user, const char *section, const char *key, co
 {
     ini_text_t *t = user;
     if (section[0] == '\0') {
-        ini_refuse(t, ARGIL_ERR_PARSE);
+        ini_refuse(t, BOARD_CONFIG_ERR_NO_SECTION);
         snprintf(t->why, t->why_len, "'%s' is outside any [section]", key);
         return 0;
     }
-    const argil_err_t rc = board_config_set(t->cfg, section, key, value, t->why, t->why_len);
-    if (rc == ARGIL_OK)
+    const board_config_err_t rc = board_config_set(t->cfg, section, key, value, t->why,
+                                                   t->why_len);
+    if (rc == BOARD_CONFIG_OK)
         return 1;
     ini_refuse(t, rc);
     const size_t n = strnlen(t->why, t->why_len);
@@ -423,8 +441,8 @@ static bool line_starts_section(const char *text, size_t len, uint32_t line)
     return at < len && text[at] == '[';
 }
 
-argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
-                                   uint32_t *line, char *why, size_t why_len)
+board_config_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
+                                          uint32_t *line, char *why, size_t why_len)
 {
     board_daemon_cfg_t parsed = *c;
     ini_text_t t = {.text = text, .len = len, .cfg = &parsed, .why = why, .why_len = why_len};
@@ -434,10 +452,10 @@ argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size
     if (first > 0 && (t.refused_line == 0 || (uint32_t)first < t.refused_line)) {
         /* libinih's two refusals: a '[' line without its ']', a line without '=' or ':' */
         *line = (uint32_t)first;
-        snprintf(why, why_len, "%s", line_starts_section(text, len, *line)
-                                         ? "expected [section]: no closing ']'"
-                                         : "expected key = value or [section]");
-        return ARGIL_ERR_PARSE;
+        const bool section = line_starts_section(text, len, *line);
+        snprintf(why, why_len, "%s", section ? "expected [section]: no closing ']'"
+                                             : "expected key = value or [section]");
+        return section ? BOARD_CONFIG_ERR_SECTION : BOARD_CONFIG_ERR_NO_VALUE;
     }
     if (t.refused_line != 0) {
         *line = t.refused_line;
@@ -446,33 +464,33 @@ argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size
     *line = t.line;
     if (first != 0) {
         snprintf(why, why_len, "libinih could not read the text (%d)", first);
-        return ARGIL_ERR_PARSE;
+        return BOARD_CONFIG_ERR_READER;
     }
     *c = parsed;
-    return ARGIL_OK;
+    return BOARD_CONFIG_OK;
 }
 
-argil_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len)
+board_config_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len)
 {
     if (c->link_key[0] != '\0' && c->link_insecure) {
         snprintf(why, why_len, "link.key and link.insecure together: a keyed link is never "
                  "insecure; drop one");
-        return ARGIL_ERR_ARG;
+        return BOARD_CONFIG_ERR_KEY_INSECURE;
     }
     if (c->link == BOARD_LINK_FFS && (c->link_key[0] != '\0' || c->link_insecure)) {
         snprintf(why, why_len, "link.%s is for the UDP link: USB (FunctionFS) is a cable to one "
                  "host and needs no key", c->link_key[0] != '\0' ? "key" : "insecure");
-        return ARGIL_ERR_ARG;
+        return BOARD_CONFIG_ERR_USB_KEY;
     }
     if (c->host_fade_ms > c->host_timeout_ms * 10u) {
         snprintf(why, why_len, "link.fade_ms (%u) must not exceed ten host timeouts (%u ms)",
                  c->host_fade_ms, c->host_timeout_ms * 10u);
-        return ARGIL_ERR_ARG;
+        return BOARD_CONFIG_ERR_FADE;
     }
     if (c->drive_heartbeat_ms * 1000u < 1000000u / c->rate_hz) {
         snprintf(why, why_len, "can.heartbeat_timeout_ms (%u) is shorter than one tick",
                  c->drive_heartbeat_ms);
-        return ARGIL_ERR_ARG;
+        return BOARD_CONFIG_ERR_HEARTBEAT;
     }
-    return ARGIL_OK;
+    return BOARD_CONFIG_OK;
 }

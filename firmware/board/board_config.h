@@ -56,10 +56,32 @@ extern const size_t board_settings_count;
 
 void board_config_default(board_daemon_cfg_t *c);
 
-/* Sets section.key from text. ARGIL_ERR_ARG for an unknown setting, ARGIL_ERR_PARSE for a
+/* The rule a setting, an INI text or the settings together broke; BOARD_CONFIG_OK = 0. */
+typedef enum {
+    BOARD_CONFIG_OK = 0,
+    BOARD_CONFIG_ERR_UNKNOWN = -1,       /* no setting section.key */
+    BOARD_CONFIG_ERR_VALUE = -2,         /* a value malformed or outside its setting's range */
+    BOARD_CONFIG_ERR_NUL = -3,           /* a NUL byte in the text */
+    BOARD_CONFIG_ERR_LINE_LONG = -4,     /* a line over libinih's 197 characters */
+    BOARD_CONFIG_ERR_AFTER_SECTION = -5, /* text after a section's ']' */
+    BOARD_CONFIG_ERR_NO_SECTION = -6,    /* a key outside any [section] */
+    BOARD_CONFIG_ERR_SECTION = -7,       /* a '[' line without its ']' */
+    BOARD_CONFIG_ERR_NO_VALUE = -8,      /* a line that is neither key = value nor a [section] */
+    BOARD_CONFIG_ERR_READER = -9,        /* libinih failed otherwise (its memory) */
+    BOARD_CONFIG_ERR_KEY_INSECURE = -10, /* link.key and link.insecure together */
+    BOARD_CONFIG_ERR_USB_KEY = -11,      /* link.key or link.insecure on a FunctionFS link */
+    BOARD_CONFIG_ERR_FADE = -12,         /* link.fade_ms above ten host timeouts */
+    BOARD_CONFIG_ERR_HEARTBEAT = -13     /* can.heartbeat_timeout_ms shorter than one tick */
+} board_config_err_t;
+
+/* The argil_err_t a command reports for e: a setting that does not exist or settings that do not
+ * go together ARGIL_ERR_ARG, every other rule ARGIL_ERR_PARSE. */
+argil_err_t board_config_err_argil(board_config_err_t e);
+
+/* Sets section.key from text. BOARD_CONFIG_ERR_UNKNOWN for an unknown setting, _VALUE for a
  * value that is malformed or out of range; why gets one line saying which. */
-argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
-                             const char *value, char *why, size_t why_len);
+board_config_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const char *key,
+                                    const char *value, char *why, size_t why_len);
 
 /* Applies INI text of len bytes (no NUL needed) through libinih: [section] headers, key = value
  * or key: value, ';' or '#' comments at the start of a line, ';' after a blank inline, blank
@@ -67,10 +89,10 @@ argil_err_t board_config_set(board_daemon_cfg_t *c, const char *section, const c
  * characters, text after a section's ']', a key outside any [section], an unknown setting, a
  * bad value; an indented line is a line of its own, never a continuation. On error *line is
  * the 1-based line, why says what is wrong and *c is unchanged. */
-argil_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
-                                   uint32_t *line, char *why, size_t why_len);
+board_config_err_t board_config_parse_ini(board_daemon_cfg_t *c, const char *text, size_t len,
+                                          uint32_t *line, char *why, size_t why_len);
 
-/* Checks the settings together (rate, priority, limits); one line into why. */
-argil_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len);
+/* Checks the settings together (keys, fade, heartbeat against the rate); one line into why. */
+board_config_err_t board_config_check(const board_daemon_cfg_t *c, char *why, size_t why_len);
 
 #endif

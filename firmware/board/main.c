@@ -94,10 +94,10 @@ static argil_err_t load_file(board_daemon_cfg_t *c, const char *path, char *why,
     }
     uint32_t line = 0;
     char inner[160];
-    const argil_err_t rc = board_config_parse_ini(c, text, n, &line, inner, sizeof(inner));
-    if (rc != ARGIL_OK)
+    const board_config_err_t rc = board_config_parse_ini(c, text, n, &line, inner, sizeof(inner));
+    if (rc != BOARD_CONFIG_OK)
         snprintf(why, why_len, "%s:%u: %s", path, line, inner);
-    return rc;
+    return board_config_err_argil(rc);
 }
 
 /* Returns -1 to run, or the exit status. */
@@ -155,7 +155,7 @@ static int parse_args(board_daemon_cfg_t *c, int argc, char **argv)
             sec[dot - value] = '\0';
             memcpy(key, dot + 1, (size_t)(veq - dot - 1));
             key[veq - dot - 1] = '\0';
-            if (board_config_set(c, sec, key, veq + 1, why, sizeof(why)) != ARGIL_OK)
+            if (board_config_set(c, sec, key, veq + 1, why, sizeof(why)) != BOARD_CONFIG_OK)
                 return fail(2, "%s%s", why, "");
             continue;
         }
@@ -169,10 +169,10 @@ static int parse_args(board_daemon_cfg_t *c, int argc, char **argv)
                 return fail(2, "option '%s' needs a value (%s)", a, s->arg);
             value = argv[++i];
         }
-        if (board_config_set(c, s->section, s->key, value, why, sizeof(why)) != ARGIL_OK)
+        if (board_config_set(c, s->section, s->key, value, why, sizeof(why)) != BOARD_CONFIG_OK)
             return fail(2, "%s%s", why, "");
     }
-    if (board_config_check(c, why, sizeof(why)) != ARGIL_OK)
+    if (board_config_check(c, why, sizeof(why)) != BOARD_CONFIG_OK)
         return fail(2, "%s%s", why, "");
     return -1;
 }

@@ -45,8 +45,16 @@ typedef struct {
 /* The sender key of an IPv4 address and port (link_bind.h). */
 uint64_t link_udp_key(const struct sockaddr_in *a);
 
-/* Parses "ADDR:PORT" (IPv4 dotted quad, port 1..65535). */
-argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
+/* The rule an "ADDR:PORT" text broke (link_udp_parse); LINK_UDP_ADDR_OK = 0. */
+typedef enum {
+    LINK_UDP_ADDR_OK = 0,
+    LINK_UDP_ADDR_ERR_FORM = -1, /* no text, no ':' before the port, or nothing before it */
+    LINK_UDP_ADDR_ERR_HOST = -2, /* ADDR is not an IPv4 dotted quad */
+    LINK_UDP_ADDR_ERR_PORT = -3  /* PORT is not a whole number 1..65535 */
+} link_udp_addr_err_t;
+
+/* Parses "ADDR:PORT" (IPv4 dotted quad, port 1..65535) into *addr. */
+link_udp_addr_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr);
 
 /* Binds a non-blocking UDP socket to spec ("ADDR:PORT"); one line into err on failure. */
 argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len);

@@ -13,25 +13,27 @@
 
 #define LINK_UDP_REFUSED_PER_CALL 256u
 
-argil_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr)
+link_udp_addr_err_t link_udp_parse(const char *spec, struct sockaddr_in *addr)
 {
     char host[64];
     const char *colon = spec ? strrchr(spec, ':') : NULL;
-    if (colon == NULL || colon == spec || (size_t)(colon - spec) >= sizeof(host))
-        return ARGIL_ERR_PARSE;
+    if (colon == NULL || colon == spec)
+        return LINK_UDP_ADDR_ERR_FORM;
+    if ((size_t)(colon - spec) >= sizeof(host))
+        return LINK_UDP_ADDR_ERR_HOST;
     memcpy(host, spec, (size_t)(colon - spec));
     host[colon - spec] = '\0';
     char *end = NULL;
     errno = 0;
     const long port = strtol(colon + 1, &end, 10);
     if (errno != 0 || end == colon + 1 || *end != '\0' || port < 1 || port > 65535)
-        return ARGIL_ERR_PARSE;
+        return LINK_UDP_ADDR_ERR_PORT;
     memset(addr, 0, sizeof(*addr));
     addr->sin_family = AF_INET;
     addr->sin_port = htons((uint16_t)port);
     if (inet_pton(AF_INET, host, &addr->sin_addr) != 1)
-        return ARGIL_ERR_PARSE;
-    return ARGIL_OK;
+        return LINK_UDP_ADDR_ERR_HOST;
+    return LINK_UDP_ADDR_OK;
 }
 
 argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err_len)
@@ -40,7 +42,7 @@ argil_err_t link_udp_open(link_udp_t *u, const char *spec, char *err, size_t err
     link_bind_init(&u->bind);
     u->fd = -1;
     struct sockaddr_in addr;
-    if (link_udp_parse(spec, &addr) != ARGIL_OK) {
+    if (link_udp_parse(spec, &addr) != LINK_UDP_ADDR_OK) {
         snprintf(err, err_len, "host link 'udp:%s': expected udp:ADDR:PORT with an IPv4 "
                  "address and a port 1-65535", spec);
         return ARGIL_ERR_ARG;

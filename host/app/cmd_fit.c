@@ -429,7 +429,7 @@ static int fit_volume(const char *in, const char *out, fit_method_t method, doub
         fprintf(stderr, "argil fit: %s: a volume is fitted with --method grid or octree\n", in);
         return 2;
     }
-    if (volume_read_nrrd(in, &v, err, sizeof(err)) != ARGIL_OK) {
+    if (volume_read_nrrd(in, &v, err, sizeof(err)) != VOLUME_OK) {
         fprintf(stderr, "argil fit: %s\n", err);
         return 1;
     }

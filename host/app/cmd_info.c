@@ -162,7 +162,7 @@ int cmd_info(int argc, char **argv)
     }
     if (has_ext(path, ".nrrd") || has_ext(path, ".nhdr")) {
         volume_t v;
-        if (volume_read_nrrd(path, &v, err, sizeof(err)) != ARGIL_OK) {
+        if (volume_read_nrrd(path, &v, err, sizeof(err)) != VOLUME_OK) {
             fprintf(stderr, "argil info: %s\n", err);
             return 1;
         }

@@ -14,7 +14,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     uint32_t line = 0;
     char why[160];
     why[0] = '\0';
-    if (board_config_parse_ini(&c, (const char *)data, size, &line, why, sizeof(why)) == ARGIL_OK)
+    if (board_config_parse_ini(&c, (const char *)data, size, &line, why, sizeof(why)) ==
+        BOARD_CONFIG_OK)
         (void)board_config_check(&c, why, sizeof(why));
     return 0;
 }

@@ -19,8 +19,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         char err[512];
         err[0] = '\0';
         volume_t v;
-        const argil_err_t e = volume_read_nrrd(path, &v, err, sizeof(err));
-        if (e == ARGIL_OK) {
+        const volume_err_t e = volume_read_nrrd(path, &v, err, sizeof(err));
+        if (e == VOLUME_OK) {
             const size_t n = (size_t)v.dims[0] * (size_t)v.dims[1] * (size_t)v.dims[2];
             for (size_t i = 0; i < n; i++)
                 if (!isfinite(v.value[i]))

@@ -23,9 +23,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const int32_t dims[3] = {size > 0 ? 1 + data[0] % 8 : 1, size > 1 ? 1 + data[1] % 8 : 1,
                                  size > 2 ? 1 + data[2] % 8 : 1};
         const vol_type_t t = (vol_type_t)(size > 3 ? data[3] % 8 : 0);
-        const argil_err_t e = volume_read_raw(path, dims, t, size > 4 && (data[4] & 1), &v, err,
-                                              sizeof(err));
-        if (e == ARGIL_OK) {
+        const volume_err_t e = volume_read_raw(path, dims, t, size > 4 && (data[4] & 1), &v, err,
+                                               sizeof(err));
+        if (e == VOLUME_OK) {
             const size_t n = (size_t)v.dims[0] * (size_t)v.dims[1] * (size_t)v.dims[2];
             for (size_t i = 0; i < n; i++)
                 if (!isfinite(v.value[i]))

@@ -271,6 +271,35 @@ static void test_gpio_errors_name_the_line(void **st)
     assert_non_null(strstr(err, "cannot be requested as input"));
 }
 
+/* Each malformed "ADDR:PORT" is refused with the code of the rule it broke. */
+static void test_udp_address_rules(void **st)
+{
+    (void)st;
+    static const struct {
+        link_udp_addr_err_t want;
+        const char *specs[6]; /* NULL ends */
+    } rules[] = {
+        {LINK_UDP_ADDR_ERR_FORM, {"", "127.0.0.1", ":7700"}},
+        {LINK_UDP_ADDR_ERR_HOST,
+         {"localhost:7700", "127.0.0.256:7700", "::1:7700",
+          "1111111111111111111111111111111111111111111111111111111111111111:7700"}},
+        {LINK_UDP_ADDR_ERR_PORT,
+         {"127.0.0.1:", "127.0.0.1:0", "127.0.0.1:65536", "127.0.0.1:77a",
+          "127.0.0.1:99999999999999999999"}},
+    };
+    struct sockaddr_in a;
+    assert_int_equal(link_udp_parse(NULL, &a), LINK_UDP_ADDR_ERR_FORM);
+    for (size_t r = 0; r < sizeof(rules) / sizeof(rules[0]); r++)
+        for (size_t i = 0; i < 6 && rules[r].specs[i] != NULL; i++) {
+            const link_udp_addr_err_t got = link_udp_parse(rules[r].specs[i], &a);
+            if (got != rules[r].want)
+                fail_msg("'%s': %d, expected %d", rules[r].specs[i], got, rules[r].want);
+        }
+    assert_int_equal(link_udp_parse("10.1.2.3:65535", &a), LINK_UDP_ADDR_OK);
+    assert_int_equal(ntohs(a.sin_port), 65535);
+    assert_int_equal(ntohl(a.sin_addr.s_addr), 0x0a010203u);
+}
+
 static void test_udp_link_loopback(void **st)
 {
     (void)st;
@@ -283,7 +312,7 @@ static void test_udp_link_loopback(void **st)
     assert_int_equal(link_udp_send(&u, frame, 10), ARGIL_ERR_STATE); /* no host yet */
     const int h = socket(AF_INET, SOCK_DGRAM, 0);
     struct sockaddr_in to;
-    assert_int_equal(link_udp_parse("127.0.0.1:47311", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47311", &to), LINK_UDP_ADDR_OK);
     proto_msg_t m;
     memset(&m, 0, sizeof(m));
     m.type = MSG_HELLO;
@@ -368,7 +397,7 @@ static void test_udp_link_serves_its_session_host_only(void **st)
     char err[200];
     assert_int_equal(link_udp_open(&u, "127.0.0.1:47313", err, sizeof(err)), ARGIL_OK);
     struct sockaddr_in to, ha, sa;
-    assert_int_equal(link_udp_parse("127.0.0.1:47313", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47313", &to), LINK_UDP_ADDR_OK);
     const int host = udp_peer(&ha), stranger = udp_peer(&sa);
     uint8_t f[PROTO_FRAME_MAX];
     const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
@@ -552,7 +581,7 @@ static void test_udp_link_with_a_key(void **st)
     other.k[31] ^= 1u;
     link_udp_set_key(&u, &key);
     struct sockaddr_in to, ha;
-    assert_int_equal(link_udp_parse("127.0.0.1:47317", &to), ARGIL_OK);
+    assert_int_equal(link_udp_parse("127.0.0.1:47317", &to), LINK_UDP_ADDR_OK);
     const int host = udp_peer(&ha);
     uint8_t f[PROTO_FRAME_MAX], g[PROTO_FRAME_MAX];
     const size_t flen = frame_of(MSG_HEARTBEAT, 0, 0, f);
@@ -617,9 +646,14 @@ static void test_udp_link_with_a_key(void **st)
     link_udp_close(&u);
 }
 
-typedef struct { const char *text; uint32_t line; const char *says; } ini_refusal_t;
+typedef struct {
+    const char *text;
+    uint32_t line;
+    board_config_err_t want;
+    const char *says;
+} ini_refusal_t;
 
-/* Each text is refused, at its line, with words that say why. */
+/* Each text is refused, at its line, with the code of the rule it broke and words that say why. */
 static void expect_ini_refusals(const ini_refusal_t *bad, size_t n)
 {
     board_daemon_cfg_t c;
@@ -628,11 +662,11 @@ static void expect_ini_refusals(const ini_refusal_t *bad, size_t n)
     for (size_t i = 0; i < n; i++) {
         board_config_default(&c);
         why[0] = '\0';
-        assert_int_not_equal(board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line,
-                                                    why, sizeof(why)), ARGIL_OK);
-        if (line != bad[i].line || strstr(why, bad[i].says) == NULL)
-            fail_msg("case %zu: line %u '%s', expected line %u saying '%s'", i, line, why,
-                     bad[i].line, bad[i].says);
+        const board_config_err_t got =
+            board_config_parse_ini(&c, bad[i].text, strlen(bad[i].text), &line, why, sizeof(why));
+        if (got != bad[i].want || line != bad[i].line || strstr(why, bad[i].says) == NULL)
+            fail_msg("case %zu: %d at line %u '%s', expected %d at line %u saying '%s'", i, got,
+                     line, why, bad[i].want, bad[i].line, bad[i].says);
     }
 }
 
@@ -647,7 +681,8 @@ static void test_config_ini_and_refusals(void **st)
                      "[link]\nhost = ffs:/dev/ffs-argil\nrt_priority = 79\n[loop]\nrate_hz=4000\n"
                      "cpu = 1\n"
                      "[transform]\noffset_m = 0.01,-0.02,0.5\n";
-    assert_int_equal(board_config_parse_ini(&c, ok, strlen(ok), &line, why, sizeof(why)), ARGIL_OK);
+    assert_int_equal(board_config_parse_ini(&c, ok, strlen(ok), &line, why, sizeof(why)),
+                     BOARD_CONFIG_OK);
     assert_string_equal(c.can_if, "can1");
     assert_string_equal(c.gpio.in[0], "EMERG");
     assert_int_equal(c.link, BOARD_LINK_FFS);
@@ -656,20 +691,20 @@ static void test_config_ini_and_refusals(void **st)
     assert_int_equal(c.link_rt_priority, 79);
     assert_float_equal(c.model_offset_m[1], -0.02f, 1e-7f);
     static const ini_refusal_t bad[] = {
-        {"x = 1\n", 1, "outside any [section]"},
-        {"[loop\n", 1, "expected [section]"},
-        {"[loop]\nrate_hz\n", 2, "expected key = value"},
-        {"[loop]\nrate_hz = 3000\n", 2, "rate_hz '3000'"},
-        {"[loop]\nrt_priority = 100\n", 2, "expected 0-99"},
-        {"[link]\nrt_priority = -1\n", 2, "link.rt_priority '-1'"},
-        {"[loop]\nbogus = 1\n", 2, "unknown setting 'loop.bogus'"},
-        {"[can]\nbus = vcan\n", 2, "expected socketcan or sim"},
-        {"[limits]\nmax_force_n = nan\n", 2, "max_force_n"},
-        {"[transform]\noffset_m = 1,2\n", 2, "expected X,Y,Z"},
-        {"[link]\nhost = tcp:1\n", 2, "udp:ADDR:PORT or ffs:DIR"},
-        {"[gpio]\nestop = two words\n", 2, "gpio.estop"},
-        {"[link]\ninsecure = maybe\n", 2, "expected yes or no"},
-        {"[link]\nkey =\n", 2, "link.key"},
+        {"x = 1\n", 1, BOARD_CONFIG_ERR_NO_SECTION, "outside any [section]"},
+        {"[loop\n", 1, BOARD_CONFIG_ERR_SECTION, "expected [section]"},
+        {"[loop]\nrate_hz\n", 2, BOARD_CONFIG_ERR_NO_VALUE, "expected key = value"},
+        {"[loop]\nrate_hz = 3000\n", 2, BOARD_CONFIG_ERR_VALUE, "rate_hz '3000'"},
+        {"[loop]\nrt_priority = 100\n", 2, BOARD_CONFIG_ERR_VALUE, "expected 0-99"},
+        {"[link]\nrt_priority = -1\n", 2, BOARD_CONFIG_ERR_VALUE, "link.rt_priority '-1'"},
+        {"[loop]\nbogus = 1\n", 2, BOARD_CONFIG_ERR_UNKNOWN, "unknown setting 'loop.bogus'"},
+        {"[can]\nbus = vcan\n", 2, BOARD_CONFIG_ERR_VALUE, "expected socketcan or sim"},
+        {"[limits]\nmax_force_n = nan\n", 2, BOARD_CONFIG_ERR_VALUE, "max_force_n"},
+        {"[transform]\noffset_m = 1,2\n", 2, BOARD_CONFIG_ERR_VALUE, "expected X,Y,Z"},
+        {"[link]\nhost = tcp:1\n", 2, BOARD_CONFIG_ERR_VALUE, "udp:ADDR:PORT or ffs:DIR"},
+        {"[gpio]\nestop = two words\n", 2, BOARD_CONFIG_ERR_VALUE, "gpio.estop"},
+        {"[link]\ninsecure = maybe\n", 2, BOARD_CONFIG_ERR_VALUE, "expected yes or no"},
+        {"[link]\nkey =\n", 2, BOARD_CONFIG_ERR_VALUE, "link.key"},
     };
     expect_ini_refusals(bad, sizeof(bad) / sizeof(bad[0]));
 }
@@ -689,7 +724,7 @@ static void test_config_ini_rules_over_libinih(void **st)
     board_config_default(&c);
     const char *indented = "[loop]\n  rate_hz = 2000\n\tcpu = 1\n";
     assert_int_equal(board_config_parse_ini(&c, indented, strlen(indented), &line, why,
-                                            sizeof(why)), ARGIL_OK);
+                                            sizeof(why)), BOARD_CONFIG_OK);
     assert_int_equal(c.rate_hz, 2000);
     assert_int_equal(c.cpu, 1);
 
@@ -698,7 +733,7 @@ static void test_config_ini_rules_over_libinih(void **st)
     const char *forms = "\xEF\xBB\xBF[loop] ; the fast loop\r\nrate_hz: 4000\r\n"
                         "[can]\r\ninterface = can1 ; inline\r\n";
     assert_int_equal(board_config_parse_ini(&c, forms, strlen(forms), &line, why, sizeof(why)),
-                     ARGIL_OK);
+                     BOARD_CONFIG_OK);
     assert_int_equal(c.rate_hz, 4000);
     assert_string_equal(c.can_if, "can1");
 
@@ -706,7 +741,7 @@ static void test_config_ini_rules_over_libinih(void **st)
     board_config_default(&c);
     const char *cut = "[loop]\nrate_hz = 2000\ncpu = 5";
     assert_int_equal(board_config_parse_ini(&c, cut, strlen("[loop]\nrate_hz = 2000\n"), &line,
-                                            why, sizeof(why)), ARGIL_OK);
+                                            why, sizeof(why)), BOARD_CONFIG_OK);
     assert_int_equal(c.rate_hz, 2000);
     assert_int_equal(c.cpu, -1);
 
@@ -714,7 +749,7 @@ static void test_config_ini_rules_over_libinih(void **st)
     board_config_default(&c);
     const char nul[] = "[loop]\ncpu = 1\nrate_hz = 2000" "\0" "x\n";
     assert_int_equal(board_config_parse_ini(&c, nul, sizeof(nul) - 1u, &line, why, sizeof(why)),
-                     ARGIL_ERR_PARSE);
+                     BOARD_CONFIG_ERR_NUL);
     assert_int_equal(line, 3);
     assert_non_null(strstr(why, "NUL byte"));
 
@@ -729,13 +764,13 @@ static void test_config_ini_rules_over_libinih(void **st)
         memcpy(text + head + n, "\r\nrate_hz = 2000\n", strlen("\r\nrate_hz = 2000\n") + 1u);
         board_config_default(&c);
         why[0] = '\0';
-        const argil_err_t rc = board_config_parse_ini(&c, text, strlen(text), &line, why,
-                                                      sizeof(why));
+        const board_config_err_t rc = board_config_parse_ini(&c, text, strlen(text), &line, why,
+                                                             sizeof(why));
         if (n == 197) {
-            assert_int_equal(rc, ARGIL_OK);
+            assert_int_equal(rc, BOARD_CONFIG_OK);
             assert_int_equal(c.rate_hz, 2000);
         } else {
-            assert_int_equal(rc, ARGIL_ERR_PARSE);
+            assert_int_equal(rc, BOARD_CONFIG_ERR_LINE_LONG);
             assert_int_equal(line, 2);
             assert_non_null(strstr(why, "longer than 197 characters"));
         }
@@ -745,29 +780,84 @@ static void test_config_ini_rules_over_libinih(void **st)
     board_config_default(&c);
     const char *late = "[loop]\nrate_hz = 2000\n[can\ncpu = 3\n";
     assert_int_equal(board_config_parse_ini(&c, late, strlen(late), &line, why, sizeof(why)),
-                     ARGIL_ERR_PARSE);
+                     BOARD_CONFIG_ERR_SECTION);
     assert_int_equal(line, 3);
     assert_int_equal(c.rate_hz, 1000);
     assert_int_equal(c.cpu, -1);
 
     static const ini_refusal_t bad[] = {
         /* a setting on its section's line would otherwise be dropped without a word */
-        {"[limits] max_force_n = 1\n", 1, "after the section's ']'"},
-        {"[loop]] ; x\n", 1, "after the section's ']'"},
-        {"\xEF\xBB\xBF [limits] max_force_n = 1\n", 1, "after the section's ']'"},
+        {"[limits] max_force_n = 1\n", 1, BOARD_CONFIG_ERR_AFTER_SECTION,
+         "after the section's ']'"},
+        {"[loop]] ; x\n", 1, BOARD_CONFIG_ERR_AFTER_SECTION, "after the section's ']'"},
+        {"\xEF\xBB\xBF [limits] max_force_n = 1\n", 1, BOARD_CONFIG_ERR_AFTER_SECTION,
+         "after the section's ']'"},
         /* '#' is a comment at the start of a line only; the value says why it failed */
-        {"[loop]\nrate_hz = 2000 # fast\n", 2, "inline comments start with ';'"},
-        {"[]\nrate_hz = 2000\n", 2, "outside any [section]"},
-        {"[ loop ]\nrate_hz = 2000\n", 2, "unknown setting ' loop .rate_hz'"},
+        {"[loop]\nrate_hz = 2000 # fast\n", 2, BOARD_CONFIG_ERR_VALUE,
+         "inline comments start with ';'"},
+        {"[]\nrate_hz = 2000\n", 2, BOARD_CONFIG_ERR_NO_SECTION, "outside any [section]"},
+        {"[ loop ]\nrate_hz = 2000\n", 2, BOARD_CONFIG_ERR_UNKNOWN,
+         "unknown setting ' loop .rate_hz'"},
         {"[a_section_name_longer_than_the_49_characters_libinih_keeps]\nk = 1\n", 2,
-         "unknown setting"},
+         BOARD_CONFIG_ERR_UNKNOWN, "unknown setting"},
         /* the first refusal is the one reported, libinih's or argil's */
-        {"[loop\n[loop]\nbogus = 1\n", 1, "expected [section]"},
-        {"[loop]\nrate_hz\nbogus = 1\n", 2, "expected key = value"},
-        {"\xEF\xBB\xBF[loop\n", 1, "expected [section]"},
-        {"[loop]\n\t[link\n", 2, "expected [section]"},
+        {"[loop\n[loop]\nbogus = 1\n", 1, BOARD_CONFIG_ERR_SECTION, "expected [section]"},
+        {"[loop]\nrate_hz\nbogus = 1\n", 2, BOARD_CONFIG_ERR_NO_VALUE, "expected key = value"},
+        {"\xEF\xBB\xBF[loop\n", 1, BOARD_CONFIG_ERR_SECTION, "expected [section]"},
+        {"[loop]\n\t[link\n", 2, BOARD_CONFIG_ERR_SECTION, "expected [section]"},
     };
     expect_ini_refusals(bad, sizeof(bad) / sizeof(bad[0]));
+}
+
+/* Settings that parse alone but not together are refused by the check, each with its rule's
+ * code; a command gets ARG for those and for an unknown setting, PARSE for every rule of the
+ * text. */
+static void test_config_check_rules(void **st)
+{
+    (void)st;
+    board_daemon_cfg_t c;
+    char why[200];
+    board_config_default(&c);
+    assert_int_equal(board_config_check(&c, why, sizeof(why)), BOARD_CONFIG_OK);
+    static const struct {
+        const char *set[2][3]; /* section, key, value */
+        board_config_err_t want;
+        const char *says;
+    } cases[] = {
+        {{{"link", "key", "k.key"}, {"link", "insecure", "yes"}}, BOARD_CONFIG_ERR_KEY_INSECURE,
+         "link.key and link.insecure together"},
+        {{{"link", "host", "ffs:/dev/ffs"}, {"link", "insecure", "yes"}},
+         BOARD_CONFIG_ERR_USB_KEY, "link.insecure is for the UDP link"},
+        {{{"link", "host", "ffs:/dev/ffs"}, {"link", "key", "k.key"}}, BOARD_CONFIG_ERR_USB_KEY,
+         "link.key is for the UDP link"},
+        {{{"link", "heartbeat_timeout_ms", "5"}, {"link", "fade_ms", "51"}},
+         BOARD_CONFIG_ERR_FADE, "must not exceed ten host timeouts (50 ms)"},
+    };
+    for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        board_config_default(&c);
+        for (size_t k = 0; k < 2; k++)
+            assert_int_equal(board_config_set(&c, cases[i].set[k][0], cases[i].set[k][1],
+                                              cases[i].set[k][2], why, sizeof(why)),
+                             BOARD_CONFIG_OK);
+        why[0] = '\0';
+        const board_config_err_t got = board_config_check(&c, why, sizeof(why));
+        if (got != cases[i].want || strstr(why, cases[i].says) == NULL)
+            fail_msg("case %zu: %d '%s', expected %d saying '%s'", i, got, why, cases[i].want,
+                     cases[i].says);
+    }
+    /* a drive heartbeat shorter than one tick (set directly: its setting's range keeps it
+     * above the slowest tick) */
+    board_config_default(&c);
+    c.drive_heartbeat_ms = 0;
+    assert_int_equal(board_config_check(&c, why, sizeof(why)), BOARD_CONFIG_ERR_HEARTBEAT);
+    assert_non_null(strstr(why, "is shorter than one tick"));
+
+    assert_int_equal(board_config_err_argil(BOARD_CONFIG_OK), ARGIL_OK);
+    assert_int_equal(board_config_err_argil(BOARD_CONFIG_ERR_UNKNOWN), ARGIL_ERR_ARG);
+    for (int e = BOARD_CONFIG_ERR_VALUE; e >= BOARD_CONFIG_ERR_READER; e--)
+        assert_int_equal(board_config_err_argil((board_config_err_t)e), ARGIL_ERR_PARSE);
+    for (int e = BOARD_CONFIG_ERR_KEY_INSECURE; e >= BOARD_CONFIG_ERR_HEARTBEAT; e--)
+        assert_int_equal(board_config_err_argil((board_config_err_t)e), ARGIL_ERR_ARG);
 }
 
 int main(void)
@@ -778,6 +868,7 @@ int main(void)
         cmocka_unit_test(test_can_open_errors_are_one_line),
         cmocka_unit_test(test_gpio_mapping_by_name),
         cmocka_unit_test(test_gpio_errors_name_the_line),
+        cmocka_unit_test(test_udp_address_rules),
         cmocka_unit_test(test_udp_link_loopback),
         cmocka_unit_test(test_udp_link_serves_its_session_host_only),
         cmocka_unit_test(test_udp_link_with_a_key),
@@ -786,6 +877,7 @@ int main(void)
         cmocka_unit_test(test_spsc_ring_wraps_and_refuses),
         cmocka_unit_test(test_config_ini_and_refusals),
         cmocka_unit_test(test_config_ini_rules_over_libinih),
+        cmocka_unit_test(test_config_check_rules),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

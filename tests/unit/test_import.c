@@ -13,6 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "host/io/io_util.h"
 #include "host/io/mesh_export.h"
 #include "host/io/mesh_import.h"
 #include "host/io/volume.h"
@@ -365,6 +366,7 @@ static void test_obj_xyz_errors(void **state)
     EXPECT_TXT(xyz_read, "e.xyz", "# only a comment\n\n", "line 2", "no points");
 }
 
+/* How a volume case is read: raw with dims, type and byte order, or NRRD. */
 typedef struct {
     int32_t dims[3];
     vol_type_t t;
@@ -372,23 +374,26 @@ typedef struct {
     bool raw;
 } vol_case_t;
 
-static vol_case_t g_vol;
-
-static argil_err_t rd_vol(const char *p, mesh_t *m, bool *n, char *e, size_t l)
+/* Writes data as name, reads it as c says, and expects the rule want, no samples, and where and
+ * rule in the one-line message that names the file. */
+static void expect_vol(const vol_case_t *c, const char *name, const void *data, size_t len,
+                       volume_err_t want, const char *where, const char *rule)
 {
-    (void)m;
-    (void)n;
+    char p[128], err[512] = "";
+    test_path(p, sizeof(p), name);
+    test_spit(p, data, len);
     volume_t v;
-    argil_err_t r = g_vol.raw ? volume_read_raw(p, g_vol.dims, g_vol.t, g_vol.big, &v, e, l)
-                              : volume_read_nrrd(p, &v, e, l);
-    if (r == ARGIL_OK) {
-        assert_null(NULL);
-        volume_free(&v);
-    } else {
-        assert_null(v.value);
-    }
-    return r;
+    const volume_err_t got = c->raw
+                                 ? volume_read_raw(p, c->dims, c->t, c->big, &v, err, sizeof(err))
+                                 : volume_read_nrrd(p, &v, err, sizeof(err));
+    if (got != want || strstr(err, p) == NULL || strstr(err, where) == NULL ||
+        strstr(err, rule) == NULL || strchr(err, '\n') != NULL)
+        fail_msg("%s: got %d '%s', want %d with '%s' and '%s'", name, got, err, want, where, rule);
+    assert_null(v.value);
 }
+
+#define EXPECT_VOL(c, name, text, want, where, rule) \
+    expect_vol(c, name, text, strlen(text), want, where, rule)
 
 static void test_volumes(void **state)
 {
@@ -407,7 +412,7 @@ static void test_volumes(void **state)
     vol_type_t t;
     assert_true(vol_type_parse("u16", &t));
     assert_false(vol_type_parse("u17", &t));
-    assert_int_equal(volume_read_raw(p, dims, t, true, &v, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(volume_read_raw(p, dims, t, true, &v, err, sizeof(err)), VOLUME_OK);
     assert_float_equal(v.value[23], 230.0f, 0);
     assert_float_equal(v.spacing_m[1], 1.0f, 0);
     volume_free(&v);
@@ -420,7 +425,7 @@ static void test_volumes(void **state)
     memcpy(hdr + n, raw, sizeof(raw));
     test_path(p, sizeof(p), "v.nrrd");
     test_spit(p, hdr, (size_t)n + sizeof(raw));
-    assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), VOLUME_OK);
     assert_float_equal(v.value[5], 50.0f, 0);
     assert_float_equal(v.spacing_m[2], 2.0f, 1e-6f);
     assert_float_equal(v.origin_m.z, 3.0f, 0);
@@ -429,62 +434,153 @@ static void test_volumes(void **state)
                      "endian: big\nspacings: 1 1 1\ndata file: v.raw\n\n");
     test_path(p, sizeof(p), "d.nhdr");
     test_spit(p, hdr, (size_t)n);
-    assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), VOLUME_OK);
     assert_float_equal(v.value[1], 10.0f, 0);
     volume_free(&v);
+}
 
-    g_vol = (vol_case_t){{2, 3, 4}, VOL_U16, true, true};
-    expect_err(rd_vol, "r.raw", raw, 47, ARGIL_ERR_PARSE, "byte 0", "need 48 data bytes, the file has 47");
-    g_vol.t = VOL_F32;
-    g_vol.dims[2] = 2;
+/* Every type name of NRRD and of argil's raw options names its type. */
+static void test_volume_type_names(void **state)
+{
+    (void)state;
+    static const char *const spellings[VOL_F64 + 1] = {
+        [VOL_U8] = "u8|uchar|unsigned char|uint8|uint8_t",
+        [VOL_I8] = "i8|signed char|int8|int8_t",
+        [VOL_U16] = "u16|ushort|unsigned short|unsigned short int|uint16|uint16_t",
+        [VOL_I16] = "i16|short|short int|signed short|signed short int|int16|int16_t",
+        [VOL_U32] = "u32|uint|unsigned int|uint32|uint32_t",
+        [VOL_I32] = "i32|int|signed int|int32|int32_t",
+        [VOL_F32] = "f32|float",
+        [VOL_F64] = "f64|double",
+    };
+    int count = 0;
+    for (int want = VOL_U8; want <= VOL_F64; want++) {
+        char list[96];
+        snprintf(list, sizeof(list), "%s", spellings[want]);
+        for (char *name = strtok(list, "|"); name != NULL; name = strtok(NULL, "|"), count++) {
+            vol_type_t t = want == VOL_U8 ? VOL_F64 : VOL_U8;
+            if (!vol_type_parse(name, &t) || (int)t != want)
+                fail_msg("'%s' gave %d, want %d", name, t, want);
+        }
+    }
+    assert_int_equal(count, 36);
+    vol_type_t t = VOL_I16;
+    assert_false(vol_type_parse("Float", &t));
+    assert_false(vol_type_parse("", &t));
+    assert_false(vol_type_parse(NULL, &t));
+    assert_int_equal(t, VOL_I16);
+}
+
+/* A NRRD header line refused at line 2 with a rule's code and words that say why. */
+typedef struct { const char *line; volume_err_t want; const char *says; } nrrd_refusal_t;
+
+static const nrrd_refusal_t nrrd_field_refusals[] = {
+    {"type float", VOLUME_ERR_FIELD, "expected '<field>: <value>'"},
+    {"type: quaternion", VOLUME_ERR_TYPE, "unknown type"},
+    {"dimension: 2", VOLUME_ERR_DIMENSION, "dimension must be 3"},
+    {"sizes: 2 0 2", VOLUME_ERR_SIZES, "sizes must be three"},
+    {"sizes: 2 2 2 2", VOLUME_ERR_SIZES, "sizes must be three"},
+    {"sizes: 2 2.5 2", VOLUME_ERR_SIZES, "sizes must be three"},
+    {"encoding: gzip", VOLUME_ERR_ENCODING, "'gzip' is not supported"},
+    {"endian: middle", VOLUME_ERR_ENDIAN, "endian must be"},
+    {"spacings: 1 -1 1", VOLUME_ERR_SPACINGS, "spacings must be"},
+    {"space directions: (1,0,0) (0,1,0)", VOLUME_ERR_DIRECTIONS, "space directions must be three"},
+    {"space directions: (1,0,0) (0,0,0) (0,0,1)", VOLUME_ERR_DIRECTIONS, "zero length"},
+    {"space origin: (1,2)", VOLUME_ERR_ORIGIN, "space origin must"},
+    {"data file: ../../etc/passwd", VOLUME_ERR_DATA_FILE, "one plain file name"},
+};
+
+/* Each malformed raw file or NRRD header is refused with the code of the rule it broke. */
+static void test_volume_rules(void **state)
+{
+    (void)state;
+    uint8_t raw[48] = {0};
+    vol_case_t c = {{2, 3, 4}, VOL_U16, true, true};
+    expect_vol(&c, "r.raw", raw, 47, VOLUME_ERR_DATA_LENGTH, "byte 0",
+               "need 48 data bytes, the file has 47");
+    c.t = VOL_F32;
+    c.dims[2] = 2;
     uint8_t nanraw[48] = {0};
     nanraw[44] = 0x7f;
     nanraw[45] = 0xc0;
-    expect_err(rd_vol, "r.raw", nanraw, 48, ARGIL_ERR_PARSE, "byte 44", "sample 11 is not a finite");
-    g_vol.dims[0] = 0;
-    expect_err(rd_vol, "r.raw", raw, 48, ARGIL_ERR_ARG, "dimension 0", "must be 1..2^30");
-    g_vol.dims[0] = 65536;
-    g_vol.dims[1] = 65536;
-    expect_err(rd_vol, "r.raw", raw, 48, ARGIL_ERR_ARG, "65536 x 65536", "exceed the limit");
+    expect_vol(&c, "r.raw", nanraw, 48, VOLUME_ERR_SAMPLE, "byte 44", "sample 11 is not a finite");
+    c.dims[0] = 0;
+    expect_vol(&c, "r.raw", raw, 48, VOLUME_ERR_ARG, "dimension 0", "must be 1..2^30");
+    c.dims[0] = 65536;
+    c.dims[1] = 65536;
+    expect_vol(&c, "r.raw", raw, 48, VOLUME_ERR_ARG, "65536 x 65536", "exceed the limit");
 
-    g_vol.raw = false;
+    c.raw = false;
     const char *H = "NRRD0004\ntype: float\ndimension: 3\nsizes: 1 1 1\nencoding: raw\nendian: little\n";
     char buf[1024];
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0009\n", "line 1", "not a NRRD file");
+    EXPECT_VOL(&c, "e.nrrd", "NRRD0009\n", VOLUME_ERR_MAGIC, "line 1", "not a NRRD file");
     memset(buf, 'a', 400);
     memcpy(buf, "NRRD0004\n", 9);
-    expect_err(rd_vol, "e.nrrd", buf, 400, ARGIL_ERR_PARSE, "line 2", "longer than 255");
-    expect_err(rd_vol, "e.nrrd", "NRRD0004\nty\0pe: float\n", 22, ARGIL_ERR_PARSE, "line 2", "NUL");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype: float\n", "line 2", "does not end with a blank");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype float\n\n", "line 2", "expected '<field>: <value>'");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype: quaternion\n\n", "line 2", "unknown type");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ndimension: 2\n\n", "line 2", "dimension must be 3");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nsizes: 2 0 2\n\n", "line 2", "sizes must be three");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nsizes: 2 2 2 2\n\n", "line 2", "sizes must be three");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nencoding: gzip\n\n", "line 2", "'gzip' is not supported");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nendian: middle\n\n", "line 2", "endian must be");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nspacings: 1 -1 1\n\n", "line 2", "spacings must be");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nspace directions: (1,0,0) (0,1,0)\n\n", "line 2",
-               "space directions must be three");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nspace directions: (1,0,0) (0,0,0) (0,0,1)\n\n",
-               "line 2", "zero length");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\nspace origin: (1,2)\n\n", "line 2", "space origin must");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ndata file: ../../etc/passwd\n\n", "line 2",
-               "one plain file name");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nencoding: raw\n\n",
-               "line 5", "lacks the required field 'sizes'");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 1 1 1\n"
-               "encoding: raw\n\n", "line 6", "lacks 'endian' for a 4-byte type");
+    expect_vol(&c, "e.nrrd", buf, 400, VOLUME_ERR_LINE_LONG, "line 2", "longer than 255");
+    expect_vol(&c, "e.nrrd", "NRRD0004\nty\0pe: float\n", 22, VOLUME_ERR_LINE_NUL, "line 2", "NUL");
+    EXPECT_VOL(&c, "e.nrrd", "NRRD0004\ntype: float\n", VOLUME_ERR_HEADER_END, "line 2",
+               "does not end with a blank");
+    for (size_t i = 0; i < sizeof(nrrd_field_refusals) / sizeof(nrrd_field_refusals[0]); i++) {
+        snprintf(buf, sizeof(buf), "NRRD0004\n%s\n\n", nrrd_field_refusals[i].line);
+        EXPECT_VOL(&c, "e.nrrd", buf, nrrd_field_refusals[i].want, "line 2",
+                   nrrd_field_refusals[i].says);
+    }
+    EXPECT_VOL(&c, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nencoding: raw\n\n",
+               VOLUME_ERR_MISSING, "line 5", "lacks the required field 'sizes'");
+    EXPECT_VOL(&c, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 1 1 1\n"
+               "encoding: raw\n\n", VOLUME_ERR_MISSING, "line 6",
+               "lacks 'endian' for a 4-byte type");
     char at[32];
     sprintf(at, "byte %zu", strlen(H) + 1);
     sprintf(buf, "%s\n", H);
-    EXPECT_TXT(rd_vol, "e.nrrd", buf, at, "need 4 data bytes, the file has 0");
+    EXPECT_VOL(&c, "e.nrrd", buf, VOLUME_ERR_DATA_LENGTH, at, "need 4 data bytes, the file has 0");
     sprintf(buf, "%s\n\xff\xff\xff\xff", H);
-    EXPECT_TXT(rd_vol, "e.nrrd", buf, at, "sample 0 is not a finite");
-    EXPECT_TXT(rd_vol, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 1073741824 1073741824 "
-               "1073741824\nencoding: raw\nendian: little\n\n", "line 4", "more than 2^30 samples");
+    EXPECT_VOL(&c, "e.nrrd", buf, VOLUME_ERR_SAMPLE, at, "sample 0 is not a finite");
+    EXPECT_VOL(&c, "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 1073741824 1073741824 "
+               "1073741824\nencoding: raw\nendian: little\n\n", VOLUME_ERR_SAMPLES_MAX, "line 4",
+               "more than 2^30 samples");
     sprintf(buf, "%sdata file: nothere.raw\n\n", H);
-    expect_err(rd_vol, "e.nrrd", buf, strlen(buf), ARGIL_ERR_IO, "nothere.raw", "cannot open");
+    EXPECT_VOL(&c, "e.nrrd", buf, VOLUME_ERR_IO, "nothere.raw", "cannot open");
+    /* a detached data file's own rule comes back through the header's reader */
+    char p[128];
+    test_path(p, sizeof(p), "short.raw");
+    test_spit(p, "\0\0\0", 3);
+    sprintf(buf, "%sdata file: short.raw\n\n", H);
+    EXPECT_VOL(&c, "e.nrrd", buf, VOLUME_ERR_DATA_LENGTH, "data file: ", "the file has 3");
+}
+
+/* Failures outside the file's rules: arguments, the file system, a file over the size limit;
+ * and each code's argil_err_t. */
+static void test_volume_failures(void **state)
+{
+    (void)state;
+    char p[128], err[256] = "";
+    volume_t v;
+    const int32_t dims[3] = {1, 1, 1};
+    assert_int_equal(volume_read_nrrd(NULL, &v, err, sizeof(err)), VOLUME_ERR_ARG);
+    assert_string_equal(err, "volume_read_nrrd: missing argument");
+    assert_int_equal(volume_read_raw(NULL, dims, VOL_U8, false, &v, err, sizeof(err)),
+                     VOLUME_ERR_ARG);
+    assert_string_equal(err, "volume_read_raw: missing argument");
+    test_path(p, sizeof(p), "");
+    assert_int_equal(volume_read_nrrd(p, &v, err, sizeof(err)), VOLUME_ERR_IO);
+    assert_non_null(strstr(err, "not a regular file"));
+    /* a sparse file one byte over the limit: refused before any byte is read */
+    test_path(p, sizeof(p), "huge.raw");
+    test_spit(p, "", 0);
+    assert_int_equal(truncate(p, (off_t)IO_FILE_MAX_BYTES + 1), 0);
+    assert_int_equal(volume_read_raw(p, dims, VOL_U8, false, &v, err, sizeof(err)),
+                     VOLUME_ERR_FILE_SIZE);
+    assert_non_null(strstr(err, "more than the 4294967296 this reader takes"));
+    assert_null(v.value);
+    assert_int_equal(unlink(p), 0);
+
+    assert_int_equal(volume_err_argil(VOLUME_OK), ARGIL_OK);
+    assert_int_equal(volume_err_argil(VOLUME_ERR_ARG), ARGIL_ERR_ARG);
+    assert_int_equal(volume_err_argil(VOLUME_ERR_IO), ARGIL_ERR_IO);
+    assert_int_equal(volume_err_argil(VOLUME_ERR_NOMEM), ARGIL_ERR_NOMEM);
+    for (int e = VOLUME_ERR_FILE_SIZE; e >= VOLUME_ERR_MISSING; e--)
+        assert_int_equal(volume_err_argil((volume_err_t)e), ARGIL_ERR_PARSE);
 }
 
 int main(void)
@@ -492,7 +588,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trips),   cmocka_unit_test(test_ply_errors),
         cmocka_unit_test(test_stl_errors),    cmocka_unit_test(test_obj_xyz_errors),
-        cmocka_unit_test(test_volumes),
+        cmocka_unit_test(test_volumes),       cmocka_unit_test(test_volume_type_names),
+        cmocka_unit_test(test_volume_rules),  cmocka_unit_test(test_volume_failures),
     };
     return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }
