@@ -661,13 +661,19 @@ bool grid_rgb_painted(const grid_t *g)
     return false;
 }
 
-uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
+/* Sets lo and n to the grid's bounding box and returns its sample count. */
+static size_t dense_box(const grid_t *g, int32_t lo[3], int32_t n[3])
 {
     int32_t hi[3];
     grid_bounds(g, lo, hi);
     for (int a = 0; a < 3; a++)
         n[a] = hi[a] - lo[a];
-    uint8_t *out = malloc(3 * box_count(n));
+    return box_count(n);
+}
+
+uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
+{
+    uint8_t *out = malloc(3 * dense_box(g, lo, n));
     if (out != NULL)
         grid_rgb_read_box(g, lo, n, out);
     return out;
@@ -698,11 +704,7 @@ bool grid_rgb_equal(const grid_t *a, const grid_t *b)
 
 float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3])
 {
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    float *out = malloc(box_count(n) * sizeof(float));
+    float *out = malloc(dense_box(g, lo, n) * sizeof(float));
     if (out != NULL)
         grid_read_box(g, ch, lo, n, out);
     return out;
@@ -710,11 +712,7 @@ float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3
 
 float *grid_dense_copy_mat(const grid_t *g, grid_mat_t ch, int32_t lo[3], int32_t n[3])
 {
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    float *out = malloc(box_count(n) * sizeof(float));
+    float *out = malloc(dense_box(g, lo, n) * sizeof(float));
     if (out != NULL)
         grid_mat_read_box(g, ch, lo, n, out);
     return out;
