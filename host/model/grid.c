@@ -64,37 +64,41 @@ static float uniform_of(const grid_block_t *b, grid_ch_t ch)
     return b != NULL && (ch == GRID_DENSITY || ch == GRID_REST) ? b->uniform : 0.0f;
 }
 
+/* A block's worth of n_ch channels, channel c filled with fill[c]; NULL when out of memory. */
+static float *channels_new(int n_ch, const float *fill)
+{
+    float *p = malloc(sizeof(float) * (size_t)n_ch * GRID_BN);
+    if (p != NULL)
+        for (int c = 0; c < n_ch; c++)
+            for (int i = 0; i < GRID_BN; i++)
+                p[c * GRID_BN + i] = fill[c];
+    return p;
+}
+
 /* Gives b its sample arrays (filled with what it held); false when out of memory. */
 static bool block_data(grid_t *g, grid_block_t *b)
 {
     if (b->data != NULL)
         return true;
-    b->data = malloc(sizeof(float) * GRID_CH_N * GRID_BN);
-    if (b->data == NULL)
-        return false;
-    for (int c = 0; c < GRID_CH_N; c++) {
-        const float v = uniform_of(b, (grid_ch_t)c);
-        for (int i = 0; i < GRID_BN; i++)
-            b->data[c * GRID_BN + i] = v;
-    }
-    g->data_blocks++;
-    return true;
+    float held[GRID_CH_N];
+    for (int c = 0; c < GRID_CH_N; c++)
+        held[c] = uniform_of(b, (grid_ch_t)c);
+    b->data = channels_new(GRID_CH_N, held);
+    g->data_blocks += b->data != NULL;
+    return b->data != NULL;
 }
 
+/* Gives b its painted channels (filled with their defaults); false when out of memory. */
 static bool block_mat(grid_t *g, grid_block_t *b)
 {
     if (b->mat != NULL)
         return true;
-    b->mat = malloc(sizeof(float) * GRID_MAT_N * GRID_BN);
-    if (b->mat == NULL)
-        return false;
-    for (int c = 0; c < GRID_MAT_N; c++) {
-        const float v = grid_mat_default((grid_mat_t)c);
-        for (int i = 0; i < GRID_BN; i++)
-            b->mat[c * GRID_BN + i] = v;
-    }
-    g->mat_blocks++;
-    return true;
+    float def[GRID_MAT_N];
+    for (int c = 0; c < GRID_MAT_N; c++)
+        def[c] = grid_mat_default((grid_mat_t)c);
+    b->mat = channels_new(GRID_MAT_N, def);
+    g->mat_blocks += b->mat != NULL;
+    return b->mat != NULL;
 }
 
 static void split(int32_t x, int32_t y, int32_t z, int32_t k[3], int *li)
