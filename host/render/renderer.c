@@ -158,13 +158,14 @@ static unsigned link_program(const gl_api_t *gl, const char *vs_src, const char 
     return p;
 }
 
-/* A unit UV sphere whose positions are also its normals. */
+/* The linked program of vs_src and fs_src; 0 with the reason in err. */
 unsigned renderer_program(const gl_api_t *gl, const char *vs_src, const char *fs_src,
                           char *err, size_t err_len)
 {
     return link_program(gl, vs_src, fs_src, err, err_len);
 }
 
+/* A unit UV sphere whose positions are also its normals. */
 static argil_err_t make_sphere(renderer_t *r)
 {
     const gl_api_t *gl = r->gl;
@@ -262,24 +263,45 @@ argil_err_t renderer_init(renderer_t *r, const gl_api_t *gl, char *err, size_t e
     return ARGIL_OK;
 }
 
+/* Loads n_vert 3-float vectors into buffer vbo and feeds them to attribute attr of the bound
+ * vertex array. */
+static void upload_vec3(const gl_api_t *gl, unsigned vbo, unsigned attr, size_t n_vert,
+                        const float *v)
+{
+    gl->BindBuffer(GL_ARRAY_BUFFER, vbo);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * n_vert), v, GL_STATIC_DRAW);
+    gl->VertexAttribPointer(attr, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    gl->EnableVertexAttribArray(attr);
+}
+
+/* Loads m's triangles into index buffer ibo of the bound vertex array, unbinds the array and
+ * returns the index count. */
+static size_t upload_tris(const gl_api_t *gl, unsigned ibo, const mesh_t *m)
+{
+    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
+                   GL_STATIC_DRAW);
+    gl->BindVertexArray(0);
+    return 3 * m->n_tri;
+}
+
+/* True when m can be uploaded: its arrays are there (normals too when with_normals) and its
+ * index count fits GL's. */
+static bool mesh_uploadable(const mesh_t *m, bool with_normals)
+{
+    if (m->n_tri > 0 && (m->pos == NULL || (with_normals && m->normal == NULL) || m->tri == NULL))
+        return false;
+    return m->n_tri <= (size_t)INT32_MAX / 3;
+}
+
 argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (m->n_tri > 0 && (m->pos == NULL || m->normal == NULL || m->tri == NULL))
-        return ARGIL_ERR_ARG;
-    if (m->n_tri > (size_t)INT32_MAX / 3)
+    if (!mesh_uploadable(m, true))
         return ARGIL_ERR_ARG;
     gl->BindVertexArray(r->vao_mesh);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_pos);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->pos,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_POS, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_POS);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_nrm);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->normal,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_NORMAL, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_NORMAL);
+    upload_vec3(gl, r->vbo_pos, ATTR_POS, m->n_vert, m->pos);
+    upload_vec3(gl, r->vbo_nrm, ATTR_NORMAL, m->n_vert, m->normal);
     r->mesh_has_rgb = m->has_rgb && m->rgb != NULL;
     if (r->mesh_has_rgb) {
         gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_rgb);
@@ -289,32 +311,18 @@ argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
     } else {
         gl->DisableVertexAttribArray(ATTR_RGB);
     }
-    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_mesh);
-    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
-                   GL_STATIC_DRAW);
-    gl->BindVertexArray(0);
-    r->mesh_index_count = 3 * m->n_tri;
+    r->mesh_index_count = upload_tris(gl, r->ibo_mesh, m);
     return gl->GetError() == GL_NO_ERROR ? ARGIL_OK : ARGIL_ERR_NOMEM;
 }
 
 argil_err_t renderer_set_wire_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (m->n_tri > 0 && (m->pos == NULL || m->tri == NULL))
-        return ARGIL_ERR_ARG;
-    if (m->n_tri > (size_t)INT32_MAX / 3)
+    if (!mesh_uploadable(m, false))
         return ARGIL_ERR_ARG;
     gl->BindVertexArray(r->vao_wire);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_wire);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->pos,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_POS, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_POS);
-    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_wire);
-    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
-                   GL_STATIC_DRAW);
-    gl->BindVertexArray(0);
-    r->wire_index_count = 3 * m->n_tri;
+    upload_vec3(gl, r->vbo_wire, ATTR_POS, m->n_vert, m->pos);
+    r->wire_index_count = upload_tris(gl, r->ibo_wire, m);
     return gl->GetError() == GL_NO_ERROR ? ARGIL_OK : ARGIL_ERR_NOMEM;
 }
 
