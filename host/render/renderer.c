@@ -107,6 +107,17 @@ void render_scene_default(render_scene_t *s)
     s->wire_rgb = vec3(0.90f, 0.40f, 1.0f);
 }
 
+/* Writes "what: " and the first line of object obj's info log into err (get reads a shader's
+ * or a program's log). */
+static void say_log(PFNGLGETSHADERINFOLOGPROC get, GLuint obj, const char *what, char *err,
+                    size_t err_len)
+{
+    char log[512] = "";
+    get(obj, sizeof(log), NULL, log);
+    log[strcspn(log, "\n")] = '\0';
+    snprintf(err, err_len, "%s: %s", what, log);
+}
+
 /* Compiles one stage; 0 with the log's first line in err on failure. */
 static unsigned compile(const gl_api_t *gl, GLenum type, const char *src, char *err,
                         size_t err_len)
@@ -117,11 +128,10 @@ static unsigned compile(const gl_api_t *gl, GLenum type, const char *src, char *
     GLint ok = 0;
     gl->GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-        char log[512] = "";
-        gl->GetShaderInfoLog(sh, sizeof(log), NULL, log);
-        log[strcspn(log, "\n")] = '\0';
-        snprintf(err, err_len, "%s shader does not compile: %s",
-                 type == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+        say_log(gl->GetShaderInfoLog, sh,
+                type == GL_VERTEX_SHADER ? "vertex shader does not compile"
+                                         : "fragment shader does not compile",
+                err, err_len);
         gl->DeleteShader(sh);
         return 0;
     }
@@ -148,10 +158,7 @@ static unsigned link_program(const gl_api_t *gl, const char *vs_src, const char 
     GLint ok = 0;
     gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
     if (!ok) {
-        char log[512] = "";
-        gl->GetProgramInfoLog(p, sizeof(log), NULL, log);
-        log[strcspn(log, "\n")] = '\0';
-        snprintf(err, err_len, "shaders do not link: %s", log);
+        say_log(gl->GetProgramInfoLog, p, "shaders do not link", err, err_len);
         gl->DeleteProgram(p);
         return 0;
     }
@@ -285,22 +292,25 @@ static size_t upload_tris(const gl_api_t *gl, unsigned ibo, const mesh_t *m)
     return 3 * m->n_tri;
 }
 
-/* True when m can be uploaded: its arrays are there (normals too when with_normals) and its
- * index count fits GL's. */
-static bool mesh_uploadable(const mesh_t *m, bool with_normals)
+/* Binds vertex array vao and loads m's positions into vbo_pos; false, with nothing bound, when
+ * m lacks an array it needs (normals too when with_normals) or has more indices than GL counts. */
+static bool upload_begin(const gl_api_t *gl, const mesh_t *m, bool with_normals, unsigned vao,
+                         unsigned vbo_pos)
 {
     if (m->n_tri > 0 && (m->pos == NULL || (with_normals && m->normal == NULL) || m->tri == NULL))
         return false;
-    return m->n_tri <= (size_t)INT32_MAX / 3;
+    if (m->n_tri > (size_t)INT32_MAX / 3)
+        return false;
+    gl->BindVertexArray(vao);
+    upload_vec3(gl, vbo_pos, ATTR_POS, m->n_vert, m->pos);
+    return true;
 }
 
 argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (!mesh_uploadable(m, true))
+    if (!upload_begin(gl, m, true, r->vao_mesh, r->vbo_pos))
         return ARGIL_ERR_ARG;
-    gl->BindVertexArray(r->vao_mesh);
-    upload_vec3(gl, r->vbo_pos, ATTR_POS, m->n_vert, m->pos);
     upload_vec3(gl, r->vbo_nrm, ATTR_NORMAL, m->n_vert, m->normal);
     r->mesh_has_rgb = m->has_rgb && m->rgb != NULL;
     if (r->mesh_has_rgb) {
@@ -318,10 +328,8 @@ argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
 argil_err_t renderer_set_wire_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (!mesh_uploadable(m, false))
+    if (!upload_begin(gl, m, false, r->vao_wire, r->vbo_wire))
         return ARGIL_ERR_ARG;
-    gl->BindVertexArray(r->vao_wire);
-    upload_vec3(gl, r->vbo_wire, ATTR_POS, m->n_vert, m->pos);
     r->wire_index_count = upload_tris(gl, r->ibo_wire, m);
     return gl->GetError() == GL_NO_ERROR ? ARGIL_OK : ARGIL_ERR_NOMEM;
 }
