@@ -7,15 +7,7 @@
 
 void mesh_init(mesh_t *m)
 {
-    m->pos = NULL;
-    m->normal = NULL;
-    m->tri = NULL;
-    m->rgb = NULL;
-    m->has_rgb = 0;
-    m->n_vert = 0;
-    m->n_tri = 0;
-    m->cap_vert = 0;
-    m->cap_tri = 0;
+    *m = (mesh_t){0};
 }
 
 void mesh_free(mesh_t *m)
