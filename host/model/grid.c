@@ -1132,41 +1132,41 @@ bool grid_block_next(const grid_t *g, size_t *slot, grid_block_view_t *v)
 
 /* ---- Queries for the live mesher (host/mesh/grid_mesh.c) ---- */
 
+typedef struct {
+    const grid_t *g;
+    float v;
+} at_most_ctx_t;
+
+/* True when every density of block k over [a0, a1) is at most ctx's v (an absent block reads 0). */
+static bool block_at_most(void *vctx, const int32_t k[3], const int32_t a0[3], const int32_t a1[3])
+{
+    const at_most_ctx_t *c = vctx;
+    const grid_block_t *b = block_find(c->g, k);
+    if (b == NULL)
+        return true;
+    if (b->data == NULL)
+        return b->uniform <= c->v;
+    const float *d = b->data + GRID_DENSITY * GRID_BN;
+    for (int32_t z = a0[2]; z < a1[2]; z++)
+        for (int32_t y = a0[1]; y < a1[1]; y++)
+            for (int32_t x = a0[0]; x < a1[0]; x++)
+                if (!(d[local_at(k, x, y, z)] <= c->v))
+                    return false;
+    return true;
+}
+
 bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_t hi[3], float v)
 {
     if (!(v >= 0.0f))
         return false; /* blocks not held read 0 */
-    int32_t klo[3], khi[3];
-    for (int a = 0; a < 3; a++) {
+    int32_t clo[3], chi[3], n[3];
+    for (int a = 0; a < 3; a++)
         if (lo[a] >= hi[a])
             return true;
-        klo[a] = floor_div_i32(lo[a], GRID_B);
-        khi[a] = floor_div_i32(hi[a] - 1, GRID_B);
-    }
-    int32_t k[3];
-    for (k[2] = klo[2]; k[2] <= khi[2]; k[2]++)
-        for (k[1] = klo[1]; k[1] <= khi[1]; k[1]++)
-            for (k[0] = klo[0]; k[0] <= khi[0]; k[0]++) {
-                const grid_block_t *b = block_find(g, k);
-                if (b == NULL)
-                    continue;
-                if (b->data == NULL) {
-                    if (!(b->uniform <= v))
-                        return false;
-                    continue;
-                }
-                int32_t a0[3], a1[3]; /* the box's part of this block, block-local */
-                for (int a = 0; a < 3; a++) {
-                    const int32_t base = k[a] * GRID_B;
-                    a0[a] = lo[a] > base ? lo[a] - base : 0;
-                    a1[a] = hi[a] < base + GRID_B ? hi[a] - base : GRID_B;
-                }
-                const float *d = b->data + GRID_DENSITY * GRID_BN;
-                for (int32_t z = a0[2]; z < a1[2]; z++)
-                    for (int32_t y = a0[1]; y < a1[1]; y++)
-                        for (int32_t x = a0[0]; x < a1[0]; x++)
-                            if (!(d[x + GRID_B * (y + GRID_B * z)] <= v))
-                                return false;
-            }
-    return true;
+    if (!grid_clip(g, lo, hi, clo, chi))
+        return true; /* outside what the grid can hold: all 0 */
+    for (int a = 0; a < 3; a++)
+        n[a] = chi[a] - clo[a];
+    at_most_ctx_t c = {g, v};
+    return for_blocks(g, clo, n, block_at_most, &c);
 }
