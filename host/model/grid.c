@@ -258,11 +258,34 @@ argil_err_t grid_set(grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z, f
     return ARGIL_OK;
 }
 
+/* Samples in a box of n per axis; 0 when any axis is empty. */
 static size_t box_count(const int32_t n[3])
 {
     if (n[0] <= 0 || n[1] <= 0 || n[2] <= 0)
         return 0;
     return (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+}
+
+/* Sets lo and n to the grid's bounding box and returns its sample count. */
+static size_t dense_box(const grid_t *g, int32_t lo[3], int32_t n[3])
+{
+    int32_t hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        n[a] = hi[a] - lo[a];
+    return box_count(n);
+}
+
+/* True when a and b have the same bounding box, which lo and n are set to (n: samples per axis). */
+static bool same_box(const grid_t *a, const grid_t *b, int32_t lo[3], int32_t n[3])
+{
+    int32_t blo[3], bhi[3];
+    (void)dense_box(a, lo, n);
+    grid_bounds(b, blo, bhi);
+    for (int q = 0; q < 3; q++)
+        if (lo[q] != blo[q] || lo[q] + n[q] != bhi[q])
+            return false;
+    return true;
 }
 
 /* Calls fn for each block overlapping the box [lo, lo+n) with the part [a0, a1) of the box it
@@ -502,14 +525,9 @@ bool grid_mat_painted(const grid_t *g, grid_mat_t ch)
 
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)
 {
-    int32_t alo[3], ahi[3], blo[3], bhi[3], n[3];
-    grid_bounds(a, alo, ahi);
-    grid_bounds(b, blo, bhi);
-    for (int q = 0; q < 3; q++) {
-        if (alo[q] != blo[q] || ahi[q] != bhi[q])
-            return false;
-        n[q] = ahi[q] - alo[q];
-    }
+    int32_t alo[3], n[3];
+    if (!same_box(a, b, alo, n))
+        return false;
     const size_t cnt = box_count(n);
     float *u = malloc(2 * cnt * sizeof(float));
     if (u == NULL)
@@ -665,16 +683,6 @@ bool grid_rgb_painted(const grid_t *g)
     return false;
 }
 
-/* Sets lo and n to the grid's bounding box and returns its sample count. */
-static size_t dense_box(const grid_t *g, int32_t lo[3], int32_t n[3])
-{
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    return box_count(n);
-}
-
 uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
 {
     uint8_t *out = malloc(3 * dense_box(g, lo, n));
@@ -685,14 +693,9 @@ uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
 
 bool grid_rgb_equal(const grid_t *a, const grid_t *b)
 {
-    int32_t alo[3], ahi[3], blo[3], bhi[3], n[3];
-    grid_bounds(a, alo, ahi);
-    grid_bounds(b, blo, bhi);
-    for (int q = 0; q < 3; q++) {
-        if (alo[q] != blo[q] || ahi[q] != bhi[q])
-            return false;
-        n[q] = ahi[q] - alo[q];
-    }
+    int32_t alo[3], n[3];
+    if (!same_box(a, b, alo, n))
+        return false;
     if (!grid_rgb_any(a) && !grid_rgb_any(b))
         return true;
     const size_t cnt = 3 * box_count(n);
