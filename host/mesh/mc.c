@@ -12,6 +12,13 @@
 #define MC_NONE UINT32_MAX
 
 /* Working state for one extraction over the padded lattice (sample index + 1 per axis). */
+/* One padded layer of samples. */
+typedef struct {
+    float *val;            /* densities */
+    uint8_t *ins;          /* 1 where that density > iso */
+    uint32_t *xe, *ye;     /* vertex of the x / y edge starting at each sample */
+} mc_layer_t;
+
 typedef struct {
     const float *density;
     int32_t dims[3];
@@ -20,9 +27,7 @@ typedef struct {
     float spacing_m;
     vec3_t origin_m;
     float iso;
-    float *val[2];         /* padded densities of the cell slab's lower and upper layers */
-    uint8_t *ins[2];       /* 1 where that density > iso */
-    uint32_t *xe[2], *ye[2]; /* vertex of the x / y edge starting at each sample of a layer */
+    mc_layer_t lay[2];     /* the cell slab's lower and upper layers */
     uint32_t *ze;          /* vertex of the z edge between the two layers */
     mesh_t *out;
 } mc_work_t;
@@ -46,8 +51,8 @@ static vec3_t mc_gradient(const mc_work_t *w, const int64_t s[3])
 /* Fills padded layer Z (0 .. pad[2]-1) into slot k; false when a density is not finite. */
 static bool mc_load_layer(mc_work_t *w, int32_t pz, int k)
 {
-    float *val = w->val[k];
-    uint8_t *ins = w->ins[k];
+    float *val = w->lay[k].val;
+    uint8_t *ins = w->lay[k].ins;
     const int32_t z = pz - 1;
     for (size_t i = 0; i < w->layer; i++) {
         val[i] = 0.0f;
@@ -119,13 +124,13 @@ static argil_err_t mc_edge_vertex(mc_work_t *w, int32_t px, int32_t py, int32_t 
     const int lz = p[2] - pz; /* layer slot of the lower end */
     const size_t i = (size_t)p[0] + (size_t)w->pad[0] * (size_t)p[1];
     const size_t step = a == 0 ? 1 : (a == 1 ? (size_t)w->pad[0] : 0);
-    uint32_t *slot = a == 0 ? &w->xe[lz][i] : (a == 1 ? &w->ye[lz][i] : &w->ze[i]);
+    uint32_t *slot = a == 0 ? &w->lay[lz].xe[i] : (a == 1 ? &w->lay[lz].ye[i] : &w->ze[i]);
     if (*slot != MC_NONE) {
         *id = *slot;
         return ARGIL_OK;
     }
-    const float d0 = w->val[lz][i];
-    const float d1 = a == 2 ? w->val[1][i] : w->val[lz][i + step];
+    const float d0 = w->lay[lz].val[i];
+    const float d1 = a == 2 ? w->lay[1].val[i] : w->lay[lz].val[i + step];
     argil_err_t err = mc_make_vertex(w, p, a, d0, d1, slot);
     *id = *slot;
     return err;
@@ -141,7 +146,7 @@ static void mc_fill_none(uint32_t *a, size_t n)
 static argil_err_t mc_slab(mc_work_t *w, const mc_table_t *tab, int32_t pz)
 {
     const size_t px_n = (size_t)w->pad[0];
-    const uint8_t *i0 = w->ins[0], *i1 = w->ins[1];
+    const uint8_t *i0 = w->lay[0].ins, *i1 = w->lay[1].ins;
     for (int32_t py = 0; py + 1 < w->pad[1]; py++) {
         for (int32_t px = 0; px + 1 < w->pad[0]; px++) {
             const size_t i = (size_t)px + px_n * (size_t)py;
@@ -173,32 +178,43 @@ static argil_err_t mc_run(mc_work_t *w, const mc_table_t *tab)
 {
     if (!mc_load_layer(w, 0, 0))
         return ARGIL_ERR_NONFINITE;
-    mc_fill_none(w->xe[0], w->layer);
-    mc_fill_none(w->ye[0], w->layer);
+    mc_fill_none(w->lay[0].xe, w->layer);
+    mc_fill_none(w->lay[0].ye, w->layer);
     for (int32_t pz = 0; pz + 1 < w->pad[2]; pz++) {
         if (!mc_load_layer(w, pz + 1, 1))
             return ARGIL_ERR_NONFINITE;
-        mc_fill_none(w->xe[1], w->layer);
-        mc_fill_none(w->ye[1], w->layer);
+        mc_fill_none(w->lay[1].xe, w->layer);
+        mc_fill_none(w->lay[1].ye, w->layer);
         mc_fill_none(w->ze, w->layer);
         argil_err_t err = mc_slab(w, tab, pz);
         if (err != ARGIL_OK)
             return err;
         /* The upper layer becomes the next slab's lower layer. */
-        float *fv = w->val[0];
-        w->val[0] = w->val[1];
-        w->val[1] = fv;
-        uint8_t *fi = w->ins[0];
-        w->ins[0] = w->ins[1];
-        w->ins[1] = fi;
-        uint32_t *fx = w->xe[0];
-        w->xe[0] = w->xe[1];
-        w->xe[1] = fx;
-        uint32_t *fy = w->ye[0];
-        w->ye[0] = w->ye[1];
-        w->ye[1] = fy;
+        const mc_layer_t lower = w->lay[0];
+        w->lay[0] = w->lay[1];
+        w->lay[1] = lower;
     }
     return ARGIL_OK;
+}
+
+/* Gives layer l arrays of n samples; false when any could not be made (mc_layer_free frees
+ * the rest). */
+static bool mc_layer_alloc(mc_layer_t *l, size_t n)
+{
+    l->val = malloc(n * sizeof(float));
+    l->ins = malloc(n);
+    l->xe = malloc(n * sizeof(uint32_t));
+    l->ye = malloc(n * sizeof(uint32_t));
+    return l->val != NULL && l->ins != NULL && l->xe != NULL && l->ye != NULL;
+}
+
+/* Frees layer l's arrays. */
+static void mc_layer_free(mc_layer_t *l)
+{
+    free(l->val);
+    free(l->ins);
+    free(l->xe);
+    free(l->ye);
 }
 
 argil_err_t mc_extract(const float *density, const int32_t dims[3], float spacing_m,
@@ -232,27 +248,16 @@ argil_err_t mc_extract(const float *density, const int32_t dims[3], float spacin
     w.origin_m = origin_m;
     w.iso = iso;
     w.out = out;
-    for (int k = 0; k < 2; k++) {
-        w.val[k] = malloc(w.layer * sizeof(float));
-        w.ins[k] = malloc(w.layer);
-        w.xe[k] = malloc(w.layer * sizeof(uint32_t));
-        w.ye[k] = malloc(w.layer * sizeof(uint32_t));
-    }
+    const bool lay0 = mc_layer_alloc(&w.lay[0], w.layer), lay1 = mc_layer_alloc(&w.lay[1], w.layer);
     w.ze = malloc(w.layer * sizeof(uint32_t));
 
     argil_err_t err = ARGIL_ERR_NOMEM;
-    if (tab != NULL && w.val[0] != NULL && w.val[1] != NULL && w.ins[0] != NULL &&
-        w.ins[1] != NULL && w.xe[0] != NULL && w.xe[1] != NULL && w.ye[0] != NULL &&
-        w.ye[1] != NULL && w.ze != NULL) {
+    if (tab != NULL && lay0 && lay1 && w.ze != NULL) {
         mc_table_build(tab);
         err = mc_run(&w, tab);
     }
-    for (int k = 0; k < 2; k++) {
-        free(w.val[k]);
-        free(w.ins[k]);
-        free(w.xe[k]);
-        free(w.ye[k]);
-    }
+    for (int k = 0; k < 2; k++)
+        mc_layer_free(&w.lay[k]);
     free(w.ze);
     free(tab);
     if (err != ARGIL_OK)

@@ -229,24 +229,13 @@ static argil_err_t mcb_grow_vert(mc_block_mesh_t *k, int with_rgb)
     if (k->cap_vert >= UINT32_MAX / 2)
         return ARGIL_ERR_FULL;
     const size_t cap = k->cap_vert < 64 ? 64 : (size_t)k->cap_vert * 2;
-    float *p = realloc(k->pos, cap * 3 * sizeof(float));
-    if (p == NULL)
-        return ARGIL_ERR_NOMEM;
-    k->pos = p;
-    float *n = realloc(k->normal, cap * 3 * sizeof(float));
-    if (n == NULL)
-        return ARGIL_ERR_NOMEM;
-    k->normal = n;
+    argil_err_t e = mesh_vert_arrays_resize(&k->pos, &k->normal, with_rgb ? &k->rgb : NULL, cap);
+    if (e != ARGIL_OK)
+        return e;
     uint64_t *key = realloc(k->key, cap * sizeof(uint64_t));
     if (key == NULL)
         return ARGIL_ERR_NOMEM;
     k->key = key;
-    if (with_rgb) {
-        uint8_t *c = realloc(k->rgb, cap * 3);
-        if (c == NULL)
-            return ARGIL_ERR_NOMEM;
-        k->rgb = c;
-    }
     k->cap_vert = (uint32_t)cap;
     return ARGIL_OK;
 }
@@ -258,10 +247,8 @@ static argil_err_t mcb_grow_tri(mc_block_mesh_t *k)
     if (k->cap_tri >= UINT32_MAX / 8)
         return ARGIL_ERR_FULL;
     const size_t cap = k->cap_tri < 128 ? 128 : (size_t)k->cap_tri * 2;
-    uint32_t *t = realloc(k->tri, cap * 3 * sizeof(uint32_t));
-    if (t == NULL)
+    if (mesh_tri_array_resize(&k->tri, cap) != ARGIL_OK)
         return ARGIL_ERR_NOMEM;
-    k->tri = t;
     k->cap_tri = (uint32_t)cap;
     return ARGIL_OK;
 }
@@ -392,13 +379,7 @@ static argil_err_t mcb_make_vertex(mcb_job_t *j, const int32_t p[3], int a, uint
     if (e != ARGIL_OK)
         return e;
     const uint32_t v = k->n_vert++;
-    float *pp = k->pos + 3 * (size_t)v, *nn = k->normal + 3 * (size_t)v;
-    pp[0] = pos.x;
-    pp[1] = pos.y;
-    pp[2] = pos.z;
-    nn[0] = n.x;
-    nn[1] = n.y;
-    nn[2] = n.z;
+    mesh_vert_put(k->pos, k->normal, v, pos, n);
     if (colour) {
         const uint8_t *c = b->col + 3 * (d0 > b->iso ? i0 : i1); /* the inside end's paint */
         memcpy(k->rgb + 3 * (size_t)v, c, 3);

@@ -7,15 +7,7 @@
 
 void mesh_init(mesh_t *m)
 {
-    m->pos = NULL;
-    m->normal = NULL;
-    m->tri = NULL;
-    m->rgb = NULL;
-    m->has_rgb = 0;
-    m->n_vert = 0;
-    m->n_tri = 0;
-    m->cap_vert = 0;
-    m->cap_tri = 0;
+    *m = (mesh_t){0};
 }
 
 void mesh_free(mesh_t *m)
@@ -44,6 +36,34 @@ static size_t next_cap(size_t cap, size_t need, size_t limit)
     return c > limit ? limit : c;
 }
 
+argil_err_t mesh_vert_arrays_resize(float **pos, float **normal, uint8_t **rgb, size_t cap)
+{
+    float *p = realloc(*pos, cap * 3 * sizeof(float));
+    if (p == NULL)
+        return ARGIL_ERR_NOMEM;
+    *pos = p;
+    float *n = realloc(*normal, cap * 3 * sizeof(float));
+    if (n == NULL)
+        return ARGIL_ERR_NOMEM;
+    *normal = n;
+    if (rgb != NULL) {
+        uint8_t *c = realloc(*rgb, cap * 3);
+        if (c == NULL)
+            return ARGIL_ERR_NOMEM;
+        *rgb = c;
+    }
+    return ARGIL_OK;
+}
+
+argil_err_t mesh_tri_array_resize(uint32_t **tri, size_t cap)
+{
+    uint32_t *t = realloc(*tri, cap * 3 * sizeof(uint32_t));
+    if (t == NULL)
+        return ARGIL_ERR_NOMEM;
+    *tri = t;
+    return ARGIL_OK;
+}
+
 argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri)
 {
     if (n_vert > MESH_MAX_VERTS || n_tri > SIZE_MAX / (3 * sizeof(uint32_t)))
@@ -52,28 +72,17 @@ argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri)
         size_t cap = next_cap(m->cap_vert, n_vert, MESH_MAX_VERTS);
         if (cap > SIZE_MAX / (3 * sizeof(float)))
             return ARGIL_ERR_NOMEM;
-        float *p = realloc(m->pos, cap * 3 * sizeof(float));
-        if (p == NULL)
-            return ARGIL_ERR_NOMEM;
-        m->pos = p;
-        float *n = realloc(m->normal, cap * 3 * sizeof(float));
-        if (n == NULL)
-            return ARGIL_ERR_NOMEM; /* pos grew already; cap_vert stays, which is safe */
-        m->normal = n;
-        if (m->has_rgb) {
-            uint8_t *c = realloc(m->rgb, cap * 3);
-            if (c == NULL)
-                return ARGIL_ERR_NOMEM;
-            m->rgb = c;
-        }
+        /* On failure the arrays that grew keep their size; cap_vert stays, which is safe. */
+        argil_err_t e =
+            mesh_vert_arrays_resize(&m->pos, &m->normal, m->has_rgb ? &m->rgb : NULL, cap);
+        if (e != ARGIL_OK)
+            return e;
         m->cap_vert = cap;
     }
     if (n_tri > m->cap_tri) {
         size_t cap = next_cap(m->cap_tri, n_tri, SIZE_MAX / (3 * sizeof(uint32_t)));
-        uint32_t *t = realloc(m->tri, cap * 3 * sizeof(uint32_t));
-        if (t == NULL)
+        if (mesh_tri_array_resize(&m->tri, cap) != ARGIL_OK)
             return ARGIL_ERR_NOMEM;
-        m->tri = t;
         m->cap_tri = cap;
     }
     return ARGIL_OK;
@@ -125,14 +134,7 @@ argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *in
         if (e != ARGIL_OK)
             return e;
     }
-    float *p = m->pos + 3 * m->n_vert;
-    float *n = m->normal + 3 * m->n_vert;
-    p[0] = pos_m.x;
-    p[1] = pos_m.y;
-    p[2] = pos_m.z;
-    n[0] = normal.x;
-    n[1] = normal.y;
-    n[2] = normal.z;
+    mesh_vert_put(m->pos, m->normal, m->n_vert, pos_m, normal);
     if (m->has_rgb) {
         uint8_t *c = m->rgb + 3 * m->n_vert;
         c[0] = c[1] = c[2] = 128;

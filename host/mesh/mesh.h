@@ -30,8 +30,27 @@ void mesh_clear(mesh_t *m);
  * ARGIL_ERR_ARG beyond 2^32 vertices); the contents are kept. */
 argil_err_t mesh_reserve(mesh_t *m, size_t n_vert, size_t n_tri);
 
+/* Resizes the vertex arrays to cap vertices: pos and normal, and rgb when it is not NULL. On
+ * ARGIL_ERR_NOMEM the arrays that were resized keep their new size (each stays valid). */
+argil_err_t mesh_vert_arrays_resize(float **pos, float **normal, uint8_t **rgb, size_t cap);
+
+/* Resizes a triangle index array to cap triangles; ARGIL_ERR_NOMEM leaves it as it was. */
+argil_err_t mesh_tri_array_resize(uint32_t **tri, size_t cap);
+
 /* Gives m a colour per vertex (existing vertices become mid grey 128); ARGIL_ERR_NOMEM. */
 argil_err_t mesh_enable_rgb(mesh_t *m);
+
+/* Stores position pos_m and normal as vertex i of the pos and normal arrays (3 floats each). */
+static inline void mesh_vert_put(float *pos, float *normal, size_t i, vec3_t pos_m, vec3_t n)
+{
+    float *p = pos + 3 * i, *q = normal + 3 * i;
+    p[0] = pos_m.x;
+    p[1] = pos_m.y;
+    p[2] = pos_m.z;
+    q[0] = n.x;
+    q[1] = n.y;
+    q[2] = n.z;
+}
 
 /* Appends a vertex and stores its index in *index_out (may be NULL). */
 argil_err_t mesh_add_vertex(mesh_t *m, vec3_t pos_m, vec3_t normal, uint32_t *index_out);

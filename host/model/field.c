@@ -2,6 +2,7 @@
  * tensor-product separability of A), evaluation with gradient, quasi-interpolating fill. */
 #include "host/model/field.h"
 
+#include "host/model/f32_buf.h"
 #include "host/model/floor_div.h"
 #include "host/model/model_hot.h"
 
@@ -172,14 +173,7 @@ float field_eval(const field_t *f, vec3_t x_m, vec3_t *grad)
 
 float *field_scratch(field_t *f, size_t n)
 {
-    if (n > f->scratch_n) {
-        float *p = realloc(f->scratch, n * sizeof(float));
-        if (p == NULL)
-            return NULL;
-        f->scratch = p;
-        f->scratch_n = n;
-    }
-    return f->scratch;
+    return f32_buf_reserve(&f->scratch, &f->scratch_n, n) ? f->scratch : NULL;
 }
 
 MODEL_HOT void field_samples_from(const field_t *f, const float *P, const int32_t clo[3], const int32_t cn[3],

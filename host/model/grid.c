@@ -64,37 +64,41 @@ static float uniform_of(const grid_block_t *b, grid_ch_t ch)
     return b != NULL && (ch == GRID_DENSITY || ch == GRID_REST) ? b->uniform : 0.0f;
 }
 
+/* A block's worth of n_ch channels, channel c filled with fill[c]; NULL when out of memory. */
+static float *channels_new(int n_ch, const float *fill)
+{
+    float *p = malloc(sizeof(float) * (size_t)n_ch * GRID_BN);
+    if (p != NULL)
+        for (int c = 0; c < n_ch; c++)
+            for (int i = 0; i < GRID_BN; i++)
+                p[c * GRID_BN + i] = fill[c];
+    return p;
+}
+
 /* Gives b its sample arrays (filled with what it held); false when out of memory. */
 static bool block_data(grid_t *g, grid_block_t *b)
 {
     if (b->data != NULL)
         return true;
-    b->data = malloc(sizeof(float) * GRID_CH_N * GRID_BN);
-    if (b->data == NULL)
-        return false;
-    for (int c = 0; c < GRID_CH_N; c++) {
-        const float v = uniform_of(b, (grid_ch_t)c);
-        for (int i = 0; i < GRID_BN; i++)
-            b->data[c * GRID_BN + i] = v;
-    }
-    g->data_blocks++;
-    return true;
+    float held[GRID_CH_N];
+    for (int c = 0; c < GRID_CH_N; c++)
+        held[c] = uniform_of(b, (grid_ch_t)c);
+    b->data = channels_new(GRID_CH_N, held);
+    g->data_blocks += b->data != NULL;
+    return b->data != NULL;
 }
 
+/* Gives b its painted channels (filled with their defaults); false when out of memory. */
 static bool block_mat(grid_t *g, grid_block_t *b)
 {
     if (b->mat != NULL)
         return true;
-    b->mat = malloc(sizeof(float) * GRID_MAT_N * GRID_BN);
-    if (b->mat == NULL)
-        return false;
-    for (int c = 0; c < GRID_MAT_N; c++) {
-        const float v = grid_mat_default((grid_mat_t)c);
-        for (int i = 0; i < GRID_BN; i++)
-            b->mat[c * GRID_BN + i] = v;
-    }
-    g->mat_blocks++;
-    return true;
+    float def[GRID_MAT_N];
+    for (int c = 0; c < GRID_MAT_N; c++)
+        def[c] = grid_mat_default((grid_mat_t)c);
+    b->mat = channels_new(GRID_MAT_N, def);
+    g->mat_blocks += b->mat != NULL;
+    return b->mat != NULL;
 }
 
 static void split(int32_t x, int32_t y, int32_t z, int32_t k[3], int *li)
@@ -254,11 +258,34 @@ argil_err_t grid_set(grid_t *g, grid_ch_t ch, int32_t x, int32_t y, int32_t z, f
     return ARGIL_OK;
 }
 
+/* Samples in a box of n per axis; 0 when any axis is empty. */
 static size_t box_count(const int32_t n[3])
 {
     if (n[0] <= 0 || n[1] <= 0 || n[2] <= 0)
         return 0;
     return (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+}
+
+/* Sets lo and n to the grid's bounding box and returns its sample count. */
+static size_t dense_box(const grid_t *g, int32_t lo[3], int32_t n[3])
+{
+    int32_t hi[3];
+    grid_bounds(g, lo, hi);
+    for (int a = 0; a < 3; a++)
+        n[a] = hi[a] - lo[a];
+    return box_count(n);
+}
+
+/* True when a and b have the same bounding box, which lo and n are set to (n: samples per axis). */
+static bool same_box(const grid_t *a, const grid_t *b, int32_t lo[3], int32_t n[3])
+{
+    int32_t blo[3], bhi[3];
+    (void)dense_box(a, lo, n);
+    grid_bounds(b, blo, bhi);
+    for (int q = 0; q < 3; q++)
+        if (lo[q] != blo[q] || lo[q] + n[q] != bhi[q])
+            return false;
+    return true;
 }
 
 /* Calls fn for each block overlapping the box [lo, lo+n) with the part [a0, a1) of the box it
@@ -498,14 +525,9 @@ bool grid_mat_painted(const grid_t *g, grid_mat_t ch)
 
 bool grid_mat_equal(const grid_t *a, const grid_t *b, grid_mat_t ch)
 {
-    int32_t alo[3], ahi[3], blo[3], bhi[3], n[3];
-    grid_bounds(a, alo, ahi);
-    grid_bounds(b, blo, bhi);
-    for (int q = 0; q < 3; q++) {
-        if (alo[q] != blo[q] || ahi[q] != bhi[q])
-            return false;
-        n[q] = ahi[q] - alo[q];
-    }
+    int32_t alo[3], n[3];
+    if (!same_box(a, b, alo, n))
+        return false;
     const size_t cnt = box_count(n);
     float *u = malloc(2 * cnt * sizeof(float));
     if (u == NULL)
@@ -663,11 +685,7 @@ bool grid_rgb_painted(const grid_t *g)
 
 uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
 {
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    uint8_t *out = malloc(3 * box_count(n));
+    uint8_t *out = malloc(3 * dense_box(g, lo, n));
     if (out != NULL)
         grid_rgb_read_box(g, lo, n, out);
     return out;
@@ -675,14 +693,9 @@ uint8_t *grid_dense_copy_rgb(const grid_t *g, int32_t lo[3], int32_t n[3])
 
 bool grid_rgb_equal(const grid_t *a, const grid_t *b)
 {
-    int32_t alo[3], ahi[3], blo[3], bhi[3], n[3];
-    grid_bounds(a, alo, ahi);
-    grid_bounds(b, blo, bhi);
-    for (int q = 0; q < 3; q++) {
-        if (alo[q] != blo[q] || ahi[q] != bhi[q])
-            return false;
-        n[q] = ahi[q] - alo[q];
-    }
+    int32_t alo[3], n[3];
+    if (!same_box(a, b, alo, n))
+        return false;
     if (!grid_rgb_any(a) && !grid_rgb_any(b))
         return true;
     const size_t cnt = 3 * box_count(n);
@@ -698,11 +711,7 @@ bool grid_rgb_equal(const grid_t *a, const grid_t *b)
 
 float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3])
 {
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    float *out = malloc(box_count(n) * sizeof(float));
+    float *out = malloc(dense_box(g, lo, n) * sizeof(float));
     if (out != NULL)
         grid_read_box(g, ch, lo, n, out);
     return out;
@@ -710,11 +719,7 @@ float *grid_dense_copy(const grid_t *g, grid_ch_t ch, int32_t lo[3], int32_t n[3
 
 float *grid_dense_copy_mat(const grid_t *g, grid_mat_t ch, int32_t lo[3], int32_t n[3])
 {
-    int32_t hi[3];
-    grid_bounds(g, lo, hi);
-    for (int a = 0; a < 3; a++)
-        n[a] = hi[a] - lo[a];
-    float *out = malloc(box_count(n) * sizeof(float));
+    float *out = malloc(dense_box(g, lo, n) * sizeof(float));
     if (out != NULL)
         grid_mat_read_box(g, ch, lo, n, out);
     return out;
@@ -1130,41 +1135,41 @@ bool grid_block_next(const grid_t *g, size_t *slot, grid_block_view_t *v)
 
 /* ---- Queries for the live mesher (host/mesh/grid_mesh.c) ---- */
 
+typedef struct {
+    const grid_t *g;
+    float v;
+} at_most_ctx_t;
+
+/* True when every density of block k over [a0, a1) is at most ctx's v (an absent block reads 0). */
+static bool block_at_most(void *vctx, const int32_t k[3], const int32_t a0[3], const int32_t a1[3])
+{
+    const at_most_ctx_t *c = vctx;
+    const grid_block_t *b = block_find(c->g, k);
+    if (b == NULL)
+        return true;
+    if (b->data == NULL)
+        return b->uniform <= c->v;
+    const float *d = b->data + GRID_DENSITY * GRID_BN;
+    for (int32_t z = a0[2]; z < a1[2]; z++)
+        for (int32_t y = a0[1]; y < a1[1]; y++)
+            for (int32_t x = a0[0]; x < a1[0]; x++)
+                if (!(d[local_at(k, x, y, z)] <= c->v))
+                    return false;
+    return true;
+}
+
 bool grid_box_density_at_most(const grid_t *g, const int32_t lo[3], const int32_t hi[3], float v)
 {
     if (!(v >= 0.0f))
         return false; /* blocks not held read 0 */
-    int32_t klo[3], khi[3];
-    for (int a = 0; a < 3; a++) {
+    int32_t clo[3], chi[3], n[3];
+    for (int a = 0; a < 3; a++)
         if (lo[a] >= hi[a])
             return true;
-        klo[a] = floor_div_i32(lo[a], GRID_B);
-        khi[a] = floor_div_i32(hi[a] - 1, GRID_B);
-    }
-    int32_t k[3];
-    for (k[2] = klo[2]; k[2] <= khi[2]; k[2]++)
-        for (k[1] = klo[1]; k[1] <= khi[1]; k[1]++)
-            for (k[0] = klo[0]; k[0] <= khi[0]; k[0]++) {
-                const grid_block_t *b = block_find(g, k);
-                if (b == NULL)
-                    continue;
-                if (b->data == NULL) {
-                    if (!(b->uniform <= v))
-                        return false;
-                    continue;
-                }
-                int32_t a0[3], a1[3]; /* the box's part of this block, block-local */
-                for (int a = 0; a < 3; a++) {
-                    const int32_t base = k[a] * GRID_B;
-                    a0[a] = lo[a] > base ? lo[a] - base : 0;
-                    a1[a] = hi[a] < base + GRID_B ? hi[a] - base : GRID_B;
-                }
-                const float *d = b->data + GRID_DENSITY * GRID_BN;
-                for (int32_t z = a0[2]; z < a1[2]; z++)
-                    for (int32_t y = a0[1]; y < a1[1]; y++)
-                        for (int32_t x = a0[0]; x < a1[0]; x++)
-                            if (!(d[x + GRID_B * (y + GRID_B * z)] <= v))
-                                return false;
-            }
-    return true;
+    if (!grid_clip(g, lo, hi, clo, chi))
+        return true; /* outside what the grid can hold: all 0 */
+    for (int a = 0; a < 3; a++)
+        n[a] = chi[a] - clo[a];
+    at_most_ctx_t c = {g, v};
+    return for_blocks(g, clo, n, block_at_most, &c);
 }

@@ -289,6 +289,30 @@ SOLVER_HOT static void solver_gather(float *restrict q, const float *const *src,
     }
 }
 
+/* q (len floats) = the sum over the samples k that coefficient c touches along axis a of their
+ * tap weight times the len floats at src + len * k. */
+SOLVER_HOT static void solver_gather_taps(const solver_t *s, int a, int32_t c, float *restrict q,
+                                          const float *src, size_t len)
+{
+    const float *gs[SOLVER_GATHER_MAX];
+    float gw[SOLVER_GATHER_MAX];
+    int n = 0;
+    bool acc = false;
+    for (int32_t k = s->tapt_lo[a][c]; k < s->tapt_hi[a][c]; k++) {
+        const int32_t j = c - s->tap_first[a][k];
+        if (j < 0 || j > 3)
+            continue;
+        gw[n] = s->tap_w[a][4 * k + j];
+        gs[n++] = src + len * (size_t)k;
+        if (n == SOLVER_GATHER_MAX) {
+            solver_gather(q, gs, gw, n, len, acc);
+            n = 0;
+            acc = true;
+        }
+    }
+    solver_gather(q, gs, gw, n, len, acc);
+}
+
 /* x = Aᵀ y (coefficients from samples), the transpose of solver_apply_A. */
 SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, float *restrict x)
 {
@@ -297,46 +321,13 @@ SOLVER_HOT static void solver_apply_At(solver_t *s, const float *restrict y, flo
     float *T1 = s->w_mid, *T2 = T1 + (size_t)ns[0] * nc[1] * nc[2];
     const size_t plane = (size_t)ns[0] * ns[1];
     /* gathered per coefficient plane (each output plane written once, four input planes a pass) */
-    const float *gs[SOLVER_GATHER_MAX];
-    float gw[SOLVER_GATHER_MAX];
-    for (int32_t c = 0; c < nc[2]; c++) {
-        float *q = T2 + plane * (size_t)c;
-        int n = 0;
-        bool acc = false;
-        for (int32_t k = s->tapt_lo[2][c]; k < s->tapt_hi[2][c]; k++) {
-            const int32_t j = c - s->tap_first[2][k];
-            if (j < 0 || j > 3)
-                continue;
-            gw[n] = tw[2][4 * k + j];
-            gs[n++] = y + plane * (size_t)k;
-            if (n == SOLVER_GATHER_MAX) {
-                solver_gather(q, gs, gw, n, plane, acc);
-                n = 0;
-                acc = true;
-            }
-        }
-        solver_gather(q, gs, gw, n, plane, acc);
-    }
+    for (int32_t c = 0; c < nc[2]; c++)
+        solver_gather_taps(s, 2, c, T2 + plane * (size_t)c, y, plane);
     const size_t st = (size_t)ns[0];
     for (int32_t z = 0; z < nc[2]; z++)
-        for (int32_t c = 0; c < nc[1]; c++) {
-            float *q = T1 + st * ((size_t)c + (size_t)nc[1] * z);
-            int n = 0;
-            bool acc = false;
-            for (int32_t k = s->tapt_lo[1][c]; k < s->tapt_hi[1][c]; k++) {
-                const int32_t j = c - s->tap_first[1][k];
-                if (j < 0 || j > 3)
-                    continue;
-                gw[n] = tw[1][4 * k + j];
-                gs[n++] = T2 + st * ((size_t)k + (size_t)ns[1] * z);
-                if (n == SOLVER_GATHER_MAX) {
-                    solver_gather(q, gs, gw, n, st, acc);
-                    n = 0;
-                    acc = true;
-                }
-            }
-            solver_gather(q, gs, gw, n, st, acc);
-        }
+        for (int32_t c = 0; c < nc[1]; c++)
+            solver_gather_taps(s, 1, c, T1 + st * ((size_t)c + (size_t)nc[1] * z),
+                               T2 + st * (size_t)ns[1] * (size_t)z, st);
     const size_t rows = (size_t)nc[1] * nc[2];
     if (s->band_at.nchunk > 0) {
         solver_band_rows(&s->band_at, T1, (size_t)ns[0], x, (size_t)nc[0], rows);
@@ -661,6 +652,19 @@ static float solver_max_acc(const solver_t *s, const float *pn, const float *pp,
     return m;
 }
 
+/* Makes p_new, reached after dt, the coefficients (the current ones become the previous);
+ * ARGIL_ERR_NONFINITE, changing nothing, when p_new holds a NaN or an infinity. */
+static argil_err_t solver_commit(solver_t *s, const float *p_new, float dt)
+{
+    for (size_t i = 0; i < s->ncoef; i++)
+        if (!isfinite(p_new[i]))
+            return ARGIL_ERR_NONFINITE;
+    memcpy(s->p_prev, s->p, sizeof(float) * s->ncoef);
+    memcpy(s->p, p_new, sizeof(float) * s->ncoef);
+    s->dt_prev_s = dt;
+    return ARGIL_OK;
+}
+
 argil_err_t solver_step_implicit(solver_t *s)
 {
     float *pp = s->w_nc[0], *rhs = s->w_nc[1], *x = s->w_nc[2], *r = s->w_nc[3], *q = s->w_nc[4],
@@ -723,12 +727,8 @@ argil_err_t solver_step_implicit(solver_t *s)
             s->stats.halvings++;
             continue;
         }
-        for (size_t i = 0; i < s->ncoef; i++)
-            if (!isfinite(x[i]))
-                return ARGIL_ERR_NONFINITE;
-        memcpy(s->p_prev, s->p, sizeof(float) * s->ncoef);
-        memcpy(s->p, x, sizeof(float) * s->ncoef);
-        s->dt_prev_s = dt;
+        if (solver_commit(s, x, dt) != ARGIL_OK)
+            return ARGIL_ERR_NONFINITE;
         s->stats.cg_iters = it;
         s->stats.residual = bnorm > 0.0 ? (float)(sqrt(rr) / bnorm) : 0.0f;
         s->stats.max_acc = acc;
@@ -780,12 +780,8 @@ argil_err_t solver_step_explicit(solver_t *s)
     for (size_t i = 0; i < s->ncoef; i++)
         pn[i] = s->p[i] + dt * (v[i] + dt * F[i]); /* semi-implicit Euler */
     solver_expand(s, pn, true);
-    for (size_t i = 0; i < s->ncoef; i++)
-        if (!isfinite(pn[i]))
-            return ARGIL_ERR_NONFINITE;
-    memcpy(s->p_prev, s->p, sizeof(float) * s->ncoef);
-    memcpy(s->p, pn, sizeof(float) * s->ncoef);
-    s->dt_prev_s = dt;
+    if (solver_commit(s, pn, dt) != ARGIL_OK)
+        return ARGIL_ERR_NONFINITE;
     s->stats.max_acc = amax;
     return ARGIL_OK;
 }

@@ -103,6 +103,31 @@ static bool sparse_box_ok(const sparse_t *s, int ch, const int32_t lo[3], const 
     return true;
 }
 
+/* The part [a0, a1) of block key that lies inside the box [lo, hi), per axis. */
+static void sparse_block_span(const int32_t key[3], const int32_t lo[3], const int32_t hi[3],
+                              int32_t a0[3], int32_t a1[3])
+{
+    for (int a = 0; a < 3; a++) {
+        a0[a] = key[a] * SPARSE_B > lo[a] ? key[a] * SPARSE_B : lo[a];
+        a1[a] = (key[a] + 1) * SPARSE_B < hi[a] ? (key[a] + 1) * SPARSE_B : hi[a];
+    }
+}
+
+/* Index of point (x, y, z) in a box of dims from lo, x fastest. */
+static size_t sparse_box_at(const int32_t lo[3], const int32_t dims[3], int32_t x, int32_t y,
+                            int32_t z)
+{
+    return (size_t)(x - lo[0]) +
+           (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
+}
+
+/* Index of point (x, y, z) of block key in its data, channel ch. */
+static size_t sparse_block_at(const int32_t key[3], int ch, int32_t x, int32_t y, int32_t z)
+{
+    return (size_t)(ch * SPARSE_BN + (x - key[0] * SPARSE_B) +
+                    SPARSE_B * ((y - key[1] * SPARSE_B) + SPARSE_B * (z - key[2] * SPARSE_B)));
+}
+
 void sparse_read_box(const sparse_t *s, int ch, const int32_t lo[3], const int32_t dims[3],
                      float *out)
 {
@@ -114,26 +139,42 @@ void sparse_read_box(const sparse_t *s, int ch, const int32_t lo[3], const int32
             for (int32_t bx = sparse_block_of(lo[0]); bx <= sparse_block_of(hi[0] - 1); bx++) {
                 const int32_t key[3] = {bx, by, bz};
                 const sparse_block_t *b = sparse_find(s, key);
-                const int32_t z0 = bz * SPARSE_B > lo[2] ? bz * SPARSE_B : lo[2];
-                const int32_t z1 = (bz + 1) * SPARSE_B < hi[2] ? (bz + 1) * SPARSE_B : hi[2];
-                const int32_t y0 = by * SPARSE_B > lo[1] ? by * SPARSE_B : lo[1];
-                const int32_t y1 = (by + 1) * SPARSE_B < hi[1] ? (by + 1) * SPARSE_B : hi[1];
-                const int32_t x0 = bx * SPARSE_B > lo[0] ? bx * SPARSE_B : lo[0];
-                const int32_t x1 = (bx + 1) * SPARSE_B < hi[0] ? (bx + 1) * SPARSE_B : hi[0];
-                for (int32_t z = z0; z < z1; z++)
-                    for (int32_t y = y0; y < y1; y++) {
-                        float *dst = out + (size_t)(x0 - lo[0]) +
-                                     (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
+                int32_t a0[3], a1[3];
+                sparse_block_span(key, lo, hi, a0, a1);
+                const size_t run = (size_t)(a1[0] - a0[0]);
+                for (int32_t z = a0[2]; z < a1[2]; z++)
+                    for (int32_t y = a0[1]; y < a1[1]; y++) {
+                        float *dst = out + sparse_box_at(lo, dims, a0[0], y, z);
                         if (b == NULL) {
-                            for (int32_t x = x0; x < x1; x++)
+                            for (size_t x = 0; x < run; x++)
                                 *dst++ = s->defaults[ch];
                         } else {
-                            const float *src = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
-                                               SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
-                            memcpy(dst, src, sizeof(float) * (size_t)(x1 - x0));
+                            memcpy(dst, b->data + sparse_block_at(key, ch, a0[0], y, z),
+                                   sizeof(float) * run);
                         }
                     }
             }
+}
+
+/* True when the part [a0, a1) of block b (absent: all defaults) differs bitwise from in. */
+static bool sparse_block_differs(const sparse_t *s, const sparse_block_t *b, int ch,
+                                 const int32_t key[3], const int32_t a0[3], const int32_t a1[3],
+                                 const int32_t lo[3], const int32_t dims[3], const float *in)
+{
+    const size_t run = (size_t)(a1[0] - a0[0]);
+    for (int32_t z = a0[2]; z < a1[2]; z++)
+        for (int32_t y = a0[1]; y < a1[1]; y++) {
+            const float *src = in + sparse_box_at(lo, dims, a0[0], y, z);
+            if (b == NULL) {
+                for (size_t x = 0; x < run; x++)
+                    if (memcmp(&src[x], &s->defaults[ch], sizeof(float)) != 0)
+                        return true;
+            } else if (memcmp(b->data + sparse_block_at(key, ch, a0[0], y, z), src,
+                              sizeof(float) * run) != 0) {
+                return true;
+            }
+        }
+    return false;
 }
 
 argil_err_t sparse_write_box(sparse_t *s, int ch, const int32_t lo[3], const int32_t dims[3],
@@ -147,28 +188,9 @@ argil_err_t sparse_write_box(sparse_t *s, int ch, const int32_t lo[3], const int
             for (int32_t bx = sparse_block_of(lo[0]); bx <= sparse_block_of(hi[0] - 1); bx++) {
                 const int32_t key[3] = {bx, by, bz};
                 sparse_block_t *b = sparse_find(s, key);
-                const int32_t z0 = bz * SPARSE_B > lo[2] ? bz * SPARSE_B : lo[2];
-                const int32_t z1 = (bz + 1) * SPARSE_B < hi[2] ? (bz + 1) * SPARSE_B : hi[2];
-                const int32_t y0 = by * SPARSE_B > lo[1] ? by * SPARSE_B : lo[1];
-                const int32_t y1 = (by + 1) * SPARSE_B < hi[1] ? (by + 1) * SPARSE_B : hi[1];
-                const int32_t x0 = bx * SPARSE_B > lo[0] ? bx * SPARSE_B : lo[0];
-                const int32_t x1 = (bx + 1) * SPARSE_B < hi[0] ? (bx + 1) * SPARSE_B : hi[0];
-                bool differs = false;
-                for (int32_t z = z0; z < z1 && !differs; z++)
-                    for (int32_t y = y0; y < y1 && !differs; y++) {
-                        const float *src = in + (size_t)(x0 - lo[0]) +
-                                           (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
-                        if (b == NULL) {
-                            for (int32_t x = x0; x < x1; x++)
-                                if (memcmp(&src[x - x0], &s->defaults[ch], sizeof(float)) != 0)
-                                    differs = true;
-                        } else {
-                            const float *dst = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
-                                               SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
-                            differs = memcmp(dst, src, sizeof(float) * (size_t)(x1 - x0)) != 0;
-                        }
-                    }
-                if (!differs)
+                int32_t a0[3], a1[3];
+                sparse_block_span(key, lo, hi, a0, a1);
+                if (!sparse_block_differs(s, b, ch, key, a0, a1, lo, dims, in))
                     continue;
                 if (b == NULL) {
                     argil_err_t e = sparse_touch(s, key, &b);
@@ -176,14 +198,11 @@ argil_err_t sparse_write_box(sparse_t *s, int ch, const int32_t lo[3], const int
                         return e;
                 }
                 b->dirty = true;
-                for (int32_t z = z0; z < z1; z++)
-                    for (int32_t y = y0; y < y1; y++) {
-                        const float *src = in + (size_t)(x0 - lo[0]) +
-                                           (size_t)dims[0] * ((size_t)(y - lo[1]) + (size_t)dims[1] * (size_t)(z - lo[2]));
-                        float *dst = b->data + ch * SPARSE_BN + (x0 - bx * SPARSE_B) +
-                                     SPARSE_B * ((y - by * SPARSE_B) + SPARSE_B * (z - bz * SPARSE_B));
-                        memcpy(dst, src, sizeof(float) * (size_t)(x1 - x0));
-                    }
+                for (int32_t z = a0[2]; z < a1[2]; z++)
+                    for (int32_t y = a0[1]; y < a1[1]; y++)
+                        memcpy(b->data + sparse_block_at(key, ch, a0[0], y, z),
+                               in + sparse_box_at(lo, dims, a0[0], y, z),
+                               sizeof(float) * (size_t)(a1[0] - a0[0]));
             }
     return ARGIL_OK;
 }

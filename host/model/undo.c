@@ -3,6 +3,8 @@
  * note themselves are snapshotted and diffed. */
 #include "host/model/undo.h"
 
+#include "host/model/f32_buf.h"
+
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -273,13 +275,8 @@ argil_err_t undo_begin(undo_t *u, const field_t *f, const int32_t clo[3], const 
         return ARGIL_ERR_ARG;
     const size_t nc = undo_box(clo, chi, u->cdims), ns = undo_box(slo, shi, u->sdims);
     const size_t need = nc * (size_t)undo_popcount(cmask) + ns * (size_t)undo_popcount(smask);
-    if (need > u->snap_cap) {
-        float *p = realloc(u->snap, need * sizeof(float));
-        if (p == NULL)
-            return ARGIL_ERR_NOMEM;
-        u->snap = p;
-        u->snap_cap = need;
-    }
+    if (!f32_buf_reserve(&u->snap, &u->snap_cap, need))
+        return ARGIL_ERR_NOMEM;
     memcpy(u->clo, clo, sizeof(u->clo));
     memcpy(u->slo, slo, sizeof(u->slo));
     u->cmask = cmask;

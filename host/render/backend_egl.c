@@ -42,19 +42,12 @@ static argil_err_t fail(egl_offscreen_t *e, const char *what, char *err, size_t 
 argil_err_t egl_offscreen_open(egl_offscreen_t *e, gl_api_t *gl, char *err, size_t err_len)
 {
     memset(e, 0, sizeof(*e));
-    e->lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
-    if (e->lib == NULL) {
-        snprintf(err, err_len, "offscreen OpenGL: cannot load libEGL.so.1 (install libegl1 and "
-                               "libegl-mesa0: toolchain/install-deps.sh render)");
-        return ARGIL_ERR_STATE;
-    }
-    egl_fns_t *f = calloc(1, sizeof(*f));
-    if (f == NULL) {
-        egl_offscreen_close(e);
-        snprintf(err, err_len, "offscreen OpenGL: out of memory");
-        return ARGIL_ERR_NOMEM;
-    }
-    e->fns = f;
+    const argil_err_t st = gl_lib_open("libEGL.so.1", "offscreen OpenGL",
+                                       "libegl1 and libegl-mesa0", sizeof(egl_fns_t), &e->lib,
+                                       &e->fns, err, err_len);
+    if (st != ARGIL_OK)
+        return st;
+    egl_fns_t *f = e->fns;
     void *gpa = dlsym(e->lib, "eglGetProcAddress");
     if (gpa == NULL)
         return fail(e, "libEGL has no eglGetProcAddress", err, err_len);

@@ -86,19 +86,11 @@ argil_err_t glfw_window_open(glfw_window_t *w, int width, int height, bool visib
         snprintf(err, err_len, "OpenGL window (GLFW): a window is already open");
         return ARGIL_ERR_STATE;
     }
-    w->lib = dlopen("libglfw.so.3", RTLD_NOW | RTLD_LOCAL);
-    if (w->lib == NULL) {
-        snprintf(err, err_len, "OpenGL window: cannot load libglfw.so.3 (install libglfw3: "
-                               "toolchain/install-deps.sh render)");
-        return ARGIL_ERR_STATE;
-    }
-    glfw_fns_t *f = calloc(1, sizeof(*f));
-    if (f == NULL) {
-        glfw_window_close(w);
-        snprintf(err, err_len, "OpenGL window: out of memory");
-        return ARGIL_ERR_NOMEM;
-    }
-    w->fns = f;
+    const argil_err_t st = gl_lib_open("libglfw.so.3", "OpenGL window", "libglfw3",
+                                       sizeof(glfw_fns_t), &w->lib, &w->fns, err, err_len);
+    if (st != ARGIL_OK)
+        return st;
+    glfw_fns_t *f = w->fns;
 #define GLFW_LOAD(name)                                                                          \
     {                                                                                            \
         void *p = dlsym(w->lib, #name);                                                          \

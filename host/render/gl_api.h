@@ -86,4 +86,11 @@ typedef gl_proc_t (*gl_get_proc_fn)(const char *name, void *ctx);
 argil_err_t gl_api_load(gl_api_t *gl, gl_get_proc_fn get_proc, void *ctx, char *err,
                         size_t err_len);
 
+/* Loads the shared library soname into *lib and a zeroed table of fns_bytes (for its entry
+ * points) into *fns, both left as they were on failure: ARGIL_ERR_STATE when the library is
+ * missing (err: "what: cannot load soname (install packages: ...)"), ARGIL_ERR_NOMEM. The
+ * library stays loaded for the process: GL drivers run exit handlers from it. */
+argil_err_t gl_lib_open(const char *soname, const char *what, const char *packages,
+                        size_t fns_bytes, void **lib, void **fns, char *err, size_t err_len);
+
 #endif

@@ -46,6 +46,39 @@ static size_t put_quad(float *v, size_t n, const float *q)
     return n + 1;
 }
 
+/* Readies the HUD's program and buffers over a width x height viewport, depth testing off;
+ * returns the location of its colour uniform. */
+static GLint hud_begin(const hud_t *h, int width, int height)
+{
+    const gl_api_t *gl = h->gl;
+    gl->Viewport(0, 0, width, height);
+    gl->Disable(GL_DEPTH_TEST);
+    gl->UseProgram(h->prog);
+    const float vp[3] = {(float)width, (float)height, 0.0f};
+    gl->Uniform3fv(gl->GetUniformLocation(h->prog, "u_viewport"), 1, vp);
+    gl->BindVertexArray(h->vao);
+    gl->BindBuffer(GL_ARRAY_BUFFER, h->vbo);
+    return gl->GetUniformLocation(h->prog, "u_color");
+}
+
+/* Fills the pixel rectangle q (x0, y0, x1, y1) with colour rgba (after hud_begin). */
+static void hud_quad(const gl_api_t *gl, GLint color, const float q[4], const float rgba[4])
+{
+    float v[12];
+    put_quad(v, 0, q);
+    gl->Uniform4fv(color, 1, rgba);
+    gl->BufferData(GL_ARRAY_BUFFER, sizeof(v), v, GL_STREAM_DRAW);
+    gl->DrawArrays(GL_TRIANGLES, 0, 6);
+}
+
+/* Unbinds what hud_begin bound and turns depth testing back on. */
+static void hud_end(const gl_api_t *gl)
+{
+    gl->BindVertexArray(0);
+    gl->UseProgram(0);
+    gl->Enable(GL_DEPTH_TEST);
+}
+
 void hud_draw(hud_t *h, const char *text, float scale, int width, int height)
 {
     const gl_api_t *gl = h->gl;
@@ -72,32 +105,19 @@ void hud_draw(hud_t *h, const char *text, float scale, int width, int height)
     const float band[4] = {0.0f, 0.0f, (float)width,
                            2.0f * pad + (float)lines * (HUD_GLYPH_H + 3) * scale - 3.0f * scale};
 
-    gl->Viewport(0, 0, width, height);
-    gl->Disable(GL_DEPTH_TEST);
+    const GLint color = hud_begin(h, width, height);
     gl->Enable(GL_BLEND);
     gl->BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    gl->UseProgram(h->prog);
-    const float vp[3] = {(float)width, (float)height, 0.0f};
-    gl->Uniform3fv(gl->GetUniformLocation(h->prog, "u_viewport"), 1, vp);
-    gl->BindVertexArray(h->vao);
-    gl->BindBuffer(GL_ARRAY_BUFFER, h->vbo);
-    const GLint color = gl->GetUniformLocation(h->prog, "u_color");
     /* The band first, then the text on it. */
-    float bandv[12];
-    put_quad(bandv, 0, band);
     const float dark[4] = {0.0f, 0.0f, 0.0f, 0.55f};
-    gl->Uniform4fv(color, 1, dark);
-    gl->BufferData(GL_ARRAY_BUFFER, sizeof(bandv), bandv, GL_STREAM_DRAW);
-    gl->DrawArrays(GL_TRIANGLES, 0, 6);
+    hud_quad(gl, color, band, dark);
     const float ink[4] = {1.0f, 0.93f, 0.55f, 1.0f};
     gl->Uniform4fv(color, 1, ink);
     gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 12 * sizeof(float)), h->verts,
                    GL_STREAM_DRAW);
     gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(nv * 6));
-    gl->BindVertexArray(0);
-    gl->UseProgram(0);
+    hud_end(gl);
     gl->Disable(GL_BLEND);
-    gl->Enable(GL_DEPTH_TEST);
 }
 
 float hud_band_height(const char *text, float scale)
@@ -114,29 +134,16 @@ void hud_draw_ramp(hud_t *h, void (*ramp)(float t, uint8_t rgb[3]), int n_steps,
     const gl_api_t *gl = h->gl;
     if (n_steps < 2)
         return;
-    gl->Viewport(0, 0, width, height);
-    gl->Disable(GL_DEPTH_TEST);
-    gl->UseProgram(h->prog);
-    const float vp[3] = {(float)width, (float)height, 0.0f};
-    gl->Uniform3fv(gl->GetUniformLocation(h->prog, "u_viewport"), 1, vp);
-    gl->BindVertexArray(h->vao);
-    gl->BindBuffer(GL_ARRAY_BUFFER, h->vbo);
-    const GLint color = gl->GetUniformLocation(h->prog, "u_color");
+    const GLint color = hud_begin(h, width, height);
     const float step = bar_w / (float)n_steps;
     for (int i = 0; i < n_steps; i++) {
         uint8_t rgb[3];
         ramp((float)i / (float)(n_steps - 1), rgb);
         const float c[4] = {rgb[0] / 255.0f, rgb[1] / 255.0f, rgb[2] / 255.0f, 1.0f};
         const float q[4] = {x + step * (float)i, y, x + step * (float)(i + 1), y + bar_h};
-        float v[12];
-        put_quad(v, 0, q);
-        gl->Uniform4fv(color, 1, c);
-        gl->BufferData(GL_ARRAY_BUFFER, sizeof(v), v, GL_STREAM_DRAW);
-        gl->DrawArrays(GL_TRIANGLES, 0, 6);
+        hud_quad(gl, color, q, c);
     }
-    gl->BindVertexArray(0);
-    gl->UseProgram(0);
-    gl->Enable(GL_DEPTH_TEST);
+    hud_end(gl);
 }
 
 void hud_free(hud_t *h)

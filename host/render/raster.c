@@ -83,18 +83,37 @@ int canvas_text_width(const char *text, int scale)
     return n > 0 ? (n * FONT_ADVANCE - 1) * scale : 0;
 }
 
+/* Draws character ch at scale device pixels per font pixel: its top-left font pixel at (x, y),
+ * or, when up, turned a quarter left (font pixel (column b, row r) lands at (x + r, y − b)). */
+static void canvas_glyph(canvas_t *c, int x, int y, char ch, int scale, bool up, rgb8_t col)
+{
+    uint8_t rows[FONT_H];
+    (void)hud_font_glyph(ch, rows); /* a box for a character the font lacks */
+    for (int r = 0; r < FONT_H; r++)
+        for (int b = 0; b < FONT_W; b++) {
+            if (!(rows[r] & (0x10 >> b)))
+                continue;
+            if (up)
+                canvas_fill_rect(c, x + r * scale, y - (b + 1) * scale + 1, x + (r + 1) * scale - 1,
+                                 y - b * scale, col);
+            else
+                canvas_fill_rect(c, x + b * scale, y + r * scale, x + (b + 1) * scale - 1,
+                                 y + (r + 1) * scale - 1, col);
+        }
+}
+
+/* The text scale clamped to 1..8 device pixels per font pixel. */
+static int text_scale(int scale)
+{
+    return scale < 1 ? 1 : (scale > 8 ? 8 : scale);
+}
+
 int canvas_text(canvas_t *c, int x, int y, const char *text, int scale, rgb8_t col)
 {
-    scale = scale < 1 ? 1 : (scale > 8 ? 8 : scale);
+    scale = text_scale(scale);
     int pen = x;
     for (const char *p = text; *p; p++) {
-        uint8_t rows[FONT_H];
-        (void)hud_font_glyph(*p, rows); /* a box for a character the font lacks */
-        for (int r = 0; r < FONT_H; r++)
-            for (int b = 0; b < FONT_W; b++)
-                if (rows[r] & (0x10 >> b))
-                    canvas_fill_rect(c, pen + b * scale, y + r * scale, pen + (b + 1) * scale - 1,
-                                     y + (r + 1) * scale - 1, col);
+        canvas_glyph(c, pen, y, *p, scale, false, col);
         pen += FONT_ADVANCE * scale;
     }
     return pen - x;
@@ -102,17 +121,10 @@ int canvas_text(canvas_t *c, int x, int y, const char *text, int scale, rgb8_t c
 
 void canvas_text_up(canvas_t *c, int x, int y, const char *text, int scale, rgb8_t col)
 {
-    scale = scale < 1 ? 1 : (scale > 8 ? 8 : scale);
+    scale = text_scale(scale);
     int pen = y;
     for (const char *p = text; *p; p++) {
-        uint8_t rows[FONT_H];
-        (void)hud_font_glyph(*p, rows); /* a box for a character the font lacks */
-        /* Font pixel (column b, row r) lands at (x + r, pen − b): turned a quarter left. */
-        for (int r = 0; r < FONT_H; r++)
-            for (int b = 0; b < FONT_W; b++)
-                if (rows[r] & (0x10 >> b))
-                    canvas_fill_rect(c, x + r * scale, pen - (b + 1) * scale + 1,
-                                     x + (r + 1) * scale - 1, pen - b * scale, col);
+        canvas_glyph(c, x, pen, *p, scale, true, col);
         pen -= FONT_ADVANCE * scale;
     }
 }

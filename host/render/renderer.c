@@ -107,6 +107,17 @@ void render_scene_default(render_scene_t *s)
     s->wire_rgb = vec3(0.90f, 0.40f, 1.0f);
 }
 
+/* Writes "what: " and the first line of object obj's info log into err (get reads a shader's
+ * or a program's log). */
+static void say_log(PFNGLGETSHADERINFOLOGPROC get, GLuint obj, const char *what, char *err,
+                    size_t err_len)
+{
+    char log[512] = "";
+    get(obj, sizeof(log), NULL, log);
+    log[strcspn(log, "\n")] = '\0';
+    snprintf(err, err_len, "%s: %s", what, log);
+}
+
 /* Compiles one stage; 0 with the log's first line in err on failure. */
 static unsigned compile(const gl_api_t *gl, GLenum type, const char *src, char *err,
                         size_t err_len)
@@ -117,11 +128,10 @@ static unsigned compile(const gl_api_t *gl, GLenum type, const char *src, char *
     GLint ok = 0;
     gl->GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-        char log[512] = "";
-        gl->GetShaderInfoLog(sh, sizeof(log), NULL, log);
-        log[strcspn(log, "\n")] = '\0';
-        snprintf(err, err_len, "%s shader does not compile: %s",
-                 type == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+        say_log(gl->GetShaderInfoLog, sh,
+                type == GL_VERTEX_SHADER ? "vertex shader does not compile"
+                                         : "fragment shader does not compile",
+                err, err_len);
         gl->DeleteShader(sh);
         return 0;
     }
@@ -148,23 +158,21 @@ static unsigned link_program(const gl_api_t *gl, const char *vs_src, const char 
     GLint ok = 0;
     gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
     if (!ok) {
-        char log[512] = "";
-        gl->GetProgramInfoLog(p, sizeof(log), NULL, log);
-        log[strcspn(log, "\n")] = '\0';
-        snprintf(err, err_len, "shaders do not link: %s", log);
+        say_log(gl->GetProgramInfoLog, p, "shaders do not link", err, err_len);
         gl->DeleteProgram(p);
         return 0;
     }
     return p;
 }
 
-/* A unit UV sphere whose positions are also its normals. */
+/* The linked program of vs_src and fs_src; 0 with the reason in err. */
 unsigned renderer_program(const gl_api_t *gl, const char *vs_src, const char *fs_src,
                           char *err, size_t err_len)
 {
     return link_program(gl, vs_src, fs_src, err, err_len);
 }
 
+/* A unit UV sphere whose positions are also its normals. */
 static argil_err_t make_sphere(renderer_t *r)
 {
     const gl_api_t *gl = r->gl;
@@ -262,24 +270,48 @@ argil_err_t renderer_init(renderer_t *r, const gl_api_t *gl, char *err, size_t e
     return ARGIL_OK;
 }
 
+/* Loads n_vert 3-float vectors into buffer vbo and feeds them to attribute attr of the bound
+ * vertex array. */
+static void upload_vec3(const gl_api_t *gl, unsigned vbo, unsigned attr, size_t n_vert,
+                        const float *v)
+{
+    gl->BindBuffer(GL_ARRAY_BUFFER, vbo);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * n_vert), v, GL_STATIC_DRAW);
+    gl->VertexAttribPointer(attr, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    gl->EnableVertexAttribArray(attr);
+}
+
+/* Loads m's triangles into index buffer ibo of the bound vertex array, unbinds the array and
+ * returns the index count. */
+static size_t upload_tris(const gl_api_t *gl, unsigned ibo, const mesh_t *m)
+{
+    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
+                   GL_STATIC_DRAW);
+    gl->BindVertexArray(0);
+    return 3 * m->n_tri;
+}
+
+/* Binds vertex array vao and loads m's positions into vbo_pos; false, with nothing bound, when
+ * m lacks an array it needs (normals too when with_normals) or has more indices than GL counts. */
+static bool upload_begin(const gl_api_t *gl, const mesh_t *m, bool with_normals, unsigned vao,
+                         unsigned vbo_pos)
+{
+    if (m->n_tri > 0 && (m->pos == NULL || (with_normals && m->normal == NULL) || m->tri == NULL))
+        return false;
+    if (m->n_tri > (size_t)INT32_MAX / 3)
+        return false;
+    gl->BindVertexArray(vao);
+    upload_vec3(gl, vbo_pos, ATTR_POS, m->n_vert, m->pos);
+    return true;
+}
+
 argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (m->n_tri > 0 && (m->pos == NULL || m->normal == NULL || m->tri == NULL))
+    if (!upload_begin(gl, m, true, r->vao_mesh, r->vbo_pos))
         return ARGIL_ERR_ARG;
-    if (m->n_tri > (size_t)INT32_MAX / 3)
-        return ARGIL_ERR_ARG;
-    gl->BindVertexArray(r->vao_mesh);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_pos);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->pos,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_POS, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_POS);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_nrm);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->normal,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_NORMAL, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_NORMAL);
+    upload_vec3(gl, r->vbo_nrm, ATTR_NORMAL, m->n_vert, m->normal);
     r->mesh_has_rgb = m->has_rgb && m->rgb != NULL;
     if (r->mesh_has_rgb) {
         gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_rgb);
@@ -289,32 +321,16 @@ argil_err_t renderer_set_mesh(renderer_t *r, const mesh_t *m)
     } else {
         gl->DisableVertexAttribArray(ATTR_RGB);
     }
-    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_mesh);
-    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
-                   GL_STATIC_DRAW);
-    gl->BindVertexArray(0);
-    r->mesh_index_count = 3 * m->n_tri;
+    r->mesh_index_count = upload_tris(gl, r->ibo_mesh, m);
     return gl->GetError() == GL_NO_ERROR ? ARGIL_OK : ARGIL_ERR_NOMEM;
 }
 
 argil_err_t renderer_set_wire_mesh(renderer_t *r, const mesh_t *m)
 {
     const gl_api_t *gl = r->gl;
-    if (m->n_tri > 0 && (m->pos == NULL || m->tri == NULL))
+    if (!upload_begin(gl, m, false, r->vao_wire, r->vbo_wire))
         return ARGIL_ERR_ARG;
-    if (m->n_tri > (size_t)INT32_MAX / 3)
-        return ARGIL_ERR_ARG;
-    gl->BindVertexArray(r->vao_wire);
-    gl->BindBuffer(GL_ARRAY_BUFFER, r->vbo_wire);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * m->n_vert), m->pos,
-                   GL_STATIC_DRAW);
-    gl->VertexAttribPointer(ATTR_POS, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    gl->EnableVertexAttribArray(ATTR_POS);
-    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_wire);
-    gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * 3 * m->n_tri), m->tri,
-                   GL_STATIC_DRAW);
-    gl->BindVertexArray(0);
-    r->wire_index_count = 3 * m->n_tri;
+    r->wire_index_count = upload_tris(gl, r->ibo_wire, m);
     return gl->GetError() == GL_NO_ERROR ? ARGIL_OK : ARGIL_ERR_NOMEM;
 }
 
