@@ -76,7 +76,7 @@ static void progress_cb(void *ctx, double frac)
         p->last_pct = pct;
 }
 
-/* Starts the progress of a new stage (its name on the bar or lines). */
+/* Starts the progress of the next stage (its name on the bar or lines). */
 static void progress_stage(progress_t *p, const char *stage)
 {
     if (p->tty && p->stage != NULL)

@@ -27,7 +27,7 @@ static void usage_keygen(FILE *f)
             "exit status: 0 written; 1 FILE exists or cannot be written; 2 a usage error.\n");
 }
 
-/* argil keygen FILE: writes a new link key into FILE, which must not exist yet. */
+/* argil keygen FILE: writes a random link key into FILE, which must not exist yet. */
 argil_err_t cmd_keygen(int argc, char **argv, int *exit_status)
 {
     if (argc == 1 && (strcmp(argv[0], "--help") == 0 || strcmp(argv[0], "-h") == 0)) {
