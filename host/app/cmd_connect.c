@@ -52,6 +52,7 @@
 
 static volatile sig_atomic_t g_connect_stop;
 
+/* Ctrl-C or SIGTERM: the solver loop ends the session at its next step. */
 static void on_stop_signal(int sig)
 {
     (void)sig;
@@ -114,6 +115,7 @@ typedef struct {
     uint32_t undo_solves;           /* peer solves seen by the undo */
 } conn_solver_t;
 
+/* The monotonic clock, microseconds. */
 static uint64_t mono_us(void)
 {
     struct timespec ts;
@@ -183,6 +185,8 @@ static uint32_t board_refusals(const peer_t *p)
            l->bad_mac + l->bad_nonce;
 }
 
+/* A telemetry frame from the board: counts restarts and ACTIVE entries, times the window
+ * round trip and writes the CSV row. */
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
 {
     conn_solver_t *s = ctx;
@@ -220,6 +224,7 @@ static void on_telemetry(void *ctx, const msg_telemetry_t *t)
     s->csv_rows++;
 }
 
+/* The once-a-second status line on stderr (redrawn in place on a terminal). */
 static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t rx_per_s,
                         uint32_t tx_per_s)
 {
@@ -379,6 +384,7 @@ static void host_tool_names(char which, size_t wrap, char *out, size_t cap)
     }
 }
 
+/* The text of `argil connect --help`. */
 static void usage_connect(FILE *f)
 {
     char actions[256], strengths[256], shapes[128];

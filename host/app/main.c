@@ -33,6 +33,7 @@ static void usage_main(FILE *f)
     fprintf(f, "  %-9s %s\n", "help", "show this text");
 }
 
+/* Runs the command argv[1] names; the process ends with the exit status it set. */
 int main(int argc, char **argv)
 {
     if (argc < 2) {
