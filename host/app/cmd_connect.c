@@ -9,6 +9,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +52,7 @@
 
 static volatile sig_atomic_t g_connect_stop;
 
+/* Ctrl-C or SIGTERM: the solver loop ends the session at its next step. */
 static void on_stop_signal(int sig)
 {
     (void)sig;
@@ -113,6 +115,7 @@ typedef struct {
     uint32_t undo_solves;           /* peer solves seen by the undo */
 } conn_solver_t;
 
+/* The monotonic clock, microseconds. */
 static uint64_t mono_us(void)
 {
     struct timespec ts;
@@ -182,6 +185,8 @@ static uint32_t board_refusals(const peer_t *p)
            l->bad_mac + l->bad_nonce;
 }
 
+/* A telemetry frame from the board: counts restarts and ACTIVE entries, times the window
+ * round trip and writes the CSV row. */
 static void on_telemetry(void *ctx, const msg_telemetry_t *t)
 {
     conn_solver_t *s = ctx;
@@ -219,6 +224,7 @@ static void on_telemetry(void *ctx, const msg_telemetry_t *t)
     s->csv_rows++;
 }
 
+/* The once-a-second status line on stderr (redrawn in place on a terminal). */
 static void status_line(conn_solver_t *s, bool tty, double elapsed_s, uint32_t rx_per_s,
                         uint32_t tx_per_s)
 {
@@ -305,9 +311,10 @@ static void undo_commands(conn_solver_t *s, bool tty)
 
 /* ---- files ---- */
 
-static int make_dir(const char *path)
+/* Creates the directory path unless it exists (ARGIL_ERR_IO, errno set, when it cannot). */
+static argil_err_t make_dir(const char *path)
 {
-    return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
+    return mkdir(path, 0777) == 0 || errno == EEXIST ? ARGIL_OK : ARGIL_ERR_IO;
 }
 
 /* Writes DIR/final.ply and DIR/model.argil (edits: the journal's edit count) from the clay, as
@@ -377,6 +384,7 @@ static void host_tool_names(char which, size_t wrap, char *out, size_t cap)
     }
 }
 
+/* The text of `argil connect --help`. */
 static void usage_connect(FILE *f)
 {
     char actions[256], strengths[256], shapes[128];
@@ -478,8 +486,8 @@ typedef struct {
 } connect_opts_t;
 
 /* The host-model settings after the options: strength against the action, the B-spline model
- * for knots and host tools. Returns -1 to go on, else the exit status (one line said why). */
-static int check_model_opts(connect_opts_t *o, bool solve_given, bool strength_given,
+ * for knots and host tools; ARGIL_ERR_ARG when they do not fit together (one line said why). */
+static argil_err_t check_model_opts(connect_opts_t *o, bool solve_given, bool strength_given,
                             const char *host_opt)
 {
     host_tool_t *t = &o->host_tool;
@@ -488,7 +496,7 @@ static int check_model_opts(connect_opts_t *o, bool solve_given, bool strength_g
         host_tool_names('s', 0, list, sizeof(list));
         fprintf(stderr, "argil connect: --strength: action '%s' takes none (only %s do)\n",
                 host_action_name(t->action), list);
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     if (!strength_given)
         t->strength = host_action_default_strength(t->action);
@@ -497,11 +505,11 @@ static int check_model_opts(connect_opts_t *o, bool solve_given, bool strength_g
         if (solve_given) {
             fprintf(stderr, "argil connect: %s needs the B-spline model (--global-solve "
                             "bspline), not springs\n", needs);
-            return 2;
+            return ARGIL_ERR_ARG;
         }
         o->global_solve = PEER_SOLVE_BSPLINE;
     }
-    return -1;
+    return ARGIL_OK;
 }
 
 /* Which host-model options parse_opts met, for check_model_opts to judge together. */
@@ -510,31 +518,20 @@ typedef struct {
     const char *host_opt;           /* the first of --action, --shape, --mirror given */
 } model_opts_seen_t;
 
-/* Takes a host-model option a (--global-solve, --knot-ratio, --strength, --action, --shape,
- * --mirror) with its value v (NULL: none left): 0 when it took v, 2 when v is bad (one line
- * said why), -1 when a is none of them. */
-static int take_model_opt(const char *a, const char *v, connect_opts_t *o,
-                          model_opts_seen_t *seen)
+/* Takes the host-model option argv[*i] (--strength, --action, --shape, --mirror), moving *i
+ * past its value. */
+static cli_opt_t take_model_opt(connect_opts_t *o, model_opts_seen_t *seen, int argc,
+                                char **argv, int *i)
 {
-    if (strcmp(a, "--global-solve") == 0) {
-        if (!cli_global_solve(v, &o->global_solve)) {
-            fprintf(stderr, "argil connect: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS
-                            "\n");
-            return 2;
-        }
-        seen->solve_given = true;
-    } else if (strcmp(a, "--knot-ratio") == 0) {
-        if (!cli_knot_ratio(v, &o->knot_ratio)) {
-            fprintf(stderr, "argil connect: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
-            return 2;
-        }
-    } else if (strcmp(a, "--strength") == 0) {
+    const char *a = argv[*i];
+    const char *v = *i + 1 < argc ? argv[*i + 1] : NULL;
+    if (strcmp(a, "--strength") == 0) {
         char *end = NULL;
         const double x = v ? strtod(v, &end) : 0.0;
         if (!v || end == v || *end != '\0' || !(x >= 0.0 && x <= HOST_STRENGTH_MAX)) {
             fprintf(stderr, "argil connect: --strength needs a number 0..%g (per second "
                             "held)\n", (double)HOST_STRENGTH_MAX);
-            return 2;
+            return CLI_OPT_BAD;
         }
         o->host_tool.strength = (float)x;
         seen->strength_given = true;
@@ -550,7 +547,7 @@ static int take_model_opt(const char *a, const char *v, connect_opts_t *o,
             fprintf(stderr, "argil connect: %s needs %s, got '%s'\n", a,
                     a[2] == 'm' ? "none, or the axes x, y, z (e.g. xz)" : list,
                     v ? v : "nothing");
-            return 2;
+            return CLI_OPT_BAD;
         }
         if (a[2] == 'a')
             o->host_tool.action = (host_action_t)k;
@@ -562,110 +559,103 @@ static int take_model_opt(const char *a, const char *v, connect_opts_t *o,
         if (!seen->host_opt)
             seen->host_opt = a;
     } else {
-        return -1;
+        return CLI_OPT_OTHER;
     }
-    return 0;
+    (*i)++;
+    return CLI_OPT_TAKEN;
 }
 
-/* Parses the options; returns -1 to go on, else the exit status. */
-static int parse_opts(int argc, char **argv, connect_opts_t *o)
+/* What parse_opts's option reader works on: the options and what it met. */
+typedef struct {
+    connect_opts_t o;
+    model_opts_seen_t seen;
+} connect_parse_t;
+
+/* The options of argil connect that are not flags or plain words: the session's, the host
+ * model's and --seconds. */
+static cli_opt_t take_connect_opt(void *opts, int argc, char **argv, int *i)
 {
-    memset(o, 0, sizeof(*o));
-    o->device = "usb";
-    o->out_dir = "out";
-    o->global_solve = PEER_SOLVE_SPRINGS; /* connect's default (peer_cfg_default) */
-    o->knot_ratio = 1;
-    host_tool_default(&o->host_tool);
-    o->journal = true;
-    o->autosave_s = 1.0f;
-    o->undo_mb = SESSION_UNDO_MB_DEFAULT;
-    model_opts_seen_t seen = {false, false, NULL};
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        const int model_opt = take_model_opt(a, v, o, &seen);
-        if (model_opt == 0) {
-            i++;
-        } else if (model_opt > 0) {
-            return model_opt;
-        } else if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage_connect(stdout);
-            return 0;
-        } else if (strcmp(a, "--arm") == 0) {
-            o->arm = true;
-        } else if (strcmp(a, "--quiet") == 0) {
-            o->quiet = true;
-        } else if (strcmp(a, "--no-journal") == 0) {
-            o->journal = false;
-        } else if (strcmp(a, "--discard-journal") == 0) {
-            o->discard_journal = true;
-        } else if (strcmp(a, "--undo-mb") == 0) {
-            char *end = NULL;
-            const long mb = v ? strtol(v, &end, 10) : -1;
-            if (!v || v[0] == '\0' || *end != '\0' || mb < 0 || mb > (long)SESSION_UNDO_MB_MAX) {
-                fprintf(stderr, "argil connect: --undo-mb needs MiB 0..%u (0: no undo)\n",
-                        SESSION_UNDO_MB_MAX);
-                return 2;
-            }
-            i++;
-            o->undo_mb = (uint32_t)mb;
-        } else if (strcmp(a, "--autosave-s") == 0) {
-            if (!cli_autosave_s(v, &o->autosave_s)) {
-                fprintf(stderr, "argil connect: --autosave-s needs " CLI_AUTOSAVE_EXPECTS
-                                " (see --help)\n");
-                return 2;
-            }
-            i++;
-        } else if (strcmp(a, "--device") == 0 || strcmp(a, "--seconds") == 0 ||
-                   strcmp(a, "--telemetry") == 0 || strcmp(a, "--out") == 0 ||
-                   strcmp(a, "--key") == 0) {
-            if (!v) {
-                fprintf(stderr, "argil connect: %s needs a value (see --help)\n", a);
-                return 2;
-            }
-            i++;
-            if (strcmp(a, "--device") == 0) {
-                o->device = v;
-            } else if (strcmp(a, "--key") == 0) {
-                o->key_file = v;
-            } else if (strcmp(a, "--telemetry") == 0) {
-                o->telemetry = v;
-            } else if (strcmp(a, "--out") == 0) {
-                o->out_dir = v;
-            } else {
-                char *end;
-                errno = 0;
-                const double s = strtod(v, &end);
-                if (errno || end == v || *end != '\0' || !(s > 0.0) || s > 1e7) {
-                    fprintf(stderr, "argil connect: --seconds must be a number > 0, got '%s'\n",
-                            v);
-                    return 2;
-                }
-                o->seconds = s;
-            }
-        } else {
-            fprintf(stderr, "argil connect: unknown option '%s' (see --help)\n", a);
-            return 2;
-        }
+    connect_parse_t *cp = opts;
+    connect_opts_t *o = &cp->o;
+    const cli_session_t shared = {&o->global_solve, &cp->seen.solve_given, &o->knot_ratio, NULL,
+                                  &o->autosave_s, NULL, &o->undo_mb};
+    cli_opt_t r = cli_session_option("connect", &shared, argc, argv, i);
+    if (r == CLI_OPT_OTHER)
+        r = take_model_opt(o, &cp->seen, argc, argv, i);
+    if (r != CLI_OPT_OTHER || strcmp(argv[*i], "--seconds") != 0)
+        return r;
+    const char *v = cli_value("connect", "a value", argc, argv, i);
+    if (!v)
+        return CLI_OPT_BAD;
+    char *end;
+    errno = 0;
+    const double sec = strtod(v, &end);
+    if (errno || end == v || *end != '\0' || !(sec > 0.0) || sec > 1e7) {
+        fprintf(stderr, "argil connect: --seconds must be a number > 0, got '%s'\n", v);
+        return CLI_OPT_BAD;
     }
-    const int st = check_model_opts(o, seen.solve_given, seen.strength_given, seen.host_opt);
-    if (st >= 0)
-        return st;
+    o->seconds = sec;
+    return CLI_OPT_TAKEN;
+}
+
+/* argil connect's command line (cli_parse). */
+static const cli_flag_t CONNECT_FLAGS[] = {
+    {"--arm", offsetof(connect_parse_t, o.arm), true},
+    {"--quiet", offsetof(connect_parse_t, o.quiet), true},
+    {"--no-journal", offsetof(connect_parse_t, o.journal), false},
+    {"--discard-journal", offsetof(connect_parse_t, o.discard_journal), true},
+};
+static const cli_word_t CONNECT_WORDS[] = {
+    {"--device", offsetof(connect_parse_t, o.device)},
+    {"--key", offsetof(connect_parse_t, o.key_file)},
+    {"--telemetry", offsetof(connect_parse_t, o.telemetry)},
+    {"--out", offsetof(connect_parse_t, o.out_dir)},
+};
+static const cli_cmd_t CONNECT_CLI = {
+    .name = "connect", .usage = usage_connect, .option = take_connect_opt,
+    .flags = CONNECT_FLAGS, .n_flags = 4, .words = CONNECT_WORDS, .n_words = 4,
+};
+
+/* Parses the options into *o. Sets *done after --help (the usage printed, exit status 0) and
+ * after a bad option, device string or pairing of them (one line said why, exit status 2). */
+static argil_err_t parse_opts(int argc, char **argv, connect_opts_t *o, bool *done,
+                              int *exit_status)
+{
+    connect_parse_t cp = {.seen = {false, false, NULL}};
+    cp.o.device = "usb";
+    cp.o.out_dir = "out";
+    cp.o.global_solve = PEER_SOLVE_SPRINGS; /* connect's default (peer_cfg_default) */
+    cp.o.knot_ratio = 1;
+    host_tool_default(&cp.o.host_tool);
+    cp.o.journal = true;
+    cp.o.autosave_s = 1.0f;
+    cp.o.undo_mb = SESSION_UNDO_MB_DEFAULT;
+    argil_err_t e = cli_parse(&CONNECT_CLI, &cp, argc, argv, done, exit_status);
+    *o = cp.o;
+    if (*done)
+        return e;
+    *done = true;
+    *exit_status = 2;
+    e = check_model_opts(o, cp.seen.solve_given, cp.seen.strength_given, cp.seen.host_opt);
+    if (e != ARGIL_OK)
+        return e;
     link_spec_t spec;
     const link_spec_err_t pe = link_spec_parse(o->device, &spec);
     if (pe != LINK_SPEC_OK) {
         fprintf(stderr, "argil connect: bad device '%s': %s\n", o->device,
                 link_spec_err_text(pe));
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     if (o->key_file && spec.kind != LINK_KIND_UDP) {
         fprintf(stderr, "argil connect: --key is for udp: devices (USB is a cable to one board "
                         "and the sim board is in this process: neither needs a key)\n");
-        return 2;
+        return ARGIL_ERR_ARG;
     }
-    return -1;
+    *done = false;
+    return ARGIL_OK;
 }
 
+/* The tool the board is sent first: touch, 4 mm, the board's own force limits. */
 static void default_tool(msg_tool_t *t)
 {
     memset(t, 0, sizeof(*t));
@@ -778,9 +768,9 @@ typedef struct {
     bool udp_hinted;
 } conn_loop_t;
 
-/* Sets up the rings and opens the link (keyed with --key); 0, else the exit status (one line
- * said why). */
-static int connect_open_link(connect_session_t *cs)
+/* Sets up the rings and opens the link (keyed with --key); when it cannot, one line says why
+ * (ARGIL_ERR_ARG: a bad key file). */
+static argil_err_t connect_open_link(connect_session_t *cs)
 {
     conn_t *c = cs->c;
     const connect_opts_t *o = &cs->o;
@@ -791,30 +781,28 @@ static int connect_open_link(connect_session_t *cs)
         spsc_init(&c->rx, c->rx_store, CONNECT_RX_RING_BYTES) != ARGIL_OK ||
         spsc_init(&c->tx, c->tx_store, CONNECT_TX_RING_BYTES) != ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory\n");
-        return 1;
+        return ARGIL_ERR_NOMEM;
     }
     link_key_t key;
     if (o->key_file && !link_crypto_init()) {
         fprintf(stderr, "argil connect: libsodium cannot start (no random source?)\n");
-        return 1;
+        return ARGIL_ERR_STATE;
     }
     if (o->key_file && link_key_file_load(o->key_file, &key, err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     const argil_err_t lo =
         link_open_keyed(&c->link, o->device, o->key_file ? key.k : NULL, err, sizeof(err));
     link_crypto_wipe(&key, sizeof(key));
-    if (lo != ARGIL_OK) {
+    if (lo != ARGIL_OK)
         fprintf(stderr, "argil connect: %s\n", err);
-        return lo == ARGIL_ERR_PARSE || lo == ARGIL_ERR_ARG ? 2 : 1;
-    }
-    return 0;
+    return lo;
 }
 
 /* The host's clay, a sphere just below the arm's workspace centre (device = model), and the
- * peer on it; 0, else the exit status (one line said why, nothing left to free). */
-static int connect_clay_open(connect_session_t *cs)
+ * peer on it; when it cannot, one line says why and nothing is left to free. */
+static argil_err_t connect_clay_open(connect_session_t *cs)
 {
     conn_solver_t *s = cs->s;
     arm_desc_t arm_desc;
@@ -830,19 +818,19 @@ static int connect_clay_open(connect_session_t *cs)
     /* The sphere is in the grid before the peer starts: the B-spline model is fitted to the
      * grid as peer_init finds it (an empty grid gave an empty model, whose solve then emptied
      * the clay inside every window it stepped). */
-    if (grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half))) !=
-        ARGIL_OK) {
+    argil_err_t e =
+        grid_init(&s->grid, dims, CONNECT_SPACING_M, vec3_sub(centre, vec3(half, half, half)));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory for the clay\n");
-        return 1;
+        return e;
     }
     grid_fill_sphere(&s->grid, vec3_sub(centre, vec3(0, 0, CONNECT_CLAY_BELOW_M)),
                      CONNECT_CLAY_RADIUS_M);
-    if (peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s) != ARGIL_OK) {
+    if ((e = peer_init(&s->peer, &pc, &s->grid, ring_send, on_telemetry, s)) != ARGIL_OK) {
         fprintf(stderr, "argil connect: out of memory for the clay\n");
         grid_free(&s->grid);
-        return 1;
     }
-    return 0;
+    return e;
 }
 
 /* Frees the clay, its peer and its undo; a journal still open keeps its files (the end was not
@@ -857,14 +845,15 @@ static void connect_clay_close(conn_solver_t *s)
 }
 
 /* Gives the peer the host tool and the board's tool, asks it to arm the board with --arm and
- * sets up undo; 0, else the exit status (one line said why). */
-static int connect_tools_init(connect_session_t *cs)
+ * sets up undo; a refused host tool is said in one line. */
+static argil_err_t connect_tools_init(connect_session_t *cs)
 {
     conn_solver_t *s = cs->s;
     const connect_opts_t *o = &cs->o;
-    if (peer_set_host_tool(&s->peer, &o->host_tool) != ARGIL_OK) {
+    const argil_err_t e = peer_set_host_tool(&s->peer, &o->host_tool);
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil connect: the host tool was refused (needs the B-spline model)\n");
-        return 1;
+        return e;
     }
     default_tool(&cs->board_tool);
     if (o->host_tool_set)
@@ -877,7 +866,7 @@ static int connect_tools_init(connect_session_t *cs)
     (void)session_undo_init(&s->undo, s->peer.gs ? &s->peer.gs->field : NULL,
                             (size_t)o->undo_mb << 20);
     s->stdin_open = true;
-    return 0;
+    return ARGIL_OK;
 }
 
 /* Closes the telemetry CSV of a session that did not run and removes it. */
@@ -888,36 +877,38 @@ static void connect_csv_discard(connect_session_t *cs)
 }
 
 /* Creates the output directory, the telemetry CSV and (unless --no-journal) the autosave
- * journal; 0, else the exit status (one line said why, no CSV left open). */
-static int connect_files_open(connect_session_t *cs)
+ * journal; when it cannot, one line says why and no CSV is left open. */
+static argil_err_t connect_files_open(connect_session_t *cs)
 {
     conn_solver_t *s = cs->s;
     const connect_opts_t *o = &cs->o;
     char err[1024] = "";
-    if (make_dir(o->out_dir) != 0) {
+    argil_err_t e = make_dir(o->out_dir);
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s: cannot create directory: %s\n", o->out_dir,
                 strerror(errno));
-        return 1;
+        return e;
     }
     if (o->telemetry)
         snprintf(cs->csv_path, sizeof(cs->csv_path), "%s", o->telemetry);
     else
         snprintf(cs->csv_path, sizeof(cs->csv_path), "%s/telemetry.csv", o->out_dir);
-    if (open_csv(s, cs->csv_path, cs->csv_tmp, sizeof(cs->csv_tmp), err, sizeof(err)) !=
-        ARGIL_OK) {
+    e = open_csv(s, cs->csv_path, cs->csv_tmp, sizeof(cs->csv_tmp), err, sizeof(err));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        return 1;
+        return e;
     }
     if (o->journal) {
-        if (peer_journal_open(&s->journal, o->out_dir, &s->grid, o->autosave_s,
-                              CONNECT_CHECKPOINT_S, err, sizeof(err)) != ARGIL_OK) {
+        e = peer_journal_open(&s->journal, o->out_dir, &s->grid, o->autosave_s,
+                              CONNECT_CHECKPOINT_S, err, sizeof(err));
+        if (e != ARGIL_OK) {
             fprintf(stderr, "argil connect: %s\n", err);
             connect_csv_discard(cs);
-            return 1;
+            return e;
         }
         s->journaling = true;
     }
-    return 0;
+    return ARGIL_OK;
 }
 
 /* From here on Ctrl-C and SIGTERM end the session at the solver's next step, not the process. */
@@ -1044,9 +1035,10 @@ static void solver_step(connect_session_t *cs, conn_loop_t *loop, double elapsed
     }
 }
 
-/* Runs the solver every 1 ms until --seconds (0), Ctrl-C or SIGTERM (0, cs->interrupted) or
- * until the link's authentication ends the session (1, one line said why). */
-static int connect_loop(connect_session_t *cs)
+/* Runs the solver every 1 ms until --seconds (ARGIL_OK), Ctrl-C or SIGTERM (ARGIL_OK,
+ * cs->interrupted) or until the link's authentication ends the session (ARGIL_ERR_STATE, one
+ * line said why). */
+static argil_err_t connect_loop(connect_session_t *cs)
 {
     conn_solver_t *s = cs->s;
     conn_t *c = cs->c;
@@ -1064,15 +1056,15 @@ static int connect_loop(connect_session_t *cs)
         const double elapsed_s = (double)(s->now_us - s->t0_us) * 1e-6;
         if (g_connect_stop) {
             cs->interrupted = true;
-            return 0;
+            return ARGIL_OK;
         }
         if (o->seconds > 0 && elapsed_s >= o->seconds)
-            return 0;
+            return ARGIL_OK;
         solver_take_frames(s, &loop);
         solver_keep_session(s, &loop, o->arm);
         solver_step(cs, &loop, elapsed_s);
         if (link_refusal_ends(s, o, elapsed_s, &loop.udp_hinted, cs->tty))
-            return 1;
+            return ARGIL_ERR_STATE;
         if (s->now_us >= loop.status_at_us) {
             const uint32_t rx = atomic_load(&c->pub.frames_rx);
             const uint32_t tx = atomic_load(&c->pub.frames_tx);
@@ -1116,9 +1108,10 @@ static void connect_stop(connect_session_t *cs, pthread_t lt)
     cs->frames_rx = atomic_load(&c->pub.frames_rx);
 }
 
-/* Writes the telemetry, the clay's surface and the model; a clean end removes the journal.
- * Returns exit_code, or 1 when a file could not be written or the journal had stopped. */
-static int connect_write_files(connect_session_t *cs, int exit_code)
+/* Writes the telemetry, the clay's surface and the model; a clean end (e: how the session
+ * ended, ARGIL_OK) removes the journal. Returns e, else the first file that could not be
+ * written, or ARGIL_ERR_IO when the journal had stopped. */
+static argil_err_t connect_write_files(connect_session_t *cs, argil_err_t e)
 {
     conn_solver_t *s = cs->s;
     char err[1024] = "";
@@ -1127,25 +1120,24 @@ static int connect_write_files(connect_session_t *cs, int exit_code)
     s->csv = NULL;
     if (bad || rename(cs->csv_tmp, cs->csv_path) != 0) {
         fprintf(stderr, "argil connect: %s: cannot write: %s\n", cs->csv_path, strerror(errno));
-        exit_code = 1;
+        e = e != ARGIL_OK ? e : ARGIL_ERR_IO;
     }
-    if (write_model(&s->grid, &s->peer.host_tool, cs->o.out_dir,
-                    s->journaling ? s->journal.seq : 0u, &cs->triangles, err,
-                    sizeof(err)) != ARGIL_OK) {
+    const argil_err_t we = write_model(&s->grid, &s->peer.host_tool, cs->o.out_dir,
+                                       s->journaling ? s->journal.seq : 0u, &cs->triangles, err,
+                                       sizeof(err));
+    if (we != ARGIL_OK) {
         fprintf(stderr, "argil connect: %s\n", err);
-        exit_code = 1;
+        e = e != ARGIL_OK ? e : we;
     }
     /* A clean end: the files are whole, so the journal is no longer needed. */
-    if (s->journaling && exit_code == 0) {
+    if (s->journaling && e == ARGIL_OK) {
         s->journaling = false;
-        if (journal_finish(&s->journal, err, sizeof(err)) != ARGIL_OK) {
+        if ((e = journal_finish(&s->journal, err, sizeof(err))) != ARGIL_OK)
             fprintf(stderr, "argil connect: %s\n", err);
-            exit_code = 1;
-        }
     }
-    if (cs->journal_err[0] != '\0')
-        exit_code = 1;
-    return exit_code;
+    if (cs->journal_err[0] != '\0' && e == ARGIL_OK)
+        e = ARGIL_ERR_IO;
+    return e;
 }
 
 /* Prints the session's summary on stdout: link, board, protocol, solve, tool, undo, files and
@@ -1235,50 +1227,49 @@ static void connect_summary(const connect_session_t *cs)
 }
 
 /* The session on the clay: the tools, the files, the link thread and the solver loop, then the
- * files written and the summary; the exit status. */
-static int connect_run(connect_session_t *cs)
+ * files written and the summary; the exit status into *exit_status. */
+static argil_err_t connect_run(connect_session_t *cs, int *exit_status)
 {
     const connect_opts_t *o = &cs->o;
-    int exit_code = connect_tools_init(cs);
-    if (exit_code == 0)
-        exit_code = connect_files_open(cs);
-    if (exit_code != 0)
-        return exit_code;
+    argil_err_t e = connect_tools_init(cs);
+    if (e == ARGIL_OK)
+        e = connect_files_open(cs);
+    if (e != ARGIL_OK)
+        return cmd_end(exit_status, 1, e);
     connect_catch_signals();
     pthread_t lt;
     if (pthread_create(&lt, NULL, link_thread, cs->c) != 0) {
         fprintf(stderr, "argil connect: cannot start the link thread\n");
         connect_csv_discard(cs);
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_STATE);
     }
-    exit_code = connect_loop(cs);
+    e = connect_loop(cs);
     connect_stop(cs, lt);
-    exit_code = connect_write_files(cs, exit_code);
+    e = connect_write_files(cs, e);
     if (!o->quiet)
         connect_summary(cs);
-    if (cs->frames_rx == 0 && exit_code == 0) {
+    if (cs->frames_rx == 0 && e == ARGIL_OK) {
         fprintf(stderr, "argil connect: the board never answered on %s%s\n", o->device,
                 udp_key_hint(o));
-        exit_code = 1;
-    } else if (exit_code == 0 && cs->interrupted) {
-        exit_code = 130;
+        e = ARGIL_ERR_IO;
     }
-    return exit_code;
+    return cmd_end(exit_status, e != ARGIL_OK ? 1 : cs->interrupted ? 130 : 0, e);
 }
 
-/* argil connect: a live session with a board until --seconds or Ctrl-C; the exit status. */
-int cmd_connect(int argc, char **argv)
+/* argil connect: a live session with a board until --seconds or Ctrl-C. */
+argil_err_t cmd_connect(int argc, char **argv, int *exit_status)
 {
     connect_session_t cs;
     memset(&cs, 0, sizeof(cs));
-    const int st = parse_opts(argc, argv, &cs.o);
-    if (st >= 0)
-        return st;
+    bool done, go_on = true;
+    argil_err_t e = parse_opts(argc, argv, &cs.o, &done, exit_status);
+    if (done)
+        return e;
     if (cs.o.journal) {
-        const int offer =
-            recover_offer(cs.o.out_dir, cs.o.discard_journal, isatty(STDIN_FILENO) != 0);
-        if (offer >= 0)
-            return offer;
+        e = recover_offer(cs.o.out_dir, cs.o.discard_journal, isatty(STDIN_FILENO) != 0, &go_on,
+                          exit_status);
+        if (!go_on)
+            return e;
     }
     cs.tty = isatty(STDERR_FILENO);
     cs.c = calloc(1, sizeof(*cs.c));
@@ -1287,14 +1278,17 @@ int cmd_connect(int argc, char **argv)
         free(cs.c);
         free(cs.s);
         fprintf(stderr, "argil connect: out of memory\n");
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_NOMEM);
     }
     cs.s->c = cs.c;
-    int exit_code = connect_open_link(&cs);
-    if (exit_code == 0) {
-        exit_code = connect_clay_open(&cs);
-        if (exit_code == 0) {
-            exit_code = connect_run(&cs);
+    e = connect_open_link(&cs);
+    /* A bad key file or device string is a usage error (2); the link not opening, the work's. */
+    int status = e == ARGIL_ERR_ARG || e == ARGIL_ERR_PARSE ? 2 : 1;
+    if (e == ARGIL_OK) {
+        status = 1;
+        e = connect_clay_open(&cs);
+        if (e == ARGIL_OK) {
+            e = connect_run(&cs, &status);
             connect_clay_close(cs.s);
         }
         link_close(&cs.c->link);
@@ -1305,5 +1299,5 @@ int cmd_connect(int argc, char **argv)
     free(cs.s);
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
-    return exit_code;
+    return cmd_end(exit_status, status, e);
 }

@@ -11,6 +11,7 @@
 #include "host/io/volume.h"
 #include "host/mesh/mesh_check.h"
 
+/* The text of `argil info --help`. */
 static void usage_info(FILE *f)
 {
     fprintf(f, "usage: argil info FILE\n\n"
@@ -21,7 +22,8 @@ static void usage_info(FILE *f)
                "A file that cannot be read gives one line naming the file, where and why.\n");
 }
 
-static int has_ext(const char *p, const char *e)
+/* Whether path p ends in the extension e, in any case. */
+static bool has_ext(const char *p, const char *e)
 {
     const char *dot = strrchr(p, '.');
     return dot != NULL && strcasecmp(dot, e) == 0;
@@ -112,85 +114,107 @@ static void print_colour(const grid_t *g, const uint8_t *rgb)
            GRID_RGB_DEFAULT, GRID_RGB_DEFAULT, GRID_RGB_DEFAULT);
 }
 
-int cmd_info(int argc, char **argv)
+argil_err_t cmd_read_mesh(const char *path, mesh_t *m, bool *normals, float lo[3], float hi[3],
+                          char *err, size_t err_len)
 {
-    if (argc != 1 || strcmp(argv[0], "-h") == 0 || strcmp(argv[0], "--help") == 0) {
-        usage_info(argc == 1 ? stdout : stderr);
-        return argc == 1 ? 0 : 2;
+    mesh_init(m);
+    *normals = false;
+    const argil_err_t e = mesh_import(path, m, normals, err, err_len);
+    if (e != ARGIL_OK) {
+        mesh_free(m);
+        return e;
     }
-    const char *path = argv[0];
-    char err[1024];
-    if (has_ext(path, ".argil")) {
-        argil_doc_t d;
-        if (argil_file_read(path, &d, err, sizeof(err)) != ARGIL_OK) {
-            fprintf(stderr, "argil info: %s\n", err);
-            return 1;
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+        for (size_t i = 0; i < m->n_vert; i++) {
+            lo[a] = fminf(lo[a], m->pos[3 * i + (size_t)a]);
+            hi[a] = fmaxf(hi[a], m->pos[3 * i + (size_t)a]);
         }
-        const grid_t *g = &d.grid;
-        printf("%s: argil model, format version %u\n", path, d.file_version);
-        printf("  grid      %d x %d x %d samples, spacing %.4g mm, origin (%.4g, %.4g, %.4g) mm\n",
-               g->dims[0], g->dims[1], g->dims[2], g->spacing_m * 1e3, g->origin_m.x * 1e3,
-               g->origin_m.y * 1e3, g->origin_m.z * 1e3);
-        printf("  surface   iso %.3g, band %.4g mm, colours %s\n", g->iso, g->band_m * 1e3,
-               d.rgb != NULL ? "painted" : "none");
-        printf("  material  mass %g, stiffness %g, coupling %g, damping %g, plastic %g Hz\n",
-               g->material.node_mass, g->material.stiffness, g->material.coupling,
-               g->material.damping, g->material.plastic_rate_hz);
-        print_painted(g);
-        if (d.rgb != NULL)
-            print_colour(g, d.rgb);
-        printf("  tool      kind %u, radius %.4g mm, strength %.3g\n", d.tool.tool_kind,
-               d.tool.radius_m * 1e3, d.tool.strength);
-        if (d.has_rbf)
-            printf("  rbf       %u centres (%u bytes), fit error rms %.4g mm, max %.4g mm\n",
-                   d.rbf.n, 28 + 16 * d.rbf.n, d.rbf.rms_err_m * 1e3, d.rbf.max_err_m * 1e3);
-        if (d.has_octree) {
-            const octfit_model_t *o = &d.octree;
-            const unsigned long long bytes =
-                40ull + 4ull * o->n_nodes + 4ull * OCTFIT_NCOEF * o->n_leaves;
-            printf("  octree    %u nodes, %u leaves, depth %u, cube %.4g mm at (%.4g, %.4g, %.4g) mm "
-                   "(%llu bytes), ", o->n_nodes, o->n_leaves, o->depth, o->size_m * 1e3,
-                   o->origin_m[0] * 1e3, o->origin_m[1] * 1e3, o->origin_m[2] * 1e3, bytes);
-            if (o->kind == OCTFIT_INTENSITY)
-                printf("intensity error rms %.4g, max %.4g (of the range)\n", o->rms_err,
-                       o->max_err);
-            else
-                printf("fit error rms %.4g mm, max %.4g mm\n", o->rms_err * 1e3, o->max_err * 1e3);
-        }
-        argil_doc_free(&d);
-        return 0;
     }
-    if (has_ext(path, ".nrrd") || has_ext(path, ".nhdr")) {
-        volume_t v;
-        if (volume_read_nrrd(path, &v, err, sizeof(err)) != VOLUME_OK) {
-            fprintf(stderr, "argil info: %s\n", err);
-            return 1;
-        }
-        const size_t n = (size_t)v.dims[0] * (size_t)v.dims[1] * (size_t)v.dims[2];
-        float lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < n; i++) {
-            lo = fminf(lo, v.value[i]);
-            hi = fmaxf(hi, v.value[i]);
-        }
-        printf("%s: volume %d x %d x %d, spacing %g %g %g, values %g .. %g\n", path, v.dims[0],
-               v.dims[1], v.dims[2], v.spacing_m[0], v.spacing_m[1], v.spacing_m[2], lo, hi);
-        volume_free(&v);
-        return 0;
+    return ARGIL_OK;
+}
+
+void cmd_volume_range(const volume_t *v, float *lo, float *hi)
+{
+    const size_t n = (size_t)v->dims[0] * (size_t)v->dims[1] * (size_t)v->dims[2];
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        *lo = fminf(*lo, v->value[i]);
+        *hi = fmaxf(*hi, v->value[i]);
     }
+}
+
+/* Prints what the model file at path holds: grid, surface, material, paint, tool, fitted form;
+ * why it cannot be read into err. */
+static argil_err_t info_model(const char *path, char *err, size_t err_len)
+{
+    argil_doc_t d;
+    const argil_err_t e = argil_file_read(path, &d, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
+    const grid_t *g = &d.grid;
+    printf("%s: argil model, format version %u\n", path, d.file_version);
+    printf("  grid      %d x %d x %d samples, spacing %.4g mm, origin (%.4g, %.4g, %.4g) mm\n",
+           g->dims[0], g->dims[1], g->dims[2], g->spacing_m * 1e3, g->origin_m.x * 1e3,
+           g->origin_m.y * 1e3, g->origin_m.z * 1e3);
+    printf("  surface   iso %.3g, band %.4g mm, colours %s\n", g->iso, g->band_m * 1e3,
+           d.rgb != NULL ? "painted" : "none");
+    printf("  material  mass %g, stiffness %g, coupling %g, damping %g, plastic %g Hz\n",
+           g->material.node_mass, g->material.stiffness, g->material.coupling,
+           g->material.damping, g->material.plastic_rate_hz);
+    print_painted(g);
+    if (d.rgb != NULL)
+        print_colour(g, d.rgb);
+    printf("  tool      kind %u, radius %.4g mm, strength %.3g\n", d.tool.tool_kind,
+           d.tool.radius_m * 1e3, d.tool.strength);
+    if (d.has_rbf)
+        printf("  rbf       %u centres (%u bytes), fit error rms %.4g mm, max %.4g mm\n",
+               d.rbf.n, 28 + 16 * d.rbf.n, d.rbf.rms_err_m * 1e3, d.rbf.max_err_m * 1e3);
+    if (d.has_octree) {
+        const octfit_model_t *o = &d.octree;
+        const unsigned long long bytes =
+            40ull + 4ull * o->n_nodes + 4ull * OCTFIT_NCOEF * o->n_leaves;
+        printf("  octree    %u nodes, %u leaves, depth %u, cube %.4g mm at (%.4g, %.4g, %.4g) mm "
+               "(%llu bytes), ", o->n_nodes, o->n_leaves, o->depth, o->size_m * 1e3,
+               o->origin_m[0] * 1e3, o->origin_m[1] * 1e3, o->origin_m[2] * 1e3, bytes);
+        if (o->kind == OCTFIT_INTENSITY)
+            printf("intensity error rms %.4g, max %.4g (of the range)\n", o->rms_err,
+                   o->max_err);
+        else
+            printf("fit error rms %.4g mm, max %.4g mm\n", o->rms_err * 1e3, o->max_err * 1e3);
+    }
+    argil_doc_free(&d);
+    return ARGIL_OK;
+}
+
+/* Prints what the volume file at path holds: size, spacing and the range of its values; why it
+ * cannot be read into err. */
+static argil_err_t info_volume(const char *path, char *err, size_t err_len)
+{
+    volume_t v;
+    const argil_err_t e = volume_err_argil(volume_read_nrrd(path, &v, err, err_len));
+    if (e != ARGIL_OK)
+        return e;
+    float lo, hi;
+    cmd_volume_range(&v, &lo, &hi);
+    printf("%s: volume %d x %d x %d, spacing %g %g %g, values %g .. %g\n", path, v.dims[0],
+           v.dims[1], v.dims[2], v.spacing_m[0], v.spacing_m[1], v.spacing_m[2], lo, hi);
+    volume_free(&v);
+    return ARGIL_OK;
+}
+
+/* Prints what the mesh or point cloud at path holds: counts, closedness, bounds, attributes;
+ * why it cannot be read into err. */
+static argil_err_t info_mesh(const char *path, char *err, size_t err_len)
+{
     mesh_t m;
-    mesh_init(&m);
-    bool normals = false;
-    if (mesh_import(path, &m, &normals, err, sizeof(err)) != ARGIL_OK) {
-        fprintf(stderr, "argil info: %s\n", err);
-        mesh_free(&m);
-        return 1;
-    }
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < m.n_vert; i++)
-        for (int a = 0; a < 3; a++) {
-            lo[a] = fminf(lo[a], m.pos[3 * i + (size_t)a]);
-            hi[a] = fmaxf(hi[a], m.pos[3 * i + (size_t)a]);
-        }
+    bool normals;
+    float lo[3], hi[3];
+    const argil_err_t e = cmd_read_mesh(path, &m, &normals, lo, hi, err, err_len);
+    if (e != ARGIL_OK)
+        return e;
     if (m.n_tri > 0) {
         size_t boundary = 0, nonman = 0;
         const bool closed = mesh_watertight(&m, &boundary, &nonman);
@@ -203,5 +227,27 @@ int cmd_info(int argc, char **argv)
     printf("  bounds    (%g, %g, %g) .. (%g, %g, %g)\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
     printf("  normals   %s, colours %s\n", normals ? "yes" : "no", m.has_rgb ? "yes" : "no");
     mesh_free(&m);
-    return 0;
+    return ARGIL_OK;
+}
+
+/* argil info FILE: what FILE holds, by its extension; a file that cannot be read is exit 1. */
+argil_err_t cmd_info(int argc, char **argv, int *exit_status)
+{
+    if (argc != 1 || strcmp(argv[0], "-h") == 0 || strcmp(argv[0], "--help") == 0) {
+        usage_info(argc == 1 ? stdout : stderr);
+        return argc == 1 ? cmd_end(exit_status, 0, ARGIL_OK)
+                         : cmd_end(exit_status, 2, ARGIL_ERR_ARG);
+    }
+    const char *path = argv[0];
+    char err[1024];
+    argil_err_t e;
+    if (has_ext(path, ".argil"))
+        e = info_model(path, err, sizeof(err));
+    else if (has_ext(path, ".nrrd") || has_ext(path, ".nhdr"))
+        e = info_volume(path, err, sizeof(err));
+    else
+        e = info_mesh(path, err, sizeof(err));
+    if (e != ARGIL_OK)
+        fprintf(stderr, "argil info: %s\n", err);
+    return cmd_end(exit_status, e == ARGIL_OK ? 0 : 1, e);
 }

@@ -6,6 +6,7 @@
 #include "host/app/commands.h"
 #include "host/link/link_key_file.h"
 
+/* The text of `argil keygen --help`. */
 static void usage_keygen(FILE *f)
 {
     fprintf(f,
@@ -26,22 +27,23 @@ static void usage_keygen(FILE *f)
             "exit status: 0 written; 1 FILE exists or cannot be written; 2 a usage error.\n");
 }
 
-int cmd_keygen(int argc, char **argv)
+/* argil keygen FILE: writes a random link key into FILE, which must not exist yet. */
+argil_err_t cmd_keygen(int argc, char **argv, int *exit_status)
 {
     if (argc == 1 && (strcmp(argv[0], "--help") == 0 || strcmp(argv[0], "-h") == 0)) {
         usage_keygen(stdout);
-        return 0;
+        return cmd_end(exit_status, 0, ARGIL_OK);
     }
     if (argc != 1 || argv[0][0] == '-') {
         fprintf(stderr, "argil keygen: expected one FILE to create (see 'argil keygen --help')\n");
-        return 2;
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
     }
     char err[512];
     if (link_key_file_create(argv[0], err, sizeof(err)) != LINK_KEY_OK) {
         fprintf(stderr, "argil keygen: %s\n", err);
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_IO);
     }
     printf("argil keygen: wrote a new link key to %s (mode 0600): give the same file to "
            "argil-board --key and argil connect --key\n", argv[0]);
-    return 0;
+    return cmd_end(exit_status, 0, ARGIL_OK);
 }

@@ -1,16 +1,19 @@
 /* argil mesh: a saved model (.argil) to a mesh file for other tools, at any iso-value and
  * resolution, for the whole model or a box of it, with painted colours. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/io/argil_file.h"
 #include "host/io/mesh_export.h"
 #include "host/mesh/mc_blocks.h"
 #include "host/mesh/mesh_check.h"
 
+/* The text of `argil mesh --help`. */
 static void usage_mesh(FILE *f)
 {
     fprintf(f,
@@ -33,19 +36,6 @@ static void usage_mesh(FILE *f)
             "  --ascii         ASCII PLY instead of binary\n"
             "  --quiet         no summary line\n"
             "  -h, --help      this text\n");
-}
-
-static int parse_double_arg(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    char *end;
-    const double d = v != NULL ? strtod(v, &end) : 0;
-    if (v == NULL || *end != '\0' || end == v || !(d >= lo && d <= hi)) {
-        fprintf(stderr, "argil mesh: %s needs a number from %g to %g, got '%s'\n", opt, lo, hi,
-                v != NULL ? v : "");
-        return 0;
-    }
-    *out = d;
-    return 1;
 }
 
 /* Resamples the model on a new grid of about n samples along its longest axis: from the octree
@@ -99,68 +89,58 @@ static argil_err_t resample(const argil_doc_t *d, int n, float **dens, uint8_t *
     return ARGIL_OK;
 }
 
-int cmd_mesh(int argc, char **argv)
+/* What argil mesh's command line asks for. */
+typedef struct {
+    const char *in, *out;
+    double res, iso;                /* 0, -1: the model's own grid and iso */
+    double region[6];               /* --region's corners, metres (NAN: the whole model) */
+    bool ascii, quiet;
+} mesh_opts_t;
+
+/* argil mesh's command line (cli_parse). */
+static const cli_flag_t MESH_FLAGS[] = {
+    {"--ascii", offsetof(mesh_opts_t, ascii), true},
+    {"--quiet", offsetof(mesh_opts_t, quiet), true},
+};
+static const cli_number_t MESH_NUMBERS[] = {
+    {"--resolution", 2, 1024, offsetof(mesh_opts_t, res), 1, false},
+    {"--iso", 1e-6, 1 - 1e-6, offsetof(mesh_opts_t, iso), 1, false},
+    {"--region", -1e6, 1e6, offsetof(mesh_opts_t, region), 6, false},
+};
+static const cli_cmd_t MESH_CLI = {
+    .name = "mesh", .usage = usage_mesh,
+    .flags = MESH_FLAGS, .n_flags = 2, .numbers = MESH_NUMBERS, .n_numbers = 3,
+    .out_needs = "a value", .out = offsetof(mesh_opts_t, out),
+    .inputs = true, .input = offsetof(mesh_opts_t, in),
+};
+
+/* argil mesh MODEL.argil -o OUT: the model's surface into a mesh file. */
+argil_err_t cmd_mesh(int argc, char **argv, int *exit_status)
 {
-    const char *in = NULL, *out = NULL;
-    double res = 0, iso = -1, region[6];
-    int have_region = 0, ascii = 0, quiet = 0;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage_mesh(stdout);
-            return 0;
-        } else if (strcmp(a, "-o") == 0) {
-            if (v == NULL) {
-                fprintf(stderr, "argil mesh: -o needs a value (see --help)\n");
-                return 2;
-            }
-            out = v;
-            i++;
-        } else if (strcmp(a, "--resolution") == 0) {
-            if (!parse_double_arg(a, v, 2, 1024, &res))
-                return 2;
-            i++;
-        } else if (strcmp(a, "--iso") == 0) {
-            if (!parse_double_arg(a, v, 1e-6, 1 - 1e-6, &iso))
-                return 2;
-            i++;
-        } else if (strcmp(a, "--region") == 0) {
-            for (int k = 0; k < 6; k++)
-                if (!parse_double_arg(a, i + 1 + k < argc ? argv[i + 1 + k] : NULL, -1e6, 1e6,
-                                      &region[k]))
-                    return 2;
-            have_region = 1;
-            i += 6;
-        } else if (strcmp(a, "--ascii") == 0) {
-            ascii = 1;
-        } else if (strcmp(a, "--quiet") == 0) {
-            quiet = 1;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "argil mesh: unknown option '%s' (see --help)\n", a);
-            return 2;
-        } else if (in == NULL) {
-            in = a;
-        } else {
-            fprintf(stderr, "argil mesh: more than one input ('%s')\n", a);
-            return 2;
-        }
-    }
+    mesh_opts_t mo = {NULL, NULL, 0, -1, {NAN, NAN, NAN, NAN, NAN, NAN}, false, false};
+    bool done;
+    const argil_err_t pe = cli_parse(&MESH_CLI, &mo, argc, argv, &done, exit_status);
+    if (done)
+        return pe;
+    const char *in = mo.in, *out = mo.out;
+    const double res = mo.res, iso = mo.iso, *region = mo.region;
     export_format_t fmt;
     if (in == NULL || out == NULL) {
         fprintf(stderr, "argil mesh: needs MODEL.argil and -o OUT (see --help)\n");
-        return 2;
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
     }
     if (!export_format_from_path(out, &fmt)) {
         fprintf(stderr, "argil mesh: %s: output must end in .ply, .stl or .obj\n", out);
-        return 2;
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
     }
-    if (ascii && fmt == EXPORT_PLY_BINARY)
+    if (mo.ascii && fmt == EXPORT_PLY_BINARY)
         fmt = EXPORT_PLY_ASCII;
     argil_doc_t d;
     char err[1024];
-    if (argil_file_read(in, &d, err, sizeof(err)) != ARGIL_OK) {
+    argil_err_t e = argil_file_read(in, &d, err, sizeof(err));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil mesh: %s\n", err);
-        return 1;
+        return cmd_end(exit_status, 1, e);
     }
     /* A loaded model's samples fill the file's box: bounds start at 0 and rgb matches them. */
     int32_t blo[3], dims[3];
@@ -169,8 +149,7 @@ int cmd_mesh(int argc, char **argv)
     uint8_t *rgb = d.rgb;
     vec3_t origin = grid_box_origin(&d.grid, blo);
     uint8_t *own_c = NULL;
-    int rc = 1;
-    argil_err_t e = own_d != NULL ? ARGIL_OK : ARGIL_ERR_NOMEM;
+    e = own_d != NULL ? ARGIL_OK : ARGIL_ERR_NOMEM;
     if (e == ARGIL_OK && res > 0) {
         free(own_d);
         own_d = NULL;
@@ -179,7 +158,7 @@ int cmd_mesh(int argc, char **argv)
         rgb = own_c;
     }
     int32_t lo[3] = {0, 0, 0}, hi[3] = {dims[0], dims[1], dims[2]};
-    if (e == ARGIL_OK && have_region) {
+    if (e == ARGIL_OK && !isnan(region[0])) {
         const float o3[3] = {origin.x, origin.y, origin.z};
         for (int a = 0; a < 3; a++) {
             double l = (region[a] - o3[a]) / spacing, h = (region[3 + a] - o3[a]) / spacing;
@@ -192,7 +171,7 @@ int cmd_mesh(int argc, char **argv)
                 argil_doc_free(&d);
                 free(own_d);
                 free(own_c);
-                return 2;
+                return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
             }
         }
     }
@@ -207,11 +186,11 @@ int cmd_mesh(int argc, char **argv)
     } else if (m.n_tri == 0) {
         fprintf(stderr, "argil mesh: %s: no surface at iso %g in that region\n", in,
                 iso > 0 ? iso : (double)d.grid.iso);
-    } else if (mesh_export(out, &m, fmt, err, sizeof(err)) != ARGIL_OK) {
+        e = ARGIL_ERR_EMPTY;
+    } else if ((e = mesh_export(out, &m, fmt, err, sizeof(err))) != ARGIL_OK) {
         fprintf(stderr, "argil mesh: %s\n", err);
     } else {
-        rc = 0;
-        if (!quiet) {
+        if (!mo.quiet) {
             size_t boundary = 0, nonman = 0;
             const bool closed = mesh_watertight(&m, &boundary, &nonman);
             printf("argil mesh: %s: %zu triangles, %zu vertices, %s, volume %.3f cm3, grid "
@@ -224,5 +203,5 @@ int cmd_mesh(int argc, char **argv)
     free(own_d);
     free(own_c);
     argil_doc_free(&d);
-    return rc;
+    return cmd_end(exit_status, e == ARGIL_OK ? 0 : 1, e);
 }

@@ -1,12 +1,14 @@
 /* argil recover: rebuilds the model of an unfinished session from its autosave journal; and the
  * offer to do so when a new session starts in a directory that still holds one. */
 #define _POSIX_C_SOURCE 200809L
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "host/app/cli_opts.h"
 #include "host/app/commands.h"
 #include "host/app/session_files.h"
 #include "host/io/argil_file.h"
@@ -15,6 +17,7 @@
 #include "host/mesh/mc.h"
 #include "host/mesh/mesh.h"
 
+/* The text of `argil recover --help`. */
 static void usage_recover(FILE *f)
 {
     fprintf(f,
@@ -37,6 +40,7 @@ static void usage_recover(FILE *f)
             "end (the model is still written as of the last good record, and the journal kept).\n");
 }
 
+/* The line that says dir holds an unfinished session and how to restore it. */
 static void describe(const char *dir, const journal_info_t *info, FILE *f)
 {
     fprintf(f, "argil: found an unfinished session in %s (%u edits, last at %.3f s); run "
@@ -44,18 +48,24 @@ static void describe(const char *dir, const journal_info_t *info, FILE *f)
             dir, info->records, info->last_sim_s, dir);
 }
 
-int recover_offer(const char *dir, bool discard, bool interactive)
+argil_err_t recover_offer(const char *dir, bool discard, bool interactive, bool *go_on,
+                          int *exit_status)
 {
-    if (dir == NULL || !journal_exists(dir))
-        return -1;
+    *go_on = false;
+    if (dir == NULL || !journal_exists(dir)) {
+        *go_on = true;
+        return ARGIL_OK;
+    }
     char err[1024];
     if (discard) {
-        if (journal_discard(dir, err, sizeof(err)) != ARGIL_OK) {
+        const argil_err_t de = journal_discard(dir, err, sizeof(err));
+        if (de != ARGIL_OK) {
             fprintf(stderr, "argil sculpt: %s\n", err);
-            return 1;
+            return cmd_end(exit_status, 1, de);
         }
         fprintf(stderr, "argil: discarded the unfinished session's journal in %s\n", dir);
-        return -1;
+        *go_on = true;
+        return ARGIL_OK;
     }
     journal_info_t info;
     const argil_err_t e = journal_probe(dir, &info, err, sizeof(err));
@@ -63,26 +73,26 @@ int recover_offer(const char *dir, bool discard, bool interactive)
         fprintf(stderr, "argil sculpt: %s holds a journal that cannot be read (%s); run 'argil "
                         "recover %s' or --discard-journal\n",
                 dir, err, dir);
-        return 1;
+        return cmd_end(exit_status, 1, e);
     }
     describe(dir, &info, stderr);
     if (!interactive)
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_STATE);
     fprintf(stderr, "argil: recover it now [r], discard it and start a new session [d], or quit "
                     "[q]? ");
     char line[64];
     if (fgets(line, sizeof(line), stdin) == NULL)
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_STATE);
     if (line[0] == 'r' || line[0] == 'R') {
         char *argv[] = {(char *)dir};
-        return cmd_recover(1, argv);
+        return cmd_recover(1, argv, exit_status);
     }
     if (line[0] == 'd' || line[0] == 'D')
-        return recover_offer(dir, true, false);
-    return 1;
+        return recover_offer(dir, true, false, go_on, exit_status);
+    return cmd_end(exit_status, 1, ARGIL_OK);
 }
 
-/* dst = src with its .argil extension (if any) replaced by ext. */
+/* A copy of src with its .argil extension (if any) replaced by ext. */
 static char *with_ext(const char *src, const char *ext)
 {
     size_t len = strlen(src);
@@ -96,42 +106,48 @@ static char *with_ext(const char *src, const char *ext)
     return p;
 }
 
-int cmd_recover(int argc, char **argv)
+/* A second directory on the command line. */
+static void second_dir(const char *first, const char *a)
 {
-    const char *dir = NULL, *out = NULL;
-    bool keep = false;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage_recover(stdout);
-            return 0;
-        } else if (strcmp(a, "--keep-journal") == 0) {
-            keep = true;
-        } else if (strcmp(a, "-o") == 0) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "argil recover: -o needs a file name (see --help)\n");
-                return 2;
-            }
-            out = argv[++i];
-        } else if (a[0] == '-') {
-            fprintf(stderr, "argil recover: unknown option '%s' (see --help)\n", a);
-            return 2;
-        } else if (dir == NULL) {
-            dir = a;
-        } else {
-            fprintf(stderr, "argil recover: one directory only (see --help)\n");
-            return 2;
-        }
-    }
+    (void)first;
+    (void)a;
+    fprintf(stderr, "argil recover: one directory only (see --help)\n");
+}
+
+/* What argil recover's command line asks for. */
+typedef struct {
+    const char *dir, *out;          /* the session's directory; -o (NULL: DIR/recovered.argil) */
+    bool keep;                      /* --keep-journal */
+} recover_opts_t;
+
+/* argil recover's command line (cli_parse). */
+static const cli_flag_t RECOVER_FLAGS[] = {{"--keep-journal", offsetof(recover_opts_t, keep), true}};
+static const cli_cmd_t RECOVER_CLI = {
+    .name = "recover", .usage = usage_recover,
+    .flags = RECOVER_FLAGS, .n_flags = 1, .second_input = second_dir,
+    .out_needs = "a file name", .out = offsetof(recover_opts_t, out),
+    .inputs = true, .input = offsetof(recover_opts_t, dir),
+};
+
+/* argil recover DIR: the model of DIR's unfinished session, from its journal. */
+argil_err_t cmd_recover(int argc, char **argv, int *exit_status)
+{
+    recover_opts_t ro = {NULL, NULL, false};
+    bool done;
+    const argil_err_t pe = cli_parse(&RECOVER_CLI, &ro, argc, argv, &done, exit_status);
+    if (done)
+        return pe;
+    const char *dir = ro.dir, *out = ro.out;
+    const bool keep = ro.keep;
     if (dir == NULL) {
         usage_recover(stderr);
-        return 2;
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
     }
     char err[1024] = "", werr[1024] = "";
     if (!journal_exists(dir)) {
         fprintf(stderr, "argil recover: %s holds no journal (%s): nothing to recover\n", dir,
                 JOURNAL_FILE);
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_EMPTY);
     }
     char *model_path = NULL, *ply_path = NULL;
     if (out == NULL) {
@@ -146,15 +162,15 @@ int cmd_recover(int argc, char **argv)
         fprintf(stderr, "argil recover: out of memory\n");
         free(model_path);
         free(ply_path);
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_NOMEM);
     }
     argil_doc_t doc;
     journal_info_t info;
     const argil_err_t e = journal_recover(dir, &doc, &info, err, sizeof(err));
-    int status = 0;
+    argil_err_t status = ARGIL_OK; /* the error the command ends with */
     if (grid_count(&doc.grid) == 0) {
         fprintf(stderr, "argil recover: %s\n", err);
-        status = 1;
+        status = e != ARGIL_OK ? e : ARGIL_ERR_EMPTY;
         goto out;
     }
     mesh_t mesh;
@@ -171,7 +187,7 @@ int cmd_recover(int argc, char **argv)
     mesh_free(&mesh);
     if (we != ARGIL_OK || me != ARGIL_OK) {
         fprintf(stderr, "argil recover: %s\n", we != ARGIL_OK ? werr : "meshing the model failed");
-        status = 1;
+        status = we != ARGIL_OK ? we : me;
         goto out;
     }
     const time_t wall = (time_t)(info.last_wall_ms / 1000u);
@@ -207,16 +223,13 @@ int cmd_recover(int argc, char **argv)
         fprintf(stderr, "argil recover: %s; the model above is as of the record before it, and "
                         "the journal is kept\n",
                 err);
-        status = 1;
-    } else if (!keep) {
-        if (journal_discard(dir, err, sizeof(err)) != ARGIL_OK) {
-            fprintf(stderr, "argil recover: %s\n", err);
-            status = 1;
-        }
+        status = e;
+    } else if (!keep && (status = journal_discard(dir, err, sizeof(err))) != ARGIL_OK) {
+        fprintf(stderr, "argil recover: %s\n", err);
     }
 out:
     argil_doc_free(&doc);
     free(model_path);
     free(ply_path);
-    return status;
+    return cmd_end(exit_status, status == ARGIL_OK ? 0 : 1, status);
 }

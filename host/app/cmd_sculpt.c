@@ -1,6 +1,7 @@
 /* argil sculpt: a scripted (or, in the live window, mouse-driven) session on the simulated arm,
  * in lockstep; writes the result into the output directory and prints a summary. */
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,13 +24,6 @@ typedef struct {
     const char *screenshot;       /* FILE.png to render the result into afterwards, or NULL */
     char frames_dir[4096];        /* DIR/frames, for --screenshot-every */
 } sculpt_args_t;
-
-/* How one command-line option was taken. */
-typedef enum {
-    SCULPT_OPT_TAKEN,             /* understood, with its value if it has one */
-    SCULPT_OPT_OTHER,             /* not one of this group's options */
-    SCULPT_OPT_BAD,               /* its value was refused; the reason is printed */
-} sculpt_opt_t;
 
 static volatile sig_atomic_t g_stop;
 
@@ -113,127 +107,72 @@ static void print_note(void *ctx, const char *msg)
     fprintf(stderr, "argil sculpt: %s\n", msg);
 }
 /* The options that shape the session and its files. *i moves past any value taken. */
-static sculpt_opt_t parse_session_option(sculpt_args_t *sa, int argc, char **argv, int *i)
+static cli_opt_t parse_session_option(sculpt_args_t *sa, int argc, char **argv, int *i)
 {
-    const char *a = argv[*i];
+    const cli_session_t shared = {&sa->o.global_solve, NULL, &sa->o.knot_ratio, &sa->o.tick_us,
+                                  &sa->o.autosave_s, &sa->o.checkpoint_s, &sa->o.undo_mb};
+    const cli_opt_t r = cli_session_option("sculpt", &shared, argc, argv, i);
+    if (r != CLI_OPT_OTHER || strcmp(argv[*i], "--debug-journal-dump") != 0)
+        return r;
+    /* Tests: --debug-journal-dump N FILE.argil writes the model as of journal record N and ends
+     * the session there (tests/sys/test_crash_recovery.sh). */
     const char *v = *i + 1 < argc ? argv[*i + 1] : NULL;
-    if (strcmp(a, "--quiet") == 0) {
-        sa->quiet = true;
-    } else if (strcmp(a, "--no-deadline-fault") == 0) {
-        sa->o.deadline_faults = false;
-    } else if (strcmp(a, "--no-journal") == 0) {
-        sa->o.journal = false;
-    } else if (strcmp(a, "--discard-journal") == 0) {
-        sa->discard_journal = true;
-    } else if (strcmp(a, "--autosave-s") == 0 || strcmp(a, "--checkpoint-s") == 0) {
-        if (!cli_autosave_s(v, a[2] == 'a' ? &sa->o.autosave_s : &sa->o.checkpoint_s)) {
-            fprintf(stderr, "argil sculpt: %s needs " CLI_AUTOSAVE_EXPECTS " (see --help)\n", a);
-            return SCULPT_OPT_BAD;
-        }
-        (*i)++;
-    } else if (strcmp(a, "--debug-journal-dump") == 0) {
-        /* Tests: --debug-journal-dump N FILE.argil writes the model as of journal record N
-         * and ends the session there (tests/sys/test_crash_recovery.sh). */
-        char *end = NULL;
-        const unsigned long rec = v ? strtoul(v, &end, 10) : 0;
-        if (!v || *end != '\0' || rec < 1 || rec > 0xffffffffUL || *i + 2 >= argc) {
-            fprintf(stderr, "argil sculpt: --debug-journal-dump needs a record number >= 1 "
-                            "and a file\n");
-            return SCULPT_OPT_BAD;
-        }
-        sa->o.debug_dump_record = (uint32_t)rec;
-        sa->o.debug_dump_path = argv[*i + 2];
-        *i += 2;
-    } else if (strcmp(a, "--global-solve") == 0) {
-        if (!cli_global_solve(v, &sa->o.global_solve)) {
-            fprintf(stderr, "argil sculpt: --global-solve needs " CLI_GLOBAL_SOLVE_EXPECTS "\n");
-            return SCULPT_OPT_BAD;
-        }
-        (*i)++;
-    } else if (strcmp(a, "--undo-mb") == 0) {
-        char *end = NULL;
-        const long mb = v ? strtol(v, &end, 10) : -1;
-        if (!v || v[0] == '\0' || *end != '\0' || mb < 0 || mb > (long)SESSION_UNDO_MB_MAX) {
-            fprintf(stderr, "argil sculpt: --undo-mb needs MiB 0..%u (0: no undo)\n",
-                    SESSION_UNDO_MB_MAX);
-            return SCULPT_OPT_BAD;
-        }
-        (*i)++;
-        sa->o.undo_mb = (uint32_t)mb;
-    } else if (strcmp(a, "--rate-hz") == 0) {
-        if (!cli_rate_hz(v, &sa->o.tick_us)) {
-            fprintf(stderr, "argil sculpt: --rate-hz needs " CLI_RATE_HZ_EXPECTS "\n");
-            return SCULPT_OPT_BAD;
-        }
-        (*i)++;
-    } else if (strcmp(a, "--knot-ratio") == 0) {
-        if (!cli_knot_ratio(v, &sa->o.knot_ratio)) {
-            fprintf(stderr, "argil sculpt: --knot-ratio needs " CLI_KNOT_RATIO_EXPECTS "\n");
-            return SCULPT_OPT_BAD;
-        }
-        (*i)++;
-    } else {
-        return SCULPT_OPT_OTHER;
+    char *end = NULL;
+    const unsigned long rec = v ? strtoul(v, &end, 10) : 0;
+    if (!v || *end != '\0' || rec < 1 || rec > 0xffffffffUL || *i + 2 >= argc) {
+        fprintf(stderr, "argil sculpt: --debug-journal-dump needs a record number >= 1 "
+                        "and a file\n");
+        return CLI_OPT_BAD;
     }
-    return SCULPT_OPT_TAKEN;
+    sa->o.debug_dump_record = (uint32_t)rec;
+    sa->o.debug_dump_path = argv[*i + 2];
+    *i += 2;
+    return CLI_OPT_TAKEN;
 }
 
-/* The options that name a device, a file or a directory, or the board's window edge. *i moves
- * past the value. */
-static sculpt_opt_t parse_valued_option(sculpt_args_t *sa, int argc, char **argv, int *i)
+/* --device (only sim) and the board's window edge --window. *i moves past the value. */
+static cli_opt_t parse_valued_option(sculpt_args_t *sa, int argc, char **argv, int *i)
 {
     const char *a = argv[*i];
-    const char *v = *i + 1 < argc ? argv[*i + 1] : NULL;
-    if (strcmp(a, "--device") != 0 && strcmp(a, "--script") != 0 && strcmp(a, "--out") != 0 &&
-        strcmp(a, "--window") != 0 && strcmp(a, "--screenshot") != 0)
-        return SCULPT_OPT_OTHER;
-    if (!v) {
-        fprintf(stderr, "argil sculpt: %s needs a value (see --help)\n", a);
-        return SCULPT_OPT_BAD;
-    }
-    (*i)++;
+    if (strcmp(a, "--device") != 0 && strcmp(a, "--window") != 0)
+        return CLI_OPT_OTHER;
+    const char *v = cli_value("sculpt", "a value", argc, argv, i);
+    if (!v)
+        return CLI_OPT_BAD;
     if (strcmp(a, "--device") == 0) {
         if (strcmp(v, "sim") != 0) {
             fprintf(stderr,
                     "argil sculpt: device '%s': a scripted session runs on 'sim' (the "
                     "simulated arm); for a board use 'argil connect --device %s'\n",
                     v, v);
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
-    } else if (strcmp(a, "--script") == 0) {
-        sa->o.script_path = v;
-    } else if (strcmp(a, "--out") == 0) {
-        sa->o.out_dir = v;
-    } else if (strcmp(a, "--screenshot") == 0) {
-        sa->screenshot = v;
     } else {
         char *end;
         const long n = strtol(v, &end, 10);
         if (*end != '\0' || n < 4 || n > 32) {
             fprintf(stderr, "argil sculpt: --window must be a whole number 4..32, got '%s'\n",
                     v);
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         sa->o.window_edge = (int)n;
     }
-    return SCULPT_OPT_TAKEN;
+    return CLI_OPT_TAKEN;
 }
 
 /* The live window's options (docs/render.md). *i moves past any value taken. */
-static sculpt_opt_t parse_window_option(sculpt_args_t *sa, int argc, char **argv, int *i)
+static cli_opt_t parse_window_option(sculpt_args_t *sa, int argc, char **argv, int *i)
 {
     const char *a = argv[*i];
     const char *v = *i + 1 < argc ? argv[*i + 1] : NULL;
     sculpt_window_opts_t *wo = &sa->wo;
-    if (strcmp(a, "--headless") == 0 || strcmp(a, "--fast") == 0 || strcmp(a, "--mouse") == 0) {
-        *(a[2] == 'h' ? &sa->headless : a[2] == 'f' ? &wo->fast : &wo->mouse) = true;
-    } else if (strcmp(a, "--screenshot-every") == 0 || strcmp(a, "--linger") == 0) {
+    if (strcmp(a, "--screenshot-every") == 0 || strcmp(a, "--linger") == 0) {
         char *end = NULL;
         const double x = v ? strtod(v, &end) : 0.0;
         const double hi = a[2] == 's' ? 3.6e6 : 3600.0;
         if (!v || *end != '\0' || !(x >= 0.0 && x <= hi)) {
             fprintf(stderr, "argil sculpt: %s needs a number 0..%g (see --help)\n", a, hi);
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         (*i)++;
         if (a[2] == 's')
@@ -245,7 +184,7 @@ static sculpt_opt_t parse_window_option(sculpt_args_t *sa, int argc, char **argv
         const long px = v ? strtol(v, &end, 10) : 0;
         if (!v || *end != '\0' || px < 64 || px > 8192) {
             fprintf(stderr, "argil sculpt: %s needs pixels 64..8192 (see --help)\n", a);
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         (*i)++;
         *(a[2] == 'w' ? &wo->width : &wo->height) = (int)px;
@@ -255,7 +194,7 @@ static sculpt_opt_t parse_window_option(sculpt_args_t *sa, int argc, char **argv
         if (!v || *end != '\0' || !(x >= 0.05 && x <= 0.95)) {
             fprintf(stderr, "argil sculpt: --iso2 needs a density level 0.05..0.95 (the "
                             "clay's is 0.5)\n");
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         (*i)++;
         wo->iso2 = (float)x;
@@ -263,49 +202,54 @@ static sculpt_opt_t parse_window_option(sculpt_args_t *sa, int argc, char **argv
         colour_map_t cm;
         if (!v || !colour_map_parse(v, &cm)) {
             fprintf(stderr, "argil sculpt: --colour needs stiffness, mass or none\n");
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         (*i)++;
         wo->colour = (int)cm;
     } else if (strcmp(a, "--input") == 0) {
         if (!v) {
             fprintf(stderr, "argil sculpt: --input needs a file (see --help)\n");
-            return SCULPT_OPT_BAD;
+            return CLI_OPT_BAD;
         }
         wo->input_path = argv[++*i];
     } else {
-        return SCULPT_OPT_OTHER;
+        return CLI_OPT_OTHER;
     }
-    return SCULPT_OPT_TAKEN;
+    return CLI_OPT_TAKEN;
 }
 
-/* Reads the command line into sa (defaults first). Returns -1 to go on, else the exit status
- * to end with: 0 after --help, 2 after a usage error (said on stderr). */
-static int parse_sculpt_args(int argc, char **argv, sculpt_args_t *sa)
+/* The options of argil sculpt that are not flags: the session's, the valued and the window's. */
+static cli_opt_t parse_sculpt_option(void *opts, int argc, char **argv, int *i)
 {
-    memset(sa, 0, sizeof(*sa));
-    session_opts_default(&sa->o);
-    sculpt_window_opts_default(&sa->wo);
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage_sculpt(stdout);
-            return 0;
-        }
-        sculpt_opt_t r = parse_session_option(sa, argc, argv, &i);
-        if (r == SCULPT_OPT_OTHER)
-            r = parse_valued_option(sa, argc, argv, &i);
-        if (r == SCULPT_OPT_OTHER)
-            r = parse_window_option(sa, argc, argv, &i);
-        if (r == SCULPT_OPT_BAD)
-            return 2;
-        if (r == SCULPT_OPT_OTHER) {
-            fprintf(stderr, "argil sculpt: unknown option '%s' (see --help)\n", a);
-            return 2;
-        }
-    }
-    return -1;
+    sculpt_args_t *sa = opts;
+    cli_opt_t r = parse_session_option(sa, argc, argv, i);
+    if (r == CLI_OPT_OTHER)
+        r = parse_valued_option(sa, argc, argv, i);
+    if (r == CLI_OPT_OTHER)
+        r = parse_window_option(sa, argc, argv, i);
+    return r;
 }
+
+/* argil sculpt's command line (cli_parse). */
+static const cli_flag_t SCULPT_FLAGS[] = {
+    {"--quiet", offsetof(sculpt_args_t, quiet), true},
+    {"--no-deadline-fault", offsetof(sculpt_args_t, o.deadline_faults), false},
+    {"--no-journal", offsetof(sculpt_args_t, o.journal), false},
+    {"--discard-journal", offsetof(sculpt_args_t, discard_journal), true},
+    {"--headless", offsetof(sculpt_args_t, headless), true},
+    {"--fast", offsetof(sculpt_args_t, wo.fast), true},
+    {"--mouse", offsetof(sculpt_args_t, wo.mouse), true},
+};
+static const cli_word_t SCULPT_WORDS[] = {
+    {"--script", offsetof(sculpt_args_t, o.script_path)},
+    {"--out", offsetof(sculpt_args_t, o.out_dir)},
+    {"--screenshot", offsetof(sculpt_args_t, screenshot)},
+};
+static const cli_cmd_t SCULPT_CLI = {
+    .name = "sculpt", .usage = usage_sculpt, .option = parse_sculpt_option,
+    .flags = SCULPT_FLAGS, .n_flags = sizeof(SCULPT_FLAGS) / sizeof(SCULPT_FLAGS[0]),
+    .words = SCULPT_WORDS, .n_words = sizeof(SCULPT_WORDS) / sizeof(SCULPT_WORDS[0]),
+};
 
 /* The window's options need a window: a display (DISPLAY) and no --headless. Returns false,
  * having said which option on stderr, when one is given without. */
@@ -354,7 +298,6 @@ static argil_err_t run_sculpt_session(sculpt_args_t *sa, bool live, session_summ
     return rc;
 }
 
-/* The summary's lines on time: ticks, their compute time, the board's RT reports, the solve. */
 /* " 12 345 …\n": the tick numbers the summary kept of count ticks (the first ones). */
 static void print_ticks(const uint32_t *kept, uint32_t count)
 {
@@ -363,6 +306,7 @@ static void print_ticks(const uint32_t *kept, uint32_t count)
     printf("%s\n", count > SESSION_PREEMPTED_KEPT ? " …" : "");
 }
 
+/* The summary's lines on time: ticks, their compute time, the board's RT reports, the solve. */
 static void print_timing(const sculpt_args_t *sa, const session_summary_t *s)
 {
     const session_opts_t *o = &sa->o;
@@ -462,29 +406,35 @@ static void print_result(const sculpt_args_t *sa, const session_summary_t *s)
 }
 
 /* With --screenshot, renders the final clay with the tool where it ended (as `argil view`
- * would). Returns the exit status: 1 when the render failed. */
-static int render_screenshot(const sculpt_args_t *sa, const session_summary_t *s)
+ * would); the render's error (said on stderr). */
+static argil_err_t render_screenshot(const sculpt_args_t *sa, const session_summary_t *s)
 {
     if (sa->screenshot == NULL || sa->o.out_dir == NULL || s->triangles == 0)
-        return 0;
+        return ARGIL_OK;
     char ply[4096], csv[4096];
     snprintf(ply, sizeof(ply), "%s/final.ply", sa->o.out_dir);
     snprintf(csv, sizeof(csv), "%s/telemetry.csv", sa->o.out_dir);
     char *view_argv[] = {ply, "--screenshot", (char *)sa->screenshot, "--telemetry", csv};
-    return cmd_view(5, view_argv) != 0 ? 1 : 0;
+    int view_status;
+    return cmd_view(5, view_argv, &view_status);
 }
 
-int cmd_sculpt(int argc, char **argv)
+/* argil sculpt: a session on the simulated arm, its files written into --out. */
+argil_err_t cmd_sculpt(int argc, char **argv, int *exit_status)
 {
     sculpt_args_t sa;
-    const int parsed = parse_sculpt_args(argc, argv, &sa);
-    if (parsed >= 0)
-        return parsed;
+    memset(&sa, 0, sizeof(sa));
+    session_opts_default(&sa.o);
+    sculpt_window_opts_default(&sa.wo);
+    bool done, go_on = true;
+    const argil_err_t pe = cli_parse(&SCULPT_CLI, &sa, argc, argv, &done, exit_status);
+    if (done)
+        return pe;
     if (sa.o.journal) {
-        const int offer = recover_offer(sa.o.out_dir, sa.discard_journal,
-                                        isatty(STDIN_FILENO) != 0);
-        if (offer >= 0)
-            return offer;
+        const argil_err_t oe = recover_offer(sa.o.out_dir, sa.discard_journal,
+                                             isatty(STDIN_FILENO) != 0, &go_on, exit_status);
+        if (!go_on)
+            return oe;
     }
     sa.o.progress = !sa.quiet && isatty(STDERR_FILENO);
     sa.o.stop = &g_stop;
@@ -495,14 +445,14 @@ int cmd_sculpt(int argc, char **argv)
     const char *display = getenv("DISPLAY");
     const bool live = !sa.headless && display != NULL && display[0] != '\0';
     if (!window_options_fit(&sa, live))
-        return 2;
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
     session_summary_t s;
     char err[1024] = "";
     bool window_failed = false;
     const argil_err_t rc = run_sculpt_session(&sa, live, &s, &window_failed, err, sizeof(err));
     if (window_failed && sa.wo.mouse) {
         fprintf(stderr, "argil sculpt: %s\n", err);
-        return 1;
+        return cmd_end(exit_status, 1, rc);
     }
     if (!sa.quiet && s.board_ticks > 0) {
         print_timing(&sa, &s);
@@ -510,10 +460,10 @@ int cmd_sculpt(int argc, char **argv)
     }
     if (rc != ARGIL_OK) {
         fprintf(stderr, "argil sculpt: %s\n", err);
-        return 1;
+        return cmd_end(exit_status, 1, rc);
     }
-    const int shot = render_screenshot(&sa, &s);
-    if (shot != 0)
-        return shot;
-    return s.interrupted ? 130 : 0;
+    const argil_err_t shot = render_screenshot(&sa, &s);
+    if (shot != ARGIL_OK)
+        return cmd_end(exit_status, 1, shot);
+    return cmd_end(exit_status, s.interrupted ? 130 : 0, ARGIL_OK);
 }

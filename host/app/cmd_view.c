@@ -16,6 +16,7 @@
 #include "host/render/png_write.h"
 #include "host/render/telemetry_log.h"
 
+/* The text of `argil view --help`. */
 static void usage_view(FILE *f)
 {
     fprintf(f,
@@ -52,14 +53,15 @@ static void usage_view(FILE *f)
             "  -h, --help         this text\n");
 }
 
-/* Parses n floats from argv[*i + 1 …]; 0 on success (advancing *i), else prints and returns 2. */
-static int take_floats(int argc, char **argv, int *i, int n, float *out)
+/* Parses n floats from argv[*i + 1 …], advancing *i; a bad one is said on stderr
+ * (ARGIL_ERR_ARG). */
+static argil_err_t take_floats(int argc, char **argv, int *i, int n, float *out)
 {
     const char *opt = argv[*i];
     if (*i + n >= argc) {
         fprintf(stderr, "argil view: %s needs %d number%s (see --help)\n", opt, n,
                 n > 1 ? "s" : "");
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     for (int k = 0; k < n; k++) {
         const char *s = argv[*i + 1 + k];
@@ -67,20 +69,22 @@ static int take_floats(int argc, char **argv, int *i, int n, float *out)
         const double d = strtod(s, &end);
         if (end == s || *end != '\0' || !isfinite(d) || fabs(d) > 1e6) {
             fprintf(stderr, "argil view: %s: '%s' is not a number (within ±1e6)\n", opt, s);
-            return 2;
+            return ARGIL_ERR_ARG;
         }
         out[k] = (float)d;
     }
     *i += n;
-    return 0;
+    return ARGIL_OK;
 }
 
-static int take_int(int argc, char **argv, int *i, int lo, int hi, int *out)
+/* Parses argv[*i + 1] as a whole number in lo … hi, advancing *i; a bad one is said on stderr
+ * (ARGIL_ERR_ARG). */
+static argil_err_t take_int(int argc, char **argv, int *i, int lo, int hi, int *out)
 {
     const char *opt = argv[*i];
     if (*i + 1 >= argc) {
         fprintf(stderr, "argil view: %s needs a value (see --help)\n", opt);
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     const char *s = argv[++*i];
     char *end;
@@ -88,10 +92,10 @@ static int take_int(int argc, char **argv, int *i, int lo, int hi, int *out)
     if (end == s || *end != '\0' || v < lo || v > hi) {
         fprintf(stderr, "argil view: %s must be a whole number %d..%d, got '%s'\n", opt, lo, hi,
                 s);
-        return 2;
+        return ARGIL_ERR_ARG;
     }
     *out = (int)v;
-    return 0;
+    return ARGIL_OK;
 }
 
 /* Area-weighted vertex normals for meshes read without any. */
@@ -168,7 +172,8 @@ static argil_err_t load_model(const char *path, float iso2, mesh_t *m, mesh_t *w
     return rc;
 }
 
-static int run_screenshot(const mesh_t *m, const mesh_t *wire, render_scene_t *s,
+/* Renders one frame offscreen and writes it to png (said on stderr when it cannot). */
+static argil_err_t run_screenshot(const mesh_t *m, const mesh_t *wire, render_scene_t *s,
                           camera_t *cam, render_backend_t backend, int w, int h, const char *png)
 {
     char err[512] = "";
@@ -178,49 +183,50 @@ static int run_screenshot(const mesh_t *m, const mesh_t *wire, render_scene_t *s
         free(o);
         free(rgb);
         fprintf(stderr, "argil view: out of memory for a %d x %d image\n", w, h);
-        return 1;
+        return ARGIL_ERR_NOMEM;
     }
-    int status = 1;
-    if (offscreen_open(o, backend, w, h, err, sizeof(err)) != ARGIL_OK) {
+    argil_err_t e = offscreen_open(o, backend, w, h, err, sizeof(err));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
-    } else if (renderer_set_mesh(&o->renderer, m) != ARGIL_OK ||
-               renderer_set_wire_mesh(&o->renderer, wire) != ARGIL_OK) {
+    } else if ((e = renderer_set_mesh(&o->renderer, m)) != ARGIL_OK ||
+               (e = renderer_set_wire_mesh(&o->renderer, wire)) != ARGIL_OK) {
         fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
     } else {
         camera_matrices(cam, (float)w / (float)h, s->view, s->proj);
         offscreen_render(o, s, rgb);
-        if (png_write_rgb(png, w, h, rgb, err, sizeof(err)) != ARGIL_OK)
+        if ((e = png_write_rgb(png, w, h, rgb, err, sizeof(err))) != ARGIL_OK)
             fprintf(stderr, "argil view: %s\n", err);
-        else
-            status = 0;
     }
     offscreen_close(o);
     free(o);
     free(rgb);
-    return status;
+    return e;
 }
 
-static int run_window(const mesh_t *m, const mesh_t *wire, render_scene_t *s, camera_t *cam,
+/* Shows the mesh in a window with a trackball camera until it is closed or Esc. */
+static argil_err_t run_window(const mesh_t *m, const mesh_t *wire, render_scene_t *s, camera_t *cam,
                       int w, int h, const char *title)
 {
     char err[512] = "";
     glfw_window_t win;
     gl_api_t gl;
     renderer_t r;
-    if (glfw_window_open(&win, w, h, true, 4, title, &gl, err, sizeof(err)) != ARGIL_OK) {
+    argil_err_t e = glfw_window_open(&win, w, h, true, 4, title, &gl, err, sizeof(err));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil view: %s (use --screenshot FILE.png without a display)\n", err);
-        return 1;
+        return e;
     }
-    if (renderer_init(&r, &gl, err, sizeof(err)) != ARGIL_OK) {
+    if ((e = renderer_init(&r, &gl, err, sizeof(err))) != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         glfw_window_close(&win);
-        return 1;
+        return e;
     }
-    if (renderer_set_mesh(&r, m) != ARGIL_OK || renderer_set_wire_mesh(&r, wire) != ARGIL_OK) {
+    if ((e = renderer_set_mesh(&r, m)) != ARGIL_OK ||
+        (e = renderer_set_wire_mesh(&r, wire)) != ARGIL_OK) {
         fprintf(stderr, "argil view: the GPU did not take the mesh (%zu triangles)\n", m->n_tri);
         renderer_free(&r);
         glfw_window_close(&win);
-        return 1;
+        return e;
     }
     gl.Enable(GL_MULTISAMPLE);
     glfw_input_t in, prev = {0};
@@ -242,7 +248,7 @@ static int run_window(const mesh_t *m, const mesh_t *wire, render_scene_t *s, ca
     }
     renderer_free(&r);
     glfw_window_close(&win);
-    return 0;
+    return ARGIL_OK;
 }
 
 /* What argil view's command line asks for. */
@@ -258,9 +264,9 @@ typedef struct {
     int have_tool, have_force;
 } view_opts_t;
 
-/* Takes the value v of --screenshot, --telemetry, --mode or --backend (a); 0, else prints and
- * returns 2. */
-static int take_word(const char *a, const char *v, view_opts_t *o)
+/* Takes the value v of --screenshot, --telemetry, --mode or --backend (a); a bad one is said
+ * on stderr (ARGIL_ERR_ARG). */
+static argil_err_t take_word(const char *a, const char *v, view_opts_t *o)
 {
     if (strcmp(a, "--screenshot") == 0) {
         o->png = v;
@@ -273,7 +279,7 @@ static int take_word(const char *a, const char *v, view_opts_t *o)
             o->scene.mode = RENDER_MODE_CLEARCOAT;
         else {
             fprintf(stderr, "argil view: unknown mode '%s' (plain, clearcoat)\n", v);
-            return 2;
+            return ARGIL_ERR_ARG;
         }
     } else {
         if (strcmp(v, "auto") == 0)
@@ -284,16 +290,17 @@ static int take_word(const char *a, const char *v, view_opts_t *o)
             o->backend = RENDER_BACKEND_GLFW;
         else {
             fprintf(stderr, "argil view: unknown backend '%s' (auto, egl, glfw)\n", v);
-            return 2;
+            return ARGIL_ERR_ARG;
         }
     }
-    return 0;
+    return ARGIL_OK;
 }
 
-/* Parses the options into o; returns -1 to go on, else the exit status (--help: 0; a bad
- * option: 2, one line said why). */
-static int parse_view_opts(int argc, char **argv, view_opts_t *o)
+/* Parses the options into o: ARGIL_OK to go on, or with *help after --help (the usage printed);
+ * ARGIL_ERR_ARG for a bad option (one line said why). */
+static argil_err_t parse_view_opts(int argc, char **argv, view_opts_t *o, bool *help)
 {
+    *help = false;
     memset(o, 0, sizeof(*o));
     o->w = 1024;
     o->h = 768;
@@ -301,15 +308,16 @@ static int parse_view_opts(int argc, char **argv, view_opts_t *o)
     render_scene_default(&o->scene);
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        int rc = 0;
+        argil_err_t rc = ARGIL_OK;
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
             usage_view(stdout);
-            return 0;
+            *help = true;
+            return ARGIL_OK;
         } else if (strcmp(a, "--screenshot") == 0 || strcmp(a, "--mode") == 0 ||
                    strcmp(a, "--backend") == 0 || strcmp(a, "--telemetry") == 0) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "argil view: %s needs a value (see --help)\n", a);
-                return 2;
+                return ARGIL_ERR_ARG;
             }
             rc = take_word(a, argv[++i], o);
         } else if (strcmp(a, "--width") == 0) {
@@ -319,9 +327,9 @@ static int parse_view_opts(int argc, char **argv, view_opts_t *o)
         } else if (strcmp(a, "--tool") == 0) {
             rc = take_floats(argc, argv, &i, 4, o->tool);
             o->have_tool = 1;
-            if (rc == 0 && !(o->tool[3] > 0.0f)) {
+            if (rc == ARGIL_OK && !(o->tool[3] > 0.0f)) {
                 fprintf(stderr, "argil view: --tool radius must be > 0 mm\n");
-                return 2;
+                return ARGIL_ERR_ARG;
             }
         } else if (strcmp(a, "--force") == 0) {
             rc = take_floats(argc, argv, &i, 3, o->force);
@@ -332,9 +340,9 @@ static int parse_view_opts(int argc, char **argv, view_opts_t *o)
         } else if (strcmp(a, "--key") == 0 || strcmp(a, "--fill") == 0) {
             float d[3];
             rc = take_floats(argc, argv, &i, 3, d);
-            if (rc == 0 && vec3_norm(vec3(d[0], d[1], d[2])) < 1e-6f) {
+            if (rc == ARGIL_OK && vec3_norm(vec3(d[0], d[1], d[2])) < 1e-6f) {
                 fprintf(stderr, "argil view: %s needs a non-zero direction\n", a);
-                return 2;
+                return ARGIL_ERR_ARG;
             }
             if (a[2] == 'k')
                 o->scene.key.dir = vec3(d[0], d[1], d[2]);
@@ -346,39 +354,40 @@ static int parse_view_opts(int argc, char **argv, view_opts_t *o)
             rc = take_floats(argc, argv, &i, 1, &o->pitch_deg);
         } else if (strcmp(a, "--iso2") == 0) {
             rc = take_floats(argc, argv, &i, 1, &o->iso2);
-            if (rc == 0 && !(o->iso2 >= 0.05f && o->iso2 <= 0.95f)) {
+            if (rc == ARGIL_OK && !(o->iso2 >= 0.05f && o->iso2 <= 0.95f)) {
                 fprintf(stderr, "argil view: --iso2 needs a density level 0.05..0.95 (the "
                                 "surface is 0.5)\n");
-                return 2;
+                return ARGIL_ERR_ARG;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
             fprintf(stderr, "argil view: unknown option '%s' (see --help)\n", a);
-            return 2;
+            return ARGIL_ERR_ARG;
         } else if (o->model == NULL) {
             o->model = a;
         } else {
             fprintf(stderr, "argil view: one model at a time ('%s' and '%s')\n", o->model, a);
-            return 2;
+            return ARGIL_ERR_ARG;
         }
-        if (rc != 0)
+        if (rc != ARGIL_OK)
             return rc;
     }
     if (o->model == NULL) {
         usage_view(stderr);
-        return 2;
+        return ARGIL_ERR_ARG;
     }
-    return -1;
+    return ARGIL_OK;
 }
 
 /* With --telemetry, the tool (radius 4 mm) and the force not given default to the log's last
- * row; 0, else prints and returns 1. */
-static int take_telemetry(view_opts_t *o)
+ * row; a log that cannot be read is said on stderr. */
+static argil_err_t take_telemetry(view_opts_t *o)
 {
     char err[1024] = "";
     telemetry_log_t log;
-    if (telemetry_log_read(o->csv, &log, err, sizeof(err)) != ARGIL_OK) {
+    const argil_err_t e = telemetry_log_read(o->csv, &log, err, sizeof(err));
+    if (e != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
-        return 1;
+        return e;
     }
     const size_t last = log.n - 1;
     if (!o->have_tool) {
@@ -391,7 +400,7 @@ static int take_telemetry(view_opts_t *o)
         o->have_force = 1;
     }
     telemetry_log_free(&log);
-    return 0;
+    return ARGIL_OK;
 }
 
 /* Puts the tool, the force and the box the options give into the scene, in metres. */
@@ -411,65 +420,66 @@ static void place_in_scene(view_opts_t *o)
 }
 
 /* Reads the model into m with vertex normals (a .argil meshed at its surface level, and at
- * --iso2 into wire; else a mesh file); 0, else prints and returns the exit status with nothing
- * left to free. */
-static int load_view_mesh(view_opts_t *o, mesh_t *m, mesh_t *wire)
+ * --iso2 into wire; else a mesh file); when it cannot, says why on stderr, sets the exit status
+ * (2: --iso2 given for a mesh, else 1) and leaves nothing to free. */
+static argil_err_t load_view_mesh(view_opts_t *o, mesh_t *m, mesh_t *wire, int *exit_status)
 {
     char err[1024] = "";
     const char *model = o->model;
     bool has_normals = false;
     const size_t len = strlen(model);
+    argil_err_t e;
     if (len > 6 && strcmp(model + len - 6, ".argil") == 0) {
-        if (load_model(model, o->iso2, m, wire, &o->scene, err, sizeof(err)) != ARGIL_OK) {
+        if ((e = load_model(model, o->iso2, m, wire, &o->scene, err, sizeof(err))) != ARGIL_OK) {
             fprintf(stderr, "argil view: %s\n", err);
             mesh_free(m);
             mesh_free(wire);
-            return 1;
+            return cmd_end(exit_status, 1, e);
         }
         has_normals = true;
     } else if (o->iso2 > 0.0f) {
         fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
                         "model, or use 'argil sculpt --iso2')\n", model);
-        return 2;
-    } else if (mesh_import(model, m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+        return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
+    } else if ((e = mesh_import(model, m, &has_normals, err, sizeof(err))) != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
-        return 1;
+        return cmd_end(exit_status, 1, e);
     }
     if (m->n_tri == 0) {
         fprintf(stderr, "argil view: %s: no triangles to draw (a point cloud?)\n", model);
         mesh_free(m);
         mesh_free(wire);
-        return 1;
+        return cmd_end(exit_status, 1, ARGIL_ERR_EMPTY);
     }
     if (!has_normals)
         normals_from_faces(m);
-    return 0;
+    return ARGIL_OK;
 }
 
 /* argil view: draws MODEL to a PNG or in a window; the exit status. */
-int cmd_view(int argc, char **argv)
+argil_err_t cmd_view(int argc, char **argv, int *exit_status)
 {
     view_opts_t o;
-    const int st = parse_view_opts(argc, argv, &o);
-    if (st >= 0)
-        return st;
-    if (o.csv != NULL && take_telemetry(&o) != 0)
-        return 1;
+    bool help;
+    argil_err_t e = parse_view_opts(argc, argv, &o, &help);
+    if (e != ARGIL_OK || help)
+        return cmd_end(exit_status, help ? 0 : 2, e);
+    if (o.csv != NULL && (e = take_telemetry(&o)) != ARGIL_OK)
+        return cmd_end(exit_status, 1, e);
     place_in_scene(&o);
     mesh_t m, wire;
     mesh_init(&m);
     mesh_init(&wire);
-    const int load = load_view_mesh(&o, &m, &wire);
-    if (load != 0)
-        return load;
+    if ((e = load_view_mesh(&o, &m, &wire, exit_status)) != ARGIL_OK)
+        return e;
     vec3_t lo, hi;
     scene_bounds(&m, &o.scene, &lo, &hi);
     camera_t cam;
     camera_frame(&cam, lo, hi);
     camera_orbit(&cam, o.yaw_deg * (float)M_PI / 180.0f, o.pitch_deg * (float)M_PI / 180.0f);
-    const int status = o.png ? run_screenshot(&m, &wire, &o.scene, &cam, o.backend, o.w, o.h, o.png)
-                             : run_window(&m, &wire, &o.scene, &cam, o.w, o.h, o.model);
+    e = o.png ? run_screenshot(&m, &wire, &o.scene, &cam, o.backend, o.w, o.h, o.png)
+              : run_window(&m, &wire, &o.scene, &cam, o.w, o.h, o.model);
     mesh_free(&m);
     mesh_free(&wire);
-    return status;
+    return cmd_end(exit_status, e == ARGIL_OK ? 0 : 1, e);
 }

@@ -8,7 +8,7 @@
 /* Every subcommand: one line here and one declaration in commands.h. */
 static const struct {
     const char *name;
-    int (*run)(int argc, char **argv);
+    argil_err_t (*run)(int argc, char **argv, int *exit_status);
     const char *summary;
 } COMMANDS[] = {
     {"sculpt", cmd_sculpt, "run a sculpting session (see 'argil sculpt --help')"},
@@ -22,6 +22,7 @@ static const struct {
     {"keygen", cmd_keygen, "make a UDP link key file for board and host (see 'argil keygen --help')"},
 };
 
+/* The text of `argil --help`: the commands with their one-line summaries. */
 static void usage_main(FILE *f)
 {
     fprintf(f, "usage: argil COMMAND [OPTIONS]\n\n"
@@ -32,6 +33,7 @@ static void usage_main(FILE *f)
     fprintf(f, "  %-9s %s\n", "help", "show this text");
 }
 
+/* Runs the command argv[1] names; the process ends with the exit status it set. */
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -39,8 +41,12 @@ int main(int argc, char **argv)
         return 2;
     }
     for (size_t i = 0; i < sizeof(COMMANDS) / sizeof(COMMANDS[0]); i++)
-        if (strcmp(argv[1], COMMANDS[i].name) == 0)
-            return COMMANDS[i].run(argc - 2, argv + 2);
+        if (strcmp(argv[1], COMMANDS[i].name) == 0) {
+            /* The command has said what went wrong; its exit status is the process's. */
+            int exit_status = 1;
+            (void)COMMANDS[i].run(argc - 2, argv + 2, &exit_status);
+            return exit_status;
+        }
     if (strcmp(argv[1], "help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "--help") == 0) {
         usage_main(stdout);
