@@ -49,11 +49,14 @@ HOST_SRC := $(filter-out host/app/main.c,$(wildcard host/*/*.c))
 LINK_AUTH_SRC := firmware/hal/link_auth.c firmware/hal/link_key.c
 LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(wildcard $(HAL_SIM_SRC)) $(LINK_AUTH_SRC) $(SIM_SRC) $(RIG_SRC) $(HOST_SRC)
 RT_SRC := $(SHARED_SRC) $(CORE_SRC)
+# bus/: hosted Linux access to a real CAN bus (SocketCAN) and GPIO chip (libgpiod), for the
+# board daemon's HAL and for argil-sim, which plays the drives on such a bus.
+BUS_SRC := $(wildcard bus/*.c)
 # argil-board, the Linux board daemon: the core, the simulated arm (its --bus sim), the Linux
-# HAL (SocketCAN, libgpiod, UDP/FunctionFS link) and firmware/board/.
-BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/hal_sim_bus.c firmware/hal/can_socket.c \
-                 firmware/hal/gpio_port.c firmware/hal/gpio_gpiod.c firmware/hal/link_udp.c \
-                 firmware/hal/link_bind.c firmware/hal/link_ffs.c $(LINK_AUTH_SRC)
+# HAL (SocketCAN and libgpiod through bus/, UDP/FunctionFS link) and firmware/board/.
+BOARD_HAL_SRC := firmware/hal/hal_linux.c firmware/hal/hal_sim_bus.c firmware/hal/gpio_port.c \
+                 firmware/hal/link_udp.c firmware/hal/link_bind.c firmware/hal/link_ffs.c \
+                 $(BUS_SRC) $(LINK_AUTH_SRC)
 BOARD_SRC := $(filter-out firmware/board/main.c,$(wildcard firmware/board/*.c)) $(BOARD_HAL_SRC)
 BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
 # libinih (Debian's libinih-dev): reads argil-board's INI file, under the rules board_config.c
@@ -61,7 +64,7 @@ BOARD_LIB_SRC := $(SHARED_SRC) $(CORE_SRC) $(SIM_SRC) $(BOARD_SRC)
 INI_LDLIBS := -linih
 BOARD_LDLIBS := -lgpiod -lsodium $(INI_LDLIBS) -lpthread -lm
 # Sources a fuzz target may need beyond LIB_SRC (the board's config parser: libinih, no libgpiod).
-FUZZ_EXTRA_SRC := firmware/board/board_config.c firmware/hal/gpio_port.c
+FUZZ_EXTRA_SRC := firmware/board/board_config.c bus/gpio_names.c
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
 SIL_TESTS := $(patsubst tests/sil/%.c,%,$(wildcard tests/sil/test_*.c))

@@ -10,10 +10,14 @@
 # layer of a file         may include
 #   shared/               shared/
 #   firmware/core/        firmware/core/, shared/, and the HAL interface firmware/hal/hal.h
-#   firmware/hal/         firmware/hal/, shared/  (the sim backends hal_sim.*, hal_sim_bus.* also sim/)
-#   firmware/board/,      firmware/core/, firmware/hal/, shared/  (the daemon's and the MCU
+#   bus/                  bus/, shared/  (hosted Linux access to a real CAN bus and GPIO chip)
+#   firmware/hal/         firmware/hal/, bus/, shared/  (the sim backends hal_sim.*, hal_sim_bus.*
+#                         also sim/)
+#   firmware/board/,      firmware/core/, firmware/hal/, bus/, shared/  (the daemon's and the MCU
 #   firmware/cortexm/     image's mains compose the core and a HAL)
 #   sim/rig/              firmware/, sim/, shared/, host/link/link.h
+#   sim/app/              sim/ (not sim/rig/), bus/, shared/  (argil-sim plays the drives on a
+#                         real bus)
 #   sim/                  sim/ (not sim/rig/), shared/
 #   host/                 host/, shared/, sim/rig/rig.h
 #   hil/, tests/          anything
@@ -22,17 +26,19 @@ root=${1:-.}
 known="$root/toolchain/layers-known.txt"
 [ -f "$known" ] || known=/dev/null
 cd "$root"
-files=$(find shared firmware sim host hil tests -type f \( -name '*.c' -o -name '*.h' \) 2>/dev/null | LC_ALL=C sort)
+files=$(find shared bus firmware sim host hil tests -type f \( -name '*.c' -o -name '*.h' \) 2>/dev/null | LC_ALL=C sort)
 [ -n "$files" ] || { echo "check-layers: no C sources under $root" >&2; exit 1; }
 # shellcheck disable=SC2086
 awk -v known="$known" '
 function layer(p) {
     if (p ~ /^shared\//) return "shared"
+    if (p ~ /^bus\//) return "bus"
     if (p ~ /^firmware\/core\//) return "core"
     if (p ~ /^firmware\/hal\/hal_sim(_bus)?\.[ch]$/) return "hal_sim"
     if (p ~ /^firmware\/hal\//) return "hal"
     if (p ~ /^firmware\/(board|cortexm)\//) return "main"
     if (p ~ /^sim\/rig\//) return "rig"
+    if (p ~ /^sim\/app\//) return "sim_app"
     if (p ~ /^sim\//) return "sim"
     if (p ~ /^host\//) return "host"
     if (p ~ /^(hil|tests)\//) return "any"
@@ -43,16 +49,19 @@ function broken(l, p,    t) {
     t = layer(p)
     if (l == "any" || l == "other" || t == "other") return ""
     if (l == "shared") return t == "shared" ? "" : "shared/ includes only shared/"
+    if (l == "bus") return (t == "bus" || t == "shared") ? "" : "bus/ includes only bus/ and shared/"
     if (l == "core") return (t == "core" || t == "shared" || p == "firmware/hal/hal.h") ? "" : \
         "firmware/core includes only firmware/core, shared/ and firmware/hal/hal.h"
-    if (l == "hal") return (t == "hal" || t == "hal_sim" || t == "shared") ? "" : \
-        "firmware/hal includes only firmware/hal and shared/ (sim/ only from hal_sim.*, hal_sim_bus.*)"
+    if (l == "hal") return (t == "hal" || t == "hal_sim" || t == "bus" || t == "shared") ? "" : \
+        "firmware/hal includes only firmware/hal, bus/ and shared/ (sim/ only from hal_sim.*, hal_sim_bus.*)"
     if (l == "hal_sim") return (t == "hal" || t == "hal_sim" || t == "shared" || t == "sim") ? "" : \
         "the sim HAL includes only firmware/hal, sim/ and shared/"
-    if (l == "main") return (t == "core" || t == "hal" || t == "hal_sim" || t == "shared" || t == "main") ? "" : \
-        "a firmware main composes only firmware/ and shared/"
+    if (l == "main") return (t ~ /^(core|hal|hal_sim|bus|shared|main)$/) ? "" : \
+        "a firmware main composes only firmware/, bus/ and shared/"
     if (l == "rig") return (t ~ /^(core|hal|hal_sim|main|sim|rig|shared)$/ || p == "host/link/link.h") ? "" : \
         "sim/rig includes only firmware/, sim/, shared/ and host/link/link.h"
+    if (l == "sim_app") return (t == "sim" || t == "sim_app" || t == "bus" || t == "shared") ? "" : \
+        "sim/app includes only sim/ (not sim/rig), bus/ and shared/"
     if (l == "sim") return (t == "sim" || t == "shared") ? "" : "sim/ includes only sim/ and shared/"
     if (l == "host") return (t == "host" || t == "shared" || p == "sim/rig/rig.h") ? "" : \
         "host/ includes only host/, shared/ and sim/rig/rig.h"

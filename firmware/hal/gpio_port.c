@@ -13,24 +13,6 @@ static const uint32_t in_bits[GPIO_IN_COUNT] = {GPIO_IN_ESTOP_N, GPIO_IN_DRIVE_F
 static const uint32_t out_bits[GPIO_OUT_COUNT] = {GPIO_OUT_DRIVE_ENABLE, GPIO_OUT_STATUS_LED,
                                                   GPIO_OUT_WDOG_KICK};
 
-static void set_name(char *dst, const char *src)
-{
-    memset(dst, 0, GPIO_NAME_LEN);
-    memcpy(dst, src, strlen(src) < GPIO_NAME_LEN ? strlen(src) : GPIO_NAME_LEN - 1u);
-}
-
-void gpio_names_default(gpio_names_t *n)
-{
-    set_name(n->chip, "gpiochip0");
-    set_name(n->in[0], "ESTOP_N");
-    set_name(n->in[1], "DRIVE_FAULT_N");
-    set_name(n->in[2], "STYLUS_BTN1");
-    set_name(n->in[3], "STYLUS_BTN2");
-    set_name(n->out[0], "DRIVE_ENABLE");
-    set_name(n->out[1], "STATUS_LED");
-    set_name(n->out[2], "WDOG_KICK");
-}
-
 static void release_all(gpio_port_t *p)
 {
     for (uint32_t i = 0; i < GPIO_OUT_COUNT; i++) {

@@ -10,7 +10,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "can_socket.h"
+#include "bus/can_socket.h"
 #include "gpio_port.h"
 #include "hal.h"
 #include "shared/spsc_ring.h"

@@ -25,8 +25,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/hal/can_socket.h"
-#include "firmware/hal/gpio_port.h"
+#include "bus/can_socket.h"
+#include "bus/gpio_chip.h"
 #include "shared/gpio_lines.h"
 #include "sim/scenario.h"
 #include "sim/scn_clock.h"

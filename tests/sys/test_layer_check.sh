@@ -6,7 +6,7 @@ set -u
 . tests/lib/report.sh
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-report_plan 5
+report_plan 7
 
 mkdir -p "$tmp/tree/host/app" "$tmp/tree/firmware/core" "$tmp/tree/shared" "$tmp/tree/toolchain"
 printf '#pragma once\n' >"$tmp/tree/shared/units.h"
@@ -29,6 +29,23 @@ if grep -q '^host/app/main.c:2: includes "firmware/core/safety.h": host/' "$tmp/
     report PASS planted_crossing_named
 else
     report FAIL planted_crossing_named "no host/app/main.c:2 line in: $(head -n 3 "$tmp/planted")"
+fi
+
+# bus/ (SocketCAN, libgpiod) serves the board's HAL and argil-sim, never the host.
+mkdir -p "$tmp/tree/bus" "$tmp/tree/sim/app"
+printf '#pragma once\n#include "shared/units.h"\n' >"$tmp/tree/bus/can_socket.h"
+printf '#include "bus/can_socket.h"\nint main(void) { return 0; }\n' >"$tmp/tree/sim/app/argil_sim_main.c"
+printf '#include "bus/can_socket.h"\nint main(void) { return 0; }\n' >"$tmp/tree/host/app/main.c"
+if sh toolchain/check-layers.sh "$tmp/tree" >"$tmp/bus" 2>&1; then
+    report FAIL host_includes_no_bus "host/app/main.c includes bus/can_socket.h and the check passed"
+else
+    report PASS host_includes_no_bus
+fi
+printf '#include "shared/units.h"\nint main(void) { return 0; }\n' >"$tmp/tree/host/app/main.c"
+if sh toolchain/check-layers.sh "$tmp/tree" >"$tmp/sim_bus" 2>&1; then
+    report PASS sim_app_may_include_bus
+else
+    report FAIL sim_app_may_include_bus "$(tail -n 3 "$tmp/sim_bus")"
 fi
 
 printf 'host/app/main.c shared/units.h\n' >"$tmp/tree/toolchain/layers-known.txt"

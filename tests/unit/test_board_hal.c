@@ -17,7 +17,7 @@
 
 #include "firmware/board/board_config.h"
 #include "firmware/core/drives.h"
-#include "firmware/hal/can_socket.h"
+#include "bus/can_socket.h"
 #include "firmware/hal/gpio_port.h"
 #include "firmware/hal/link_io.h"
 #include "shared/gpio_lines.h"

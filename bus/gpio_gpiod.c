@@ -2,7 +2,7 @@
 #include <gpiod.h>
 #include <stddef.h>
 
-#include "gpio_port.h"
+#include "gpio_chip.h"
 
 static void *chip_open(void *ctx, const char *chip)
 {
