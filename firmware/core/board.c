@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "shared/gpio_lines.h"
+#include "shared/wire.h"
 
 /* Empties the box of nodes with pending impulses. */
 static void impulse_box_clear(board_t *b)
@@ -225,8 +226,8 @@ static void decode_frames(board_t *b, const uint8_t *buf, size_t len, bool defer
         if (defer && b->deferred_n < BOARD_DEFER_FRAMES && len - at >= PROTO_HEADER_SIZE &&
             buf[at] == 'A' && buf[at + 1u] == 'R' && buf[at + 2u] == 'G' && buf[at + 3u] == 'L' &&
             buf[at + 5u] == MSG_WINDOW) {
-            const size_t flen = PROTO_HEADER_SIZE + PROTO_CRC_SIZE +
-                                ((size_t)buf[at + 6u] | (size_t)buf[at + 7u] << 8);
+            const size_t flen =
+                PROTO_HEADER_SIZE + PROTO_CRC_SIZE + (size_t)le_get_u16(buf + at + 6u);
             if (flen <= PROTO_FRAME_MAX && flen <= len - at) {
                 memcpy(b->deferred[b->deferred_n], buf + at, flen);
                 b->deferred_len[b->deferred_n++] = (uint16_t)flen;

@@ -6,6 +6,8 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include "shared/wire.h"
+
 void hal_sim_init(hal_t *h)
 {
     memset(h, 0, sizeof(*h));
@@ -41,8 +43,7 @@ static bool fifo_put(hal_sim_fifo_t *q, const uint8_t *data, size_t len)
         fifo_compact(q);
     if (q->tail + 2u + len > HAL_SIM_LINK_BYTES)
         return false;
-    q->bytes[q->tail] = (uint8_t)(len & 0xFFu);
-    q->bytes[q->tail + 1u] = (uint8_t)(len >> 8);
+    le_put_u16(q->bytes + q->tail, (uint16_t)len);
     memcpy(q->bytes + q->tail + 2u, data, len);
     q->tail += 2u + (uint32_t)len;
     return true;
@@ -53,7 +54,7 @@ static size_t fifo_get(hal_sim_fifo_t *q, uint8_t *buf, size_t cap)
 {
     size_t n = 0;
     while (fifo_used(q) >= 2u) {
-        const uint32_t len = (uint32_t)q->bytes[q->head] | ((uint32_t)q->bytes[q->head + 1u] << 8);
+        const uint32_t len = le_get_u16(q->bytes + q->head);
         if (n + len > cap)
             break;
         memcpy(buf + n, q->bytes + q->head + 2u, len);

@@ -22,6 +22,7 @@
 #include "host/link/link_usb_api.h"
 #include "host/link/link_usb_desc.h"
 #include "shared/link_framer.h"
+#include "shared/wire.h"
 
 #define USB_IN_TRANSFERS 8u          /* bulk IN transfers kept in flight */
 #define USB_IN_BYTES 4096u           /* each */
@@ -292,7 +293,7 @@ static argil_err_t read_endpoints(usb_t *u, char *err, size_t err_len, const cha
                                      (uint16_t)(LIBUSB_DT_CONFIG << 8), 0, cfg, 9,
                                      USB_CTRL_TIMEOUT_MS);
     if (rc == 9) {
-        const uint16_t total = (uint16_t)(cfg[2] | (cfg[3] << 8));
+        const uint16_t total = le_get_u16(cfg + 2);
         rc = u->api.control_transfer(u->h, LIBUSB_ENDPOINT_IN, LIBUSB_REQUEST_GET_DESCRIPTOR,
                                      (uint16_t)(LIBUSB_DT_CONFIG << 8), 0, cfg,
                                      total < sizeof(cfg) ? total : (uint16_t)sizeof(cfg),

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "shared/wire.h"
+
 enum {
     DT_CONFIG = 2,
     DT_INTERFACE = 4,
@@ -17,7 +19,7 @@ usb_desc_err_t usb_desc_find_endpoints(const uint8_t *cfg, size_t len, usb_endpo
         return USB_DESC_ERR_SHORT;
     if (cfg[0] < 9 || cfg[1] != DT_CONFIG)
         return USB_DESC_ERR_TYPE;
-    const size_t total = (size_t)cfg[2] | ((size_t)cfg[3] << 8);
+    const size_t total = le_get_u16(cfg + 2);
     if (total < 9 || total > len)
         return USB_DESC_ERR_SHORT;
     bool in_vendor = false;
@@ -39,7 +41,7 @@ usb_desc_err_t usb_desc_find_endpoints(const uint8_t *cfg, size_t len, usb_endpo
         } else if (type == DT_ENDPOINT && dlen >= 7 && in_vendor &&
                    (cfg[at + 3] & 3u) == XFER_BULK) {
             const uint8_t addr = cfg[at + 2];
-            const uint16_t mps = (uint16_t)(cfg[at + 4] | (cfg[at + 5] << 8)) & 0x7FFu;
+            const uint16_t mps = le_get_u16(cfg + at + 4) & 0x7FFu;
             if ((addr & 0x80u) && !cur.ep_in) {
                 cur.ep_in = addr;
                 cur.in_max_packet = mps;
