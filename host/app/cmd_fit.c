@@ -293,7 +293,7 @@ static int fit_points(const char *in, const char *out, fit_method_t method, doub
     mesh_init(&m);
     bool normals = false;
     char err[1024];
-    if (mesh_import(in, &m, &normals, err, sizeof(err)) != ARGIL_OK) {
+    if (mesh_import(in, &m, &normals, err, sizeof(err)) != IMPORT_OK) {
         fprintf(stderr, "argil fit: %s\n", err);
         mesh_free(&m);
         return 1;

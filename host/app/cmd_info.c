@@ -180,7 +180,7 @@ int cmd_info(int argc, char **argv)
     mesh_t m;
     mesh_init(&m);
     bool normals = false;
-    if (mesh_import(path, &m, &normals, err, sizeof(err)) != ARGIL_OK) {
+    if (mesh_import(path, &m, &normals, err, sizeof(err)) != IMPORT_OK) {
         fprintf(stderr, "argil info: %s\n", err);
         mesh_free(&m);
         return 1;

@@ -431,7 +431,7 @@ static int load_view_mesh(view_opts_t *o, mesh_t *m, mesh_t *wire)
         fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
                         "model, or use 'argil sculpt --iso2')\n", model);
         return 2;
-    } else if (mesh_import(model, m, &has_normals, err, sizeof(err)) != ARGIL_OK) {
+    } else if (mesh_import(model, m, &has_normals, err, sizeof(err)) != IMPORT_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return 1;
     }
