@@ -47,6 +47,37 @@ static import_err_t import_line_err(const char *path, size_t line_no, long n, ch
     return n == -2 ? IMPORT_ERR_LINE_LONG : IMPORT_ERR_LINE_NUL;
 }
 
+/* A whole text file read one line at a time (OBJ, XYZ). */
+typedef struct {
+    uint8_t *buf;
+    io_lines_t it;
+    char line[IMPORT_LINE_MAX];
+} import_text_t;
+
+/* Clears *has_normals (when given) and reads path whole into t, as import_slurp. */
+static import_err_t import_text_open(import_text_t *t, const char *who, const char *path,
+                                     mesh_t *out, bool *has_normals, char *err, size_t err_len)
+{
+    if (has_normals != NULL)
+        *has_normals = false;
+    size_t len = 0;
+    t->buf = NULL;
+    const import_err_t e = import_slurp(who, path, out, &t->buf, &len, err, err_len);
+    t->it = (io_lines_t){(const char *)t->buf, len, 0, 0, 0};
+    return e;
+}
+
+/* The next line into t->line and its length; -1 at the end, or on a line too long or holding a
+ * NUL, which sets *e to its rule with err naming the line. */
+static long import_text_next(import_text_t *t, const char *path, import_err_t *e, char *err,
+                             size_t err_len)
+{
+    const long n = io_next_line(&t->it, t->line, sizeof(t->line));
+    if (n < -1)
+        *e = import_line_err(path, t->it.line_no, n, err, err_len);
+    return n < 0 ? -1 : n;
+}
+
 /* Returns e, leaving out empty unless e is IMPORT_OK. */
 static import_err_t import_done(mesh_t *out, import_err_t e)
 {
@@ -356,29 +387,17 @@ static import_err_t obj_face(const char *path, size_t line_no, char **tok, int n
 
 import_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *err, size_t err_len)
 {
-    if (has_normals != NULL)
-        *has_normals = false;
-    uint8_t *b;
-    size_t len;
-    import_err_t e = import_slurp("obj_read", path, out, &b, &len, err, err_len);
+    import_text_t t;
+    import_err_t e = import_text_open(&t, "obj_read", path, out, has_normals, err, err_len);
     if (e != IMPORT_OK)
         return e;
-    char *line = malloc(IMPORT_LINE_MAX);
     float *vn = NULL;
     uint8_t *got_n = NULL;
     size_t n_vn = 0, cap_vn = 0, cap_got = 0;
     bool any_rgb = false;
-    io_lines_t it = {(const char *)b, len, 0, 0, 0};
+    char *line = t.line;
     char *tok[66];
-    e = line != NULL ? IMPORT_OK : IMPORT_ERR_NOMEM;
-    while (e == IMPORT_OK) {
-        const long n = io_next_line(&it, line, IMPORT_LINE_MAX);
-        if (n == -1)
-            break;
-        if (n < 0) {
-            e = import_line_err(path, it.line_no, n, err, err_len);
-            break;
-        }
+    while (e == IMPORT_OK && import_text_next(&t, path, &e, err, err_len) >= 0) {
         char *hash = strchr(line, '#');
         if (hash != NULL)
             *hash = '\0';
@@ -395,7 +414,7 @@ import_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *er
                 ok = io_parse_double(tok[q], &d[q - 1]) && fabs(d[q - 1]) < 3e38;
             if (!ok) {
                 io_err(err, err_len, "%s: line %zu: '%s' needs %s finite numbers", path,
-                       it.line_no, k, is_v ? "3 (x y z), 4 (x y z w) or 6 (x y z r g b)" : "3");
+                       t.it.line_no, k, is_v ? "3 (x y z), 4 (x y z w) or 6 (x y z r g b)" : "3");
                 e = IMPORT_ERR_OBJ_VERTEX;
                 break;
             }
@@ -433,29 +452,29 @@ import_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *er
                 n_vn++;
             }
         } else if (strcmp(k, "f") == 0) {
-            e = obj_face(path, it.line_no, tok, nt, out, vn, n_vn, &got_n, &cap_got, err,
+            e = obj_face(path, t.it.line_no, tok, nt, out, vn, n_vn, &got_n, &cap_got, err,
                          err_len);
         } else if (strcmp(k, "vt") == 0 || strcmp(k, "vp") == 0 || strcmp(k, "o") == 0 ||
                    strcmp(k, "g") == 0 || strcmp(k, "s") == 0 || strcmp(k, "usemtl") == 0 ||
                    strcmp(k, "mtllib") == 0 || strcmp(k, "l") == 0) {
             continue;
         } else {
-            io_err(err, err_len, "%s: line %zu: unknown OBJ statement '%.32s'", path, it.line_no, k);
+            io_err(err, err_len, "%s: line %zu: unknown OBJ statement '%.32s'", path,
+                   t.it.line_no, k);
             e = IMPORT_ERR_OBJ_STATEMENT;
         }
     }
     if (e == IMPORT_ERR_NOMEM)
-        io_err(err, err_len, "%s: line %zu: out of memory", path, it.line_no);
+        io_err(err, err_len, "%s: line %zu: out of memory", path, t.it.line_no);
     if (e == IMPORT_OK && has_normals != NULL && out->n_vert > 0) {
         bool all = got_n != NULL && cap_got >= out->n_vert;
         for (size_t v = 0; all && v < out->n_vert; v++)
             all = got_n[v] != 0;
         *has_normals = all;
     }
-    free(line);
     free(vn);
     free(got_n);
-    free(b);
+    free(t.buf);
     return import_done(out, e);
 }
 
@@ -463,46 +482,30 @@ import_err_t obj_read(const char *path, mesh_t *out, bool *has_normals, char *er
 
 import_err_t xyz_read(const char *path, mesh_t *out, bool *has_normals, char *err, size_t err_len)
 {
-    if (has_normals != NULL)
-        *has_normals = false;
-    uint8_t *b;
-    size_t len;
-    import_err_t e = import_slurp("xyz_read", path, out, &b, &len, err, err_len);
+    import_text_t t;
+    import_err_t e = import_text_open(&t, "xyz_read", path, out, has_normals, err, err_len);
     if (e != IMPORT_OK)
         return e;
-    char *line = malloc(IMPORT_LINE_MAX);
-    if (line == NULL) {
-        free(b);
-        io_err(err, err_len, "%s: out of memory", path);
-        return IMPORT_ERR_NOMEM;
-    }
-    io_lines_t it = {(const char *)b, len, 0, 0, 0};
+    char *line = t.line;
     char *tok[8];
     int cols = 0;
     size_t first_line = 0;
-    while (e == IMPORT_OK) {
-        const long n = io_next_line(&it, line, IMPORT_LINE_MAX);
-        if (n == -1)
-            break;
-        if (n < 0) {
-            e = import_line_err(path, it.line_no, n, err, err_len);
-            break;
-        }
+    while (e == IMPORT_OK && import_text_next(&t, path, &e, err, err_len) >= 0) {
         const int nt = io_tokens(line, tok, 7);
         if (nt == 0 || tok[0][0] == '#')
             continue;
         if (nt != 3 && nt != 6) {
             io_err(err, err_len, "%s: line %zu: %d values; each point needs 3 (x y z) or 6 "
-                   "(x y z nx ny nz)", path, it.line_no, nt > 7 ? 7 : nt);
+                   "(x y z nx ny nz)", path, t.it.line_no, nt > 7 ? 7 : nt);
             e = IMPORT_ERR_XYZ_COLUMNS;
             break;
         }
         if (cols == 0) {
             cols = nt;
-            first_line = it.line_no;
+            first_line = t.it.line_no;
         } else if (nt != cols) {
             io_err(err, err_len, "%s: line %zu: %d values but line %zu had %d (every line must "
-                   "have the same count)", path, it.line_no, nt, first_line, cols);
+                   "have the same count)", path, t.it.line_no, nt, first_line, cols);
             e = IMPORT_ERR_XYZ_COLUMNS;
             break;
         }
@@ -511,7 +514,7 @@ import_err_t xyz_read(const char *path, mesh_t *out, bool *has_normals, char *er
             double d;
             if (!io_parse_double(tok[q], &d) || fabs(d) >= 3e38) {
                 io_err(err, err_len, "%s: line %zu: value %d '%.32s' is not a finite number",
-                       path, it.line_no, q + 1, tok[q]);
+                       path, t.it.line_no, q + 1, tok[q]);
                 e = IMPORT_ERR_NUMBER;
                 break;
             }
@@ -519,18 +522,17 @@ import_err_t xyz_read(const char *path, mesh_t *out, bool *has_normals, char *er
         }
         if (e == IMPORT_OK &&
             mesh_add_vertex(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]), NULL) != ARGIL_OK) {
-            io_err(err, err_len, "%s: line %zu: out of memory", path, it.line_no);
+            io_err(err, err_len, "%s: line %zu: out of memory", path, t.it.line_no);
             e = IMPORT_ERR_NOMEM;
         }
     }
     if (e == IMPORT_OK && out->n_vert == 0) {
-        io_err(err, err_len, "%s: line %zu: no points in the file", path, it.line_no);
+        io_err(err, err_len, "%s: line %zu: no points in the file", path, t.it.line_no);
         e = IMPORT_ERR_XYZ_EMPTY;
     }
     if (e == IMPORT_OK && has_normals != NULL)
         *has_normals = cols == 6;
-    free(line);
-    free(b);
+    free(t.buf);
     return import_done(out, e);
 }
 
