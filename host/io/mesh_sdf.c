@@ -148,6 +148,20 @@ static bool sdf_cross_push(sdf_cross_t **cr, size_t *n, size_t *cap, uint32_t ro
     return true;
 }
 
+bool mesh_sdf_grid_samples(const int32_t dims[3], uint64_t *samples)
+{
+    uint64_t total = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1)
+            return false;
+        total *= (uint64_t)dims[a];
+        if (total > MESH_SDF_SAMPLES_MAX)
+            return false;
+    }
+    *samples = total;
+    return true;
+}
+
 argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, vec3_t origin_m,
                      float band_m, float *sd, mesh_sdf_report_t *rep)
 {
@@ -157,14 +171,9 @@ argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, ve
     if (m == NULL || sd == NULL || m->n_tri == 0 || !(spacing_m > 0) || !isfinite(spacing_m) ||
         !(band_m > 0) || !isfinite(band_m) || !vec3_isfinite(origin_m) || m->n_tri > UINT32_MAX / 3)
         return ARGIL_ERR_ARG;
-    uint64_t total = 1;
-    for (int a = 0; a < 3; a++) {
-        if (dims[a] < 1)
-            return ARGIL_ERR_ARG;
-        total *= (uint64_t)dims[a];
-        if (total > ((uint64_t)1 << 30))
-            return ARGIL_ERR_ARG;
-    }
+    uint64_t total;
+    if (!mesh_sdf_grid_samples(dims, &total))
+        return ARGIL_ERR_ARG;
     for (size_t i = 0; i < 3 * m->n_vert; i++)
         if (!isfinite(m->pos[i]))
             return ARGIL_ERR_ARG;
