@@ -650,11 +650,11 @@ static void test_import_failures(void **state)
     assert_int_equal(unlink(p), 0);
     mesh_free(&m);
 
-    assert_int_equal(import_err_argil(IMPORT_OK), ARGIL_OK);
-    assert_int_equal(import_err_argil(IMPORT_ERR_ARG), ARGIL_ERR_ARG);
-    assert_int_equal(import_err_argil(IMPORT_ERR_IO), ARGIL_ERR_IO);
-    assert_int_equal(import_err_argil(IMPORT_ERR_NOMEM), ARGIL_ERR_NOMEM);
-    for (int e = IMPORT_ERR_FILE_SIZE; e >= IMPORT_ERR_XYZ_EMPTY; e--)
+    const argil_err_t got[] = {import_err_argil(IMPORT_OK), import_err_argil(IMPORT_ERR_ARG),
+                               import_err_argil(IMPORT_ERR_IO), import_err_argil(IMPORT_ERR_NOMEM)};
+    const argil_err_t want[] = {ARGIL_OK, ARGIL_ERR_ARG, ARGIL_ERR_IO, ARGIL_ERR_NOMEM};
+    assert_memory_equal(got, want, sizeof(want));
+    for (int e = IMPORT_ERR_FILE_SIZE; e >= IMPORT_ERR_XYZ_EMPTY; e--) /* every rule of a file */
         assert_int_equal(import_err_argil((import_err_t)e), ARGIL_ERR_PARSE);
 }
 

@@ -487,12 +487,12 @@ static void test_io_errors(void **state)
 static void test_err_argil(void **state)
 {
     (void)state;
-    assert_int_equal(ply_err_argil(PLY_OK), ARGIL_OK);
-    assert_int_equal(ply_err_argil(PLY_ERR_ARG), ARGIL_ERR_ARG);
-    assert_int_equal(ply_err_argil(PLY_ERR_IO), ARGIL_ERR_IO);
-    assert_int_equal(ply_err_argil(PLY_ERR_NOMEM), ARGIL_ERR_NOMEM);
-    for (int e = PLY_ERR_HEADER; e >= PLY_ERR_INDEX; e--)
-        assert_int_equal(ply_err_argil((ply_err_t)e), ARGIL_ERR_PARSE);
+    static const ply_err_t outside[] = {PLY_OK, PLY_ERR_ARG, PLY_ERR_IO, PLY_ERR_NOMEM};
+    static const argil_err_t as[] = {ARGIL_OK, ARGIL_ERR_ARG, ARGIL_ERR_IO, ARGIL_ERR_NOMEM};
+    for (size_t i = 0; i < sizeof(outside) / sizeof(outside[0]); i++)
+        assert_int_equal(ply_err_argil(outside[i]), as[i]);
+    for (int rule = PLY_ERR_HEADER; rule >= PLY_ERR_INDEX; rule--)
+        assert_int_equal(ply_err_argil((ply_err_t)rule), ARGIL_ERR_PARSE);
 }
 
 int main(void)
