@@ -119,7 +119,7 @@ argil_err_t cmd_read_mesh(const char *path, mesh_t *m, bool *normals, float lo[3
 {
     mesh_init(m);
     *normals = false;
-    const argil_err_t e = mesh_import(path, m, normals, err, err_len);
+    const argil_err_t e = import_err_argil(mesh_import(path, m, normals, err, err_len));
     if (e != ARGIL_OK) {
         mesh_free(m);
         return e;

@@ -441,7 +441,8 @@ static argil_err_t load_view_mesh(view_opts_t *o, mesh_t *m, mesh_t *wire, int *
         fprintf(stderr, "argil view: --iso2 needs a density field: %s is a mesh (give a .argil "
                         "model, or use 'argil sculpt --iso2')\n", model);
         return cmd_end(exit_status, 2, ARGIL_ERR_ARG);
-    } else if ((e = mesh_import(model, m, &has_normals, err, sizeof(err))) != ARGIL_OK) {
+    } else if ((e = import_err_argil(mesh_import(model, m, &has_normals, err, sizeof(err)))) !=
+               ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return cmd_end(exit_status, 1, e);
     }

@@ -10,6 +10,7 @@
 
 #include "host/fit/knn.h"
 #include "host/fit/normals.h"
+#include "host/io/mesh_sdf.h"
 
 #define OF_FIT_SAMPLES_MAX 600u  /* data used per node's normal equations (spread evenly) */
 #define OF_SPLIT_MIN 32u         /* a node holding fewer data is not split */
@@ -839,14 +840,9 @@ argil_err_t octfit_volume(const float *v, const int32_t dims[3], float spacing_m
         !vec3_isfinite(origin_m) || !isfinite(lo) || !isfinite(hi) || !(hi > lo) ||
         !isfinite(iso_norm))
         return ARGIL_ERR_ARG;
-    uint64_t total = 1;
-    for (int a = 0; a < 3; a++) {
-        if (dims[a] < 1)
-            return ARGIL_ERR_ARG;
-        total *= (uint64_t)dims[a];
-        if (total > ((uint64_t)1 << 30))
-            return ARGIL_ERR_ARG;
-    }
+    uint64_t total;
+    if (!mesh_sdf_grid_samples(dims, &total))
+        return ARGIL_ERR_ARG;
     /* at most about 2^20 data: every step-th sample along each axis */
     int32_t step = 1;
     while (total / ((uint64_t)step * step * step) > OF_VOLUME_SAMPLES_MAX)

@@ -5,6 +5,7 @@
 #include "host/io/mesh_sdf.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,35 @@ static dv_t vtx(const mesh_t *m, uint32_t i)
     return dv(m->pos[3 * (size_t)i], m->pos[3 * (size_t)i + 1], m->pos[3 * (size_t)i + 2]);
 }
 
+/* What closest_on_tri learns at corner q: the dot products of its two edge vectors e, f with
+ * p - q, and the barycentric term v of the edge along e. */
+typedef struct {
+    double qe, qf, v;
+} tri_corner_t;
+
+/* Ericson's corner and edge regions at q (q = b with e = ab, f = ac, or q = c with e = ac,
+ * f = ab; ep = e . (p - a), fp = f . (p - a)): true with *out and *feat (feat_q or feat_e) when
+ * p is nearest q or the edge from a along e (Real-Time Collision Detection, 5.1.5). */
+static bool tri_corner(dv_t p, dv_t a, dv_t q, dv_t e, dv_t f, double ep, double fp, int feat_q,
+                       int feat_e, tri_corner_t *k, dv_t *out, int *feat)
+{
+    const dv_t qp = dsub(p, q);
+    k->qe = ddot(e, qp);
+    k->qf = ddot(f, qp);
+    if (k->qe >= 0 && k->qf <= k->qe) {
+        *feat = feat_q;
+        *out = q;
+        return true;
+    }
+    k->v = ep * k->qf - k->qe * fp;
+    if (k->v <= 0 && ep >= 0 && k->qe <= 0) {
+        *feat = feat_e;
+        *out = dadd(a, dscale(e, ep / (ep - k->qe)));
+        return true;
+    }
+    return false;
+}
+
 /* Closest point on triangle abc to p; *feat: 0 face, 1..3 edge ab / bc / ca, 4..6 vertex a b c. */
 static dv_t closest_on_tri(dv_t p, dv_t a, dv_t b, dv_t c, int *feat)
 {
@@ -43,28 +73,12 @@ static dv_t closest_on_tri(dv_t p, dv_t a, dv_t b, dv_t c, int *feat)
         *feat = 4;
         return a;
     }
-    const dv_t bp = dsub(p, b);
-    const double d3 = ddot(ab, bp), d4 = ddot(ac, bp);
-    if (d3 >= 0 && d4 <= d3) {
-        *feat = 5;
-        return b;
-    }
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        *feat = 1;
-        return dadd(a, dscale(ab, d1 / (d1 - d3)));
-    }
-    const dv_t cp = dsub(p, c);
-    const double d5 = ddot(ab, cp), d6 = ddot(ac, cp);
-    if (d6 >= 0 && d5 <= d6) {
-        *feat = 6;
-        return c;
-    }
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        *feat = 3;
-        return dadd(a, dscale(ac, d2 / (d2 - d6)));
-    }
+    tri_corner_t kb, kc;
+    dv_t q;
+    if (tri_corner(p, a, b, ab, ac, d1, d2, 5, 1, &kb, &q, feat) ||
+        tri_corner(p, a, c, ac, ab, d2, d1, 6, 3, &kc, &q, feat))
+        return q;
+    const double d3 = kb.qe, d4 = kb.qf, d5 = kc.qf, d6 = kc.qe, vc = kb.v, vb = kc.v;
     const double va = d3 * d6 - d5 * d4;
     if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
         *feat = 2;
@@ -80,14 +94,20 @@ typedef struct {
     uint8_t edge;
 } sdf_edge_t;
 
+/* -1, 0 or 1 as a is below, equal to or above b. */
+static int u32_cmp(uint32_t a, uint32_t b)
+{
+    return a < b ? -1 : (a > b);
+}
+
+/* qsort order of edges: by lo, then hi, then triangle. */
 static int edge_cmp(const void *x, const void *y)
 {
     const sdf_edge_t *a = x, *b = y;
-    if (a->lo != b->lo)
-        return a->lo < b->lo ? -1 : 1;
-    if (a->hi != b->hi)
-        return a->hi < b->hi ? -1 : 1;
-    return a->tri < b->tri ? -1 : (a->tri > b->tri);
+    int c = u32_cmp(a->lo, b->lo);
+    if (c == 0)
+        c = u32_cmp(a->hi, b->hi);
+    return c != 0 ? c : u32_cmp(a->tri, b->tri);
 }
 
 typedef struct {
@@ -95,12 +115,12 @@ typedef struct {
     float x;
 } sdf_cross_t;
 
+/* qsort order of crossings: by row, then x. */
 static int cross_cmp(const void *x, const void *y)
 {
     const sdf_cross_t *a = x, *b = y;
-    if (a->row != b->row)
-        return a->row < b->row ? -1 : 1;
-    return a->x < b->x ? -1 : (a->x > b->x);
+    const int c = u32_cmp(a->row, b->row);
+    return c != 0 ? c : (a->x < b->x ? -1 : (a->x > b->x));
 }
 
 /* Face normals fn, angle-weighted vertex pseudo-normals vn (zero on entry) and the neighbour
@@ -148,6 +168,20 @@ static bool sdf_cross_push(sdf_cross_t **cr, size_t *n, size_t *cap, uint32_t ro
     return true;
 }
 
+bool mesh_sdf_grid_samples(const int32_t dims[3], uint64_t *samples)
+{
+    uint64_t total = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1)
+            return false;
+        total *= (uint64_t)dims[a];
+        if (total > MESH_SDF_SAMPLES_MAX)
+            return false;
+    }
+    *samples = total;
+    return true;
+}
+
 argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, vec3_t origin_m,
                      float band_m, float *sd, mesh_sdf_report_t *rep)
 {
@@ -157,14 +191,9 @@ argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, ve
     if (m == NULL || sd == NULL || m->n_tri == 0 || !(spacing_m > 0) || !isfinite(spacing_m) ||
         !(band_m > 0) || !isfinite(band_m) || !vec3_isfinite(origin_m) || m->n_tri > UINT32_MAX / 3)
         return ARGIL_ERR_ARG;
-    uint64_t total = 1;
-    for (int a = 0; a < 3; a++) {
-        if (dims[a] < 1)
-            return ARGIL_ERR_ARG;
-        total *= (uint64_t)dims[a];
-        if (total > ((uint64_t)1 << 30))
-            return ARGIL_ERR_ARG;
-    }
+    uint64_t total;
+    if (!mesh_sdf_grid_samples(dims, &total))
+        return ARGIL_ERR_ARG;
     for (size_t i = 0; i < 3 * m->n_vert; i++)
         if (!isfinite(m->pos[i]))
             return ARGIL_ERR_ARG;

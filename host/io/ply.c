@@ -7,7 +7,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -27,25 +26,12 @@
 static const char *const ply_prop_names[6] = {"x", "y", "z", "nx", "ny", "nz"};
 static const char *const ply_rgb_names[3] = {"red", "green", "blue"};
 
-/* Writes a formatted message into err (when there is room). */
-static void ply_err(char *err, size_t err_len, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void ply_err(char *err, size_t err_len, const char *fmt, ...)
-{
-    if (err == NULL || err_len == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, err_len, fmt, ap);
-    va_end(ap);
-}
-
 /* ---------------------------------------------------------------- writer */
 
 argil_err_t ply_write(const char *path, const mesh_t *m, char *err, size_t err_len)
 {
     if (path == NULL || m == NULL) {
-        ply_err(err, err_len, "ply_write: no path or no mesh");
+        io_err(err, err_len, "ply_write: no path or no mesh");
         return ARGIL_ERR_ARG;
     }
     /* One PLY writer: argil mesh's (vertex colours when the mesh has them). */
@@ -54,6 +40,17 @@ argil_err_t ply_write(const char *path, const mesh_t *m, char *err, size_t err_l
 
 /* ---------------------------------------------------------------- reader */
 
+argil_err_t ply_err_argil(ply_err_t e)
+{
+    switch (e) {
+    case PLY_OK: return ARGIL_OK;
+    case PLY_ERR_ARG: return ARGIL_ERR_ARG;
+    case PLY_ERR_IO: return ARGIL_ERR_IO;
+    case PLY_ERR_NOMEM: return ARGIL_ERR_NOMEM;
+    default: return ARGIL_ERR_PARSE;
+    }
+}
+
 typedef struct {
     const char *path;
     char *err;
@@ -61,24 +58,6 @@ typedef struct {
     bool rgb;          /* the header declared red green blue after the normal */
     size_t vert_bytes; /* PLY_VERT_BYTES, or PLY_VERT_RGB_BYTES with colour */
 } ply_ctx_t;
-
-/* Parses a decimal count (digits only, no sign); false when not a number or above limit. */
-static bool ply_parse_count(const char *s, uint64_t limit, uint64_t *out)
-{
-    uint64_t v = 0;
-    if (*s == '\0')
-        return false;
-    for (; *s != '\0'; s++) {
-        if (*s < '0' || *s > '9')
-            return false;
-        const uint64_t digit = (uint64_t)(*s - '0');
-        if (v > (limit - digit) / 10)
-            return false;
-        v = v * 10 + digit;
-    }
-    *out = v;
-    return true;
-}
 
 static bool ply_is(const char *s, const char *a, const char *b)
 {
@@ -118,13 +97,13 @@ static const char *ply_expected(int state)
 }
 
 /* Checks one header line against the expected state; advances it and stores counts. */
-static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *state,
-                                   uint64_t *n_vert, uint64_t *n_face)
+static ply_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *state,
+                                 uint64_t *n_vert, uint64_t *n_face)
 {
     char *tok[6];
     const int n = io_tokens(line, tok, 5);
     if (*state != PLY_H_MAGIC && n >= 1 && (ply_is(tok[0], "comment", "obj_info")))
-        return ARGIL_OK;
+        return PLY_OK;
     /* The colour is optional: the face element may follow the normal directly. */
     if (*state == PLY_H_RGB0 && n >= 1 && strcmp(tok[0], "element") == 0)
         *state = PLY_H_FACE;
@@ -144,13 +123,13 @@ static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *s
              strcmp(tok[1], vert ? "vertex" : "face") == 0;
         if (ok) {
             const uint64_t limit = vert ? PLY_VERT_MAX : UINT64_MAX / PLY_FACE_BYTES;
-            if (!ply_parse_count(tok[2], limit, vert ? n_vert : n_face)) {
-                ply_err(c->err, c->err_len,
-                        "ply_read_mesh: %s: header line %d: %s count '%.32s' is not a number "
-                        "from 0 to %llu",
-                        c->path, line_no, vert ? "vertex" : "face", tok[2],
-                        (unsigned long long)limit);
-                return ARGIL_ERR_PARSE;
+            if (!io_parse_u64(tok[2], limit, vert ? n_vert : n_face)) {
+                io_err(c->err, c->err_len,
+                       "ply_read_mesh: %s: header line %d: %s count '%.32s' is not a number "
+                       "from 0 to %llu",
+                       c->path, line_no, vert ? "vertex" : "face", tok[2],
+                       (unsigned long long)limit);
+                return PLY_ERR_COUNT;
             }
         }
         break;
@@ -179,17 +158,17 @@ static argil_err_t ply_header_line(ply_ctx_t *c, char *line, int line_no, int *s
         break;
     }
     if (!ok) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: expected '%s'", c->path,
-                line_no, ply_expected(*state));
-        return ARGIL_ERR_PARSE;
+        io_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: expected '%s'", c->path,
+               line_no, ply_expected(*state));
+        return PLY_ERR_HEADER;
     }
     (*state)++;
-    return ARGIL_OK;
+    return PLY_OK;
 }
 
 /* Parses the header at the start of buf (len bytes); sets its byte length and the counts. */
-static argil_err_t ply_parse_header(ply_ctx_t *c, const char *buf, size_t len, size_t *header_len,
-                                    uint64_t *n_vert, uint64_t *n_face)
+static ply_err_t ply_parse_header(ply_ctx_t *c, const char *buf, size_t len, size_t *header_len,
+                                  uint64_t *n_vert, uint64_t *n_face)
 {
     int state = PLY_H_MAGIC;
     int line_no = 0;
@@ -199,63 +178,63 @@ static argil_err_t ply_parse_header(ply_ctx_t *c, const char *buf, size_t len, s
         line_no++;
         const char *nl = memchr(buf + pos, '\n', len - pos);
         if (nl == NULL) {
-            ply_err(c->err, c->err_len,
-                    "ply_read_mesh: %s: header line %d: no end of line (file truncated or "
-                    "header over %d bytes)",
-                    c->path, line_no, PLY_HEADER_MAX_BYTES);
-            return ARGIL_ERR_PARSE;
+            io_err(c->err, c->err_len,
+                   "ply_read_mesh: %s: header line %d: no end of line (file truncated or "
+                   "header over %d bytes)",
+                   c->path, line_no, PLY_HEADER_MAX_BYTES);
+            return PLY_ERR_LINE_END;
         }
         size_t n = (size_t)(nl - (buf + pos));
         if (n >= sizeof(line)) {
-            ply_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: longer than %d bytes",
-                    c->path, line_no, PLY_LINE_MAX - 1);
-            return ARGIL_ERR_PARSE;
+            io_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: longer than %d bytes",
+                   c->path, line_no, PLY_LINE_MAX - 1);
+            return PLY_ERR_LINE_LONG;
         }
         memcpy(line, buf + pos, n);
         if (n > 0 && line[n - 1] == '\r')
             n--;
         line[n] = '\0';
         if (strlen(line) != n) {
-            ply_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: contains a NUL byte",
-                    c->path, line_no);
-            return ARGIL_ERR_PARSE;
+            io_err(c->err, c->err_len, "ply_read_mesh: %s: header line %d: contains a NUL byte",
+                   c->path, line_no);
+            return PLY_ERR_LINE_NUL;
         }
-        argil_err_t e = ply_header_line(c, line, line_no, &state, n_vert, n_face);
-        if (e != ARGIL_OK)
+        const ply_err_t e = ply_header_line(c, line, line_no, &state, n_vert, n_face);
+        if (e != PLY_OK)
             return e;
         pos = (size_t)(nl - buf) + 1;
     }
     *header_len = pos;
-    return ARGIL_OK;
+    return PLY_OK;
 }
 
 /* Reads exactly n bytes at the current position (offset is for the message). */
-static argil_err_t ply_read_exact(ply_ctx_t *c, FILE *f, uint8_t *dst, size_t n, uint64_t offset)
+static ply_err_t ply_read_exact(ply_ctx_t *c, FILE *f, uint8_t *dst, size_t n, uint64_t offset)
 {
     if (fread(dst, 1, n, f) == n)
-        return ARGIL_OK;
+        return PLY_OK;
     if (ferror(f)) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: %s: fread at byte %llu failed: %s", c->path,
-                (unsigned long long)offset, strerror(errno));
-        return ARGIL_ERR_IO;
+        io_err(c->err, c->err_len, "ply_read_mesh: %s: fread at byte %llu failed: %s", c->path,
+               (unsigned long long)offset, strerror(errno));
+        return PLY_ERR_IO;
     }
-    ply_err(c->err, c->err_len, "ply_read_mesh: %s: byte %llu: file ended early", c->path,
-            (unsigned long long)offset);
-    return ARGIL_ERR_PARSE;
+    io_err(c->err, c->err_len, "ply_read_mesh: %s: byte %llu: file ended early", c->path,
+           (unsigned long long)offset);
+    return PLY_ERR_TRUNCATED;
 }
 
 /* Reads and checks the vertex and face records that follow the header. */
-static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_t n_vert,
-                                 uint64_t n_face, mesh_t *out, uint8_t *buf)
+static ply_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_t n_vert,
+                               uint64_t n_face, mesh_t *out, uint8_t *buf)
 {
-    argil_err_t e;
+    ply_err_t e;
     uint64_t done = 0;
     while (done < n_vert) {
         uint64_t batch = n_vert - done;
         if (batch > PLY_CHUNK_BYTES / c->vert_bytes)
             batch = PLY_CHUNK_BYTES / c->vert_bytes;
         e = ply_read_exact(c, f, buf, (size_t)batch * c->vert_bytes, offset);
-        if (e != ARGIL_OK)
+        if (e != PLY_OK)
             return e;
         for (uint64_t i = 0; i < batch; i++, done++, offset += c->vert_bytes) {
             const uint8_t *r = buf + i * c->vert_bytes;
@@ -263,19 +242,20 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
             for (int k = 0; k < 6; k++) {
                 v[k] = le_get_f32(r + 4 * (size_t)k);
                 if (!isfinite(v[k])) {
-                    ply_err(c->err, c->err_len,
-                            "ply_read_mesh: %s: byte %llu: vertex %llu has a non-finite %s",
-                            c->path, (unsigned long long)(offset + 4 * (uint64_t)k),
-                            (unsigned long long)done, ply_prop_names[k]);
-                    return ARGIL_ERR_PARSE;
+                    io_err(c->err, c->err_len,
+                           "ply_read_mesh: %s: byte %llu: vertex %llu has a non-finite %s",
+                           c->path, (unsigned long long)(offset + 4 * (uint64_t)k),
+                           (unsigned long long)done, ply_prop_names[k]);
+                    return PLY_ERR_NONFINITE;
                 }
             }
-            e = c->rgb ? mesh_add_vertex_rgb(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]),
+            const argil_err_t me =
+                c->rgb ? mesh_add_vertex_rgb(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]),
                                              r + PLY_VERT_BYTES, NULL)
                        : mesh_add_vertex(out, vec3(v[0], v[1], v[2]), vec3(v[3], v[4], v[5]),
                                          NULL);
-            if (e != ARGIL_OK)
-                return e;
+            if (me != ARGIL_OK)
+                return PLY_ERR_NOMEM;
         }
     }
     done = 0;
@@ -284,63 +264,62 @@ static argil_err_t ply_read_body(ply_ctx_t *c, FILE *f, uint64_t offset, uint64_
         if (batch > PLY_CHUNK_BYTES / PLY_FACE_BYTES)
             batch = PLY_CHUNK_BYTES / PLY_FACE_BYTES;
         e = ply_read_exact(c, f, buf, (size_t)batch * PLY_FACE_BYTES, offset);
-        if (e != ARGIL_OK)
+        if (e != PLY_OK)
             return e;
         for (uint64_t i = 0; i < batch; i++, done++, offset += PLY_FACE_BYTES) {
             const uint8_t *r = buf + i * PLY_FACE_BYTES;
             if (r[0] != 3) {
-                ply_err(c->err, c->err_len,
-                        "ply_read_mesh: %s: byte %llu: face %llu has %u vertices (only "
-                        "triangles are read)",
-                        c->path, (unsigned long long)offset, (unsigned long long)done,
-                        (unsigned)r[0]);
-                return ARGIL_ERR_PARSE;
+                io_err(c->err, c->err_len,
+                       "ply_read_mesh: %s: byte %llu: face %llu has %u vertices (only "
+                       "triangles are read)",
+                       c->path, (unsigned long long)offset, (unsigned long long)done,
+                       (unsigned)r[0]);
+                return PLY_ERR_FACE_SIZE;
             }
             uint32_t idx[3];
             for (int k = 0; k < 3; k++) {
                 const int32_t s = (int32_t)le_get_u32(r + 1 + 4 * k);
                 if (s < 0 || (uint64_t)s >= n_vert) {
-                    ply_err(c->err, c->err_len,
-                            "ply_read_mesh: %s: byte %llu: face %llu names vertex %ld of %llu",
-                            c->path, (unsigned long long)(offset + 1 + 4 * (uint64_t)k),
-                            (unsigned long long)done, (long)s, (unsigned long long)n_vert);
-                    return ARGIL_ERR_PARSE;
+                    io_err(c->err, c->err_len,
+                           "ply_read_mesh: %s: byte %llu: face %llu names vertex %ld of %llu",
+                           c->path, (unsigned long long)(offset + 1 + 4 * (uint64_t)k),
+                           (unsigned long long)done, (long)s, (unsigned long long)n_vert);
+                    return PLY_ERR_INDEX;
                 }
                 idx[k] = (uint32_t)s;
             }
-            e = mesh_add_triangle(out, idx[0], idx[1], idx[2]);
-            if (e != ARGIL_OK)
-                return e;
+            if (mesh_add_triangle(out, idx[0], idx[1], idx[2]) != ARGIL_OK)
+                return PLY_ERR_NOMEM;
         }
     }
-    return ARGIL_OK;
+    return PLY_OK;
 }
 
 /* Everything after opening: size, header, count checks, body. */
-static argil_err_t ply_read_file(ply_ctx_t *c, FILE *f, mesh_t *out, uint8_t *buf)
+static ply_err_t ply_read_file(ply_ctx_t *c, FILE *f, mesh_t *out, uint8_t *buf)
 {
     struct stat st;
     if (fstat(fileno(f), &st) != 0) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: fstat(\"%s\") failed: %s", c->path,
-                strerror(errno));
-        return ARGIL_ERR_IO;
+        io_err(c->err, c->err_len, "ply_read_mesh: fstat(\"%s\") failed: %s", c->path,
+               strerror(errno));
+        return PLY_ERR_IO;
     }
     if (!S_ISREG(st.st_mode)) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: %s: not a regular file", c->path);
-        return ARGIL_ERR_IO;
+        io_err(c->err, c->err_len, "ply_read_mesh: %s: not a regular file", c->path);
+        return PLY_ERR_IO;
     }
     const uint64_t file_size = (uint64_t)st.st_size;
     size_t head = file_size < PLY_HEADER_MAX_BYTES ? (size_t)file_size : PLY_HEADER_MAX_BYTES;
     const size_t got = fread(buf, 1, head, f);
     if (got != head && ferror(f)) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: fread(\"%s\") failed: %s", c->path,
-                strerror(errno));
-        return ARGIL_ERR_IO;
+        io_err(c->err, c->err_len, "ply_read_mesh: fread(\"%s\") failed: %s", c->path,
+               strerror(errno));
+        return PLY_ERR_IO;
     }
     size_t header_len = 0;
     uint64_t n_vert = 0, n_face = 0;
-    argil_err_t e = ply_parse_header(c, (const char *)buf, got, &header_len, &n_vert, &n_face);
-    if (e != ARGIL_OK)
+    const ply_err_t e = ply_parse_header(c, (const char *)buf, got, &header_len, &n_vert, &n_face);
+    if (e != PLY_OK)
         return e;
     /* The declared records must fill the rest of the file exactly: no count drives an
      * allocation beyond what the file holds. */
@@ -349,56 +328,56 @@ static argil_err_t ply_read_file(ply_ctx_t *c, FILE *f, mesh_t *out, uint8_t *bu
     const bool fits = vbytes <= avail && n_face <= (avail - vbytes) / PLY_FACE_BYTES;
     const uint64_t need = fits ? vbytes + n_face * PLY_FACE_BYTES : 0;
     if (!fits || need != avail) {
-        ply_err(c->err, c->err_len,
-                "ply_read_mesh: %s: byte %zu: header declares %llu vertices and %llu faces but "
-                "%llu bytes follow the header (%s)",
-                c->path, header_len, (unsigned long long)n_vert, (unsigned long long)n_face,
-                (unsigned long long)avail, fits ? "trailing bytes" : "file too short");
-        return ARGIL_ERR_PARSE;
+        io_err(c->err, c->err_len,
+               "ply_read_mesh: %s: byte %zu: header declares %llu vertices and %llu faces but "
+               "%llu bytes follow the header (%s)",
+               c->path, header_len, (unsigned long long)n_vert, (unsigned long long)n_face,
+               (unsigned long long)avail, fits ? "trailing bytes" : "file too short");
+        return PLY_ERR_SIZE;
     }
     if (out->has_rgb && !c->rgb) { /* a colour array left from an earlier use of out */
         free(out->rgb);
         out->rgb = NULL;
         out->has_rgb = 0;
     }
-    e = mesh_reserve(out, (size_t)n_vert, (size_t)n_face);
-    if (e == ARGIL_OK && c->rgb)
-        e = mesh_enable_rgb(out);
-    if (e != ARGIL_OK) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: %s: out of memory for %llu vertices",
-                c->path, (unsigned long long)n_vert);
-        return e;
+    argil_err_t me = mesh_reserve(out, (size_t)n_vert, (size_t)n_face);
+    if (me == ARGIL_OK && c->rgb)
+        me = mesh_enable_rgb(out);
+    if (me != ARGIL_OK) {
+        io_err(c->err, c->err_len, "ply_read_mesh: %s: out of memory for %llu vertices",
+               c->path, (unsigned long long)n_vert);
+        return PLY_ERR_NOMEM;
     }
     if (fseek(f, (long)header_len, SEEK_SET) != 0) {
-        ply_err(c->err, c->err_len, "ply_read_mesh: fseek(\"%s\") failed: %s", c->path,
-                strerror(errno));
-        return ARGIL_ERR_IO;
+        io_err(c->err, c->err_len, "ply_read_mesh: fseek(\"%s\") failed: %s", c->path,
+               strerror(errno));
+        return PLY_ERR_IO;
     }
     return ply_read_body(c, f, header_len, n_vert, n_face, out, buf);
 }
 
-argil_err_t ply_read_mesh(const char *path, mesh_t *out, char *err, size_t err_len)
+ply_err_t ply_read_mesh(const char *path, mesh_t *out, char *err, size_t err_len)
 {
     if (path == NULL || out == NULL) {
-        ply_err(err, err_len, "ply_read_mesh: no path or no mesh");
-        return ARGIL_ERR_ARG;
+        io_err(err, err_len, "ply_read_mesh: no path or no mesh");
+        return PLY_ERR_ARG;
     }
     mesh_clear(out);
     ply_ctx_t c = {path, err, err_len, false, PLY_VERT_BYTES};
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
-        ply_err(err, err_len, "ply_read_mesh: fopen(\"%s\") failed: %s", path, strerror(errno));
-        return ARGIL_ERR_IO;
+        io_err(err, err_len, "ply_read_mesh: fopen(\"%s\") failed: %s", path, strerror(errno));
+        return PLY_ERR_IO;
     }
     uint8_t *buf = malloc(PLY_CHUNK_BYTES);
-    argil_err_t e = ARGIL_ERR_NOMEM;
+    ply_err_t e = PLY_ERR_NOMEM;
     if (buf == NULL)
-        ply_err(err, err_len, "ply_read_mesh: %s: out of memory", path);
+        io_err(err, err_len, "ply_read_mesh: %s: out of memory", path);
     else
         e = ply_read_file(&c, f, out, buf);
     free(buf);
     (void)fclose(f);
-    if (e != ARGIL_OK)
+    if (e != PLY_OK)
         mesh_clear(out);
     return e;
 }

@@ -65,7 +65,7 @@ static int ply_size(ply_type_t t)
 }
 
 /* Parses the header; sets in->pos to the first body byte. */
-static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
+static import_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
 {
     io_lines_t it = {(const char *)in->buf, in->len, 0, 0, 0};
     char line[IMPORT_LINE_MAX];
@@ -77,19 +77,19 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
         if (n == -1 || k >= PLY_HEADER_LINES_MAX) {
             io_err(in->err, in->err_len, "%s: line %zu: header has no end_header line%s", in->path,
                    ln, n == -1 ? " (file ends)" : " within 512 lines");
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_PLY_HEADER_END;
         }
         if (n < 0) {
             io_err(in->err, in->err_len, "%s: line %zu: header line %s", in->path, ln,
                    n == -2 ? "longer than 1023 bytes" : "contains a NUL byte");
-            return ARGIL_ERR_PARSE;
+            return n == -2 ? IMPORT_ERR_LINE_LONG : IMPORT_ERR_LINE_NUL;
         }
         const int nt = io_tokens(line, tok, 7);
         if (k == 0) {
             if (nt != 1 || strcmp(tok[0], "ply") != 0) {
                 io_err(in->err, in->err_len, "%s: line 1: not a PLY file (first line must be 'ply')",
                        in->path);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_MAGIC;
             }
             continue;
         }
@@ -101,7 +101,7 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
                        "%s: line 2: expected 'format ascii|binary_little_endian|"
                        "binary_big_endian 1.0'",
                        in->path);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_FORMAT;
             }
             in->fmt = strcmp(tok[1], "ascii") == 0 ? 0 : (tok[1][7] == 'l' ? 1 : 2);
             continue;
@@ -111,25 +111,25 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
         if (strcmp(tok[0], "end_header") == 0 && nt == 1) {
             in->pos = it.pos;
             in->line_no = it.line_no;
-            return ARGIL_OK;
+            return IMPORT_OK;
         }
         if (strcmp(tok[0], "element") == 0) {
             uint64_t cnt;
             if (nt != 3 || strlen(tok[1]) >= sizeof(el[0].name)) {
                 io_err(in->err, in->err_len, "%s: line %zu: expected 'element <name> <count>'",
                        in->path, ln);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_ELEMENT;
             }
             if (!io_parse_u64(tok[2], (uint64_t)1 << 40, &cnt)) {
                 io_err(in->err, in->err_len,
                        "%s: line %zu: element count '%.32s' is not a whole number up to 2^40",
                        in->path, ln, tok[2]);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_ELEMENT;
             }
             if (*n_el == PLY_ELEMENTS_MAX) {
                 io_err(in->err, in->err_len, "%s: line %zu: more than %d elements", in->path, ln,
                        PLY_ELEMENTS_MAX);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_LIMIT;
             }
             ply_elem_t *e = &el[(*n_el)++];
             memset(e, 0, sizeof(*e));
@@ -141,13 +141,13 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
             if (*n_el == 0) {
                 io_err(in->err, in->err_len, "%s: line %zu: property before any element",
                        in->path, ln);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_PROPERTY;
             }
             ply_elem_t *e = &el[*n_el - 1];
             if (e->n_props == PLY_PROPS_MAX) {
                 io_err(in->err, in->err_len, "%s: line %zu: more than %d properties in '%s'",
                        in->path, ln, PLY_PROPS_MAX, e->name);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_LIMIT;
             }
             ply_prop_t *p = &e->props[e->n_props];
             const bool list = nt >= 2 && strcmp(tok[1], "list") == 0;
@@ -155,7 +155,7 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
             if (nt != want || strlen(tok[nt - 1]) >= sizeof(p->name)) {
                 io_err(in->err, in->err_len, "%s: line %zu: expected 'property <type> <name>' or "
                        "'property list <count type> <item type> <name>'", in->path, ln);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_PROPERTY;
             }
             p->count_type = list ? ply_type_of(tok[2]) : PT_BAD;
             p->type = ply_type_of(tok[list ? 3 : 1]);
@@ -163,7 +163,7 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
                                                p->count_type == PT_F64))) {
                 io_err(in->err, in->err_len, "%s: line %zu: unknown or unusable property type",
                        in->path, ln);
-                return ARGIL_ERR_PARSE;
+                return IMPORT_ERR_PLY_PROPERTY;
             }
             strcpy(p->name, tok[nt - 1]);
             e->n_props++;
@@ -171,7 +171,7 @@ static argil_err_t ply_header(ply_in_t *in, ply_elem_t *el, int *n_el)
         }
         io_err(in->err, in->err_len, "%s: line %zu: unknown header keyword '%.32s'", in->path, ln,
                tok[0]);
-        return ARGIL_ERR_PARSE;
+        return IMPORT_ERR_PLY_KEYWORD;
     }
 }
 
@@ -185,8 +185,8 @@ static void ply_where(const ply_in_t *in, char *s, size_t n)
 }
 
 /* Reads one value of type t; err names elem/record. */
-static argil_err_t ply_value(ply_in_t *in, ply_type_t t, const ply_elem_t *e, uint64_t rec,
-                             double *out)
+static import_err_t ply_value(ply_in_t *in, ply_type_t t, const ply_elem_t *e, uint64_t rec,
+                              double *out)
 {
     char where[48];
     if (in->fmt == 0) {
@@ -207,33 +207,33 @@ static argil_err_t ply_value(ply_in_t *in, ply_type_t t, const ply_elem_t *e, ui
             const bool nl_end = in->len > 0 && in->buf[in->len - 1] == '\n';
             io_err(in->err, in->err_len, "%s: line %zu: file ends inside %s %llu", in->path,
                    in->line_no + (nl_end ? 0 : 1), e->name, (unsigned long long)rec);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_TRUNCATED;
         }
         if (n >= sizeof(tok) || memchr(in->buf + s, 0, n) != NULL) {
             io_err(in->err, in->err_len, "%s: line %zu: %s %llu: value is not a number", in->path,
                    in->line_no + 1, e->name, (unsigned long long)rec);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_NUMBER;
         }
         memcpy(tok, in->buf + s, n);
         tok[n] = '\0';
         if (!io_parse_double(tok, out)) {
             io_err(in->err, in->err_len, "%s: line %zu: %s %llu: '%s' is not a finite number",
                    in->path, in->line_no + 1, e->name, (unsigned long long)rec, tok);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_NUMBER;
         }
         if (t != PT_F32 && t != PT_F64 && *out != floor(*out)) {
             io_err(in->err, in->err_len, "%s: line %zu: %s %llu: '%s' must be a whole number",
                    in->path, in->line_no + 1, e->name, (unsigned long long)rec, tok);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_PLY_WHOLE;
         }
-        return ARGIL_OK;
+        return IMPORT_OK;
     }
     const int sz = ply_size(t);
     if (in->len - in->pos < (size_t)sz) {
         ply_where(in, where, sizeof(where));
         io_err(in->err, in->err_len, "%s: %s: file ends inside %s %llu", in->path, where, e->name,
                (unsigned long long)rec);
-        return ARGIL_ERR_PARSE;
+        return IMPORT_ERR_TRUNCATED;
     }
     uint8_t b[8];
     for (int k = 0; k < sz; k++)
@@ -264,10 +264,10 @@ static argil_err_t ply_value(ply_in_t *in, ply_type_t t, const ply_elem_t *e, ui
         ply_where(in, where, sizeof(where));
         io_err(in->err, in->err_len, "%s: %s: %s %llu: value is not finite (NaN or Inf)",
                in->path, where, e->name, (unsigned long long)rec);
-        return ARGIL_ERR_PARSE;
+        return IMPORT_ERR_NUMBER;
     }
     in->pos += (size_t)sz;
-    return ARGIL_OK;
+    return IMPORT_OK;
 }
 
 static int ply_find(const ply_elem_t *e, const char *name)
@@ -280,7 +280,7 @@ static int ply_find(const ply_elem_t *e, const char *name)
 
 /* Refuses element counts the bytes after the header cannot hold: every record takes at least
  * min bytes (binary: its fixed parts; ASCII: two bytes a value), checked before any allocation. */
-static argil_err_t ply_check_counts(ply_in_t *in, const ply_elem_t *el, int n_el)
+static import_err_t ply_check_counts(ply_in_t *in, const ply_elem_t *el, int n_el)
 {
     uint64_t need = 0;
     for (int i = 0; i < n_el; i++) {
@@ -296,23 +296,23 @@ static argil_err_t ply_check_counts(ply_in_t *in, const ply_elem_t *el, int n_el
                    "the header",
                    in->path, in->pos, el[i].name, (unsigned long long)el[i].count,
                    in->len - in->pos);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_PLY_COUNTS;
         }
         need += el[i].count * min;
         if (need > (uint64_t)(in->len - in->pos)) {
             io_err(in->err, in->err_len, "%s: byte %zu: elements declare more data than the %zu "
                    "bytes after the header", in->path, in->pos, in->len - in->pos);
-            return ARGIL_ERR_PARSE;
+            return IMPORT_ERR_PLY_COUNTS;
         }
     }
-    return ARGIL_OK;
+    return IMPORT_OK;
 }
 
 /* Reads all elements into out. */
-static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out, bool *normals)
+static import_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out, bool *normals)
 {
-    const argil_err_t ce = ply_check_counts(in, el, n_el);
-    if (ce != ARGIL_OK)
+    const import_err_t ce = ply_check_counts(in, el, n_el);
+    if (ce != IMPORT_OK)
         return ce;
     const ply_elem_t *ve = NULL;
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1;
@@ -334,16 +334,16 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
         ve->props[iy].count_type != PT_BAD || ve->props[iz].count_type != PT_BAD) {
         io_err(in->err, in->err_len, "%s: header: no 'vertex' element with scalar x, y and z",
                in->path);
-        return ARGIL_ERR_PARSE;
+        return IMPORT_ERR_PLY_NO_VERTEX;
     }
     *normals = inx >= 0 && iny >= 0 && inz >= 0;
     const bool rgb = ir >= 0 && ig >= 0 && ib >= 0;
     if (rgb && mesh_enable_rgb(out) != ARGIL_OK)
-        return ARGIL_ERR_NOMEM;
+        return IMPORT_ERR_NOMEM;
     if (mesh_reserve(out, (size_t)ve->count, 0) != ARGIL_OK) {
         io_err(in->err, in->err_len, "%s: out of memory for %llu vertices", in->path,
                (unsigned long long)ve->count);
-        return ARGIL_ERR_NOMEM;
+        return IMPORT_ERR_NOMEM;
     }
     uint64_t n_vert_seen = 0;
     bool faces_before_vertices = false;
@@ -357,23 +357,23 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
             double v[PLY_PROPS_MAX] = {0};
             for (int k = 0; k < e->n_props; k++) {
                 const ply_prop_t *p = &e->props[k];
-                argil_err_t er;
+                import_err_t er;
                 if (p->count_type == PT_BAD) {
                     er = ply_value(in, p->type, e, r, &v[k]);
-                    if (er != ARGIL_OK)
+                    if (er != IMPORT_OK)
                         return er;
                     continue;
                 }
                 double cnt_d;
                 er = ply_value(in, p->count_type, e, r, &cnt_d);
-                if (er != ARGIL_OK)
+                if (er != IMPORT_OK)
                     return er;
                 char where[48];
                 ply_where(in, where, sizeof(where));
                 if (cnt_d < 0 || cnt_d > 1000000) {
                     io_err(in->err, in->err_len, "%s: %s: %s %llu: list length %.0f out of 0..10^6",
                            in->path, where, e->name, (unsigned long long)r, cnt_d);
-                    return ARGIL_ERR_PARSE;
+                    return IMPORT_ERR_PLY_LIST_LENGTH;
                 }
                 const uint32_t cnt = (uint32_t)cnt_d;
                 const bool poly = is_f && (strcmp(p->name, "vertex_indices") == 0 ||
@@ -381,13 +381,13 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
                 if (poly && cnt < 3) {
                     io_err(in->err, in->err_len, "%s: %s: face %llu has %u vertices (at least 3)",
                            in->path, where, (unsigned long long)r, cnt);
-                    return ARGIL_ERR_PARSE;
+                    return IMPORT_ERR_FACE_SIZE;
                 }
                 double first = 0, prev = 0;
                 for (uint32_t q = 0; q < cnt; q++) {
                     double idx;
                     er = ply_value(in, p->type, e, r, &idx);
-                    if (er != ARGIL_OK)
+                    if (er != IMPORT_OK)
                         return er;
                     if (!poly)
                         continue;
@@ -396,7 +396,7 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
                         io_err(in->err, in->err_len, "%s: %s: face %llu names vertex %.0f of %llu",
                                in->path, where, (unsigned long long)r, idx,
                                (unsigned long long)ve->count);
-                        return ARGIL_ERR_PARSE;
+                        return IMPORT_ERR_INDEX;
                     }
                     if (q == 0)
                         first = idx;
@@ -404,12 +404,12 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
                         if (faces_before_vertices) {
                             io_err(in->err, in->err_len, "%s: %s: faces come before vertices",
                                    in->path, where);
-                            return ARGIL_ERR_PARSE;
+                            return IMPORT_ERR_PLY_FACE_ORDER;
                         }
                         if (mesh_add_triangle(out, (uint32_t)first, (uint32_t)prev,
                                               (uint32_t)idx) != ARGIL_OK) {
                             io_err(in->err, in->err_len, "%s: out of memory for faces", in->path);
-                            return ARGIL_ERR_NOMEM;
+                            return IMPORT_ERR_NOMEM;
                         }
                     }
                     prev = idx;
@@ -422,11 +422,11 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
                 if (!vec3_isfinite(pos) || !vec3_isfinite(nrm)) {
                     io_err(in->err, in->err_len, "%s: vertex %llu: coordinates overflow a float",
                            in->path, (unsigned long long)r);
-                    return ARGIL_ERR_PARSE;
+                    return IMPORT_ERR_NUMBER;
                 }
                 uint32_t id;
                 if (mesh_add_vertex(out, pos, nrm, &id) != ARGIL_OK)
-                    return ARGIL_ERR_NOMEM;
+                    return IMPORT_ERR_NOMEM;
                 if (rgb) {
                     const int ci[3] = {ir, ig, ib};
                     for (int c = 0; c < 3; c++) {
@@ -445,39 +445,34 @@ static argil_err_t ply_body(ply_in_t *in, ply_elem_t *el, int n_el, mesh_t *out,
     if (in->fmt != 0 && in->pos != in->len) {
         io_err(in->err, in->err_len, "%s: byte %zu: %zu bytes after the last element", in->path,
                in->pos, in->len - in->pos);
-        return ARGIL_ERR_PARSE;
+        return IMPORT_ERR_PLY_TRAILING;
     }
-    return ARGIL_OK;
+    return IMPORT_OK;
 }
 
-argil_err_t ply_load(const char *path, mesh_t *out, bool *has_normals, char *err, size_t err_len)
+import_err_t ply_load(const char *path, mesh_t *out, bool *has_normals, char *err, size_t err_len)
 {
-    if (path == NULL || out == NULL) {
-        io_err(err, err_len, "ply_load: no path or no mesh");
-        return ARGIL_ERR_ARG;
-    }
-    mesh_clear(out);
     uint8_t *buf;
     size_t len;
-    argil_err_t e = io_slurp(path, IO_FILE_MAX_BYTES, &buf, &len, err, err_len);
-    if (e != ARGIL_OK)
+    import_err_t e = import_slurp("ply_load", path, out, &buf, &len, err, err_len);
+    if (e != IMPORT_OK)
         return e;
     ply_elem_t *el = malloc(sizeof(ply_elem_t) * PLY_ELEMENTS_MAX);
     if (el == NULL) {
         free(buf);
-        return ARGIL_ERR_NOMEM;
+        return IMPORT_ERR_NOMEM;
     }
     ply_in_t in = {path, err, err_len, buf, len, 0, 0, 0};
     int n_el = 0;
     bool normals = false;
     e = ply_header(&in, el, &n_el);
-    if (e == ARGIL_OK)
+    if (e == IMPORT_OK)
         e = ply_body(&in, el, n_el, out, &normals);
     free(el);
     free(buf);
-    if (e != ARGIL_OK)
+    if (e != IMPORT_OK)
         mesh_clear(out);
     if (has_normals != NULL)
-        *has_normals = e == ARGIL_OK && normals;
+        *has_normals = e == IMPORT_OK && normals;
     return e;
 }

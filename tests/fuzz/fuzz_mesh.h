@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <unistd.h>
 
+#include "host/io/mesh_import.h"
 #include "host/mesh/mesh.h"
 #include "shared/argil_err.h"
 #include "tests/fuzz/fuzz_file.h"
@@ -25,7 +26,7 @@ static inline void fuzz_check_mesh(const mesh_t *m)
 }
 
 /* A mesh reader with the shape every importer shares (normals flag dropped where it has one). */
-typedef argil_err_t (*fuzz_mesh_reader_fn)(const char *path, mesh_t *m, char *err, size_t err_len);
+typedef import_err_t (*fuzz_mesh_reader_fn)(const char *path, mesh_t *m, char *err, size_t err_len);
 
 /* The whole body of a mesh-reader target: the input bytes become a temporary file with the
  * given extension; an accepted mesh must pass fuzz_check_mesh, and any error must be one line
@@ -39,8 +40,8 @@ static inline int fuzz_mesh_reader(const uint8_t *data, size_t size, const char 
         err[0] = '\0';
         mesh_t m;
         mesh_init(&m);
-        const argil_err_t e = read(path, &m, err, sizeof(err));
-        if (e == ARGIL_OK)
+        const import_err_t e = read(path, &m, err, sizeof(err));
+        if (e == IMPORT_OK)
             fuzz_check_mesh(&m);
         else if (!fuzz_error_names_file(err, path))
             abort(); /* every error is one line naming the file */

@@ -9,7 +9,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static argil_err_t read_obj(const char *path, mesh_t *m, char *err, size_t err_len)
+static import_err_t read_obj(const char *path, mesh_t *m, char *err, size_t err_len)
 {
     bool normals = false;
     return obj_read(path, m, &normals, err, err_len);

@@ -19,8 +19,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         mesh_init(&m);
         char err[256];
         err[0] = '\0';
-        const argil_err_t e = ply_read_mesh(path, &m, err, sizeof(err));
-        if (e == ARGIL_OK) {
+        const ply_err_t e = ply_read_mesh(path, &m, err, sizeof(err));
+        if (e == PLY_OK) {
             /* Whatever was accepted must be a consistent mesh. */
             fuzz_check_mesh(&m);
             (void)mesh_volume_m3(&m);

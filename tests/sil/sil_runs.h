@@ -114,7 +114,7 @@ static inline void sil_read_final(const char *dir, mesh_t *m)
     char path[128], err[512] = "";
     snprintf(path, sizeof(path), "%s/final.ply", dir);
     mesh_init(m);
-    assert_int_equal(ply_read_mesh(path, m, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(path, m, err, sizeof(err)), PLY_OK);
 }
 
 /* The farthest vertex of m along sign·axis among those within 2 mm of that axis line, mm. */

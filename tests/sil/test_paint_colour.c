@@ -172,7 +172,7 @@ static void test_paint_stroke_shows_and_persists(void **st)
     snprintf(ply, sizeof(ply), "%s/final.ply", dir);
     mesh_t fm;
     mesh_init(&fm);
-    if (ply_read_mesh(ply, &fm, err, sizeof(err)) != ARGIL_OK)
+    if (ply_read_mesh(ply, &fm, err, sizeof(err)) != PLY_OK)
         fail_msg("%s", err);
     assert_true(fm.has_rgb);
     assert_int_equal(fm.n_vert, m.n_vert);

@@ -99,7 +99,7 @@ static void test_surface_moved_where_the_script_worked(void **st)
     snprintf(path, sizeof(path), "%s/final.ply", runs.dir[0]);
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(ply_read_mesh(path, &m, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(path, &m, err, sizeof(err)), PLY_OK);
     size_t boundary, nonmanifold;
     assert_true(mesh_watertight(&m, &boundary, &nonmanifold));
     /* Pushed in on +z: the surface on the z axis is at least 2 mm below the sphere. */

@@ -76,7 +76,7 @@ static void test_round_trips(void **state)
     for (size_t k = 0; k < 3; k++) {
         test_path(p, sizeof(p), cases[k].name);
         assert_int_equal(mesh_export(p, &m, cases[k].fmt, err, sizeof(err)), ARGIL_OK);
-        assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
+        assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), IMPORT_OK);
         assert_true(nrm);
         assert_same_geometry(&m, &r, 1e-7f);
         assert_true(r.has_rgb);
@@ -88,7 +88,7 @@ static void test_round_trips(void **state)
     /* STL: welded back to the same closed surface with the same volume. */
     test_path(p, sizeof(p), "d.stl");
     assert_int_equal(mesh_export(p, &m, EXPORT_STL, err, sizeof(err)), ARGIL_OK);
-    assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(stl_read(p, &r, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_vert, m.n_vert);
     assert_int_equal(r.n_tri, m.n_tri);
     assert_true(mesh_watertight(&r, NULL, NULL));
@@ -98,7 +98,7 @@ static void test_round_trips(void **state)
     const char *a = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
                     "   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
     test_spit(p, a, strlen(a));
-    assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(stl_read(p, &r, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_tri, 1);
     assert_float_equal(r.normal[2], 1.0f, 1e-6f);
     uint8_t bin[134] = "solid but binary";
@@ -106,19 +106,19 @@ static void test_round_trips(void **state)
     for (int k = 0; k < 3; k++)
         memcpy(bin + 96 + 12 * k + 4 * k, &(float){1.0f}, 4);
     test_spit(p, bin, sizeof(bin));
-    assert_int_equal(stl_read(p, &r, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(stl_read(p, &r, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_vert, 3);
     /* XYZ with and without normals, comments and blank lines. */
     test_path(p, sizeof(p), "f.xyz");
     const char *x6 = "# cloud\n0 0 1 0 0 1\n\n1 0 0 1 0 0\r\n0 1 0 0 1 0\n";
     test_spit(p, x6, strlen(x6));
-    assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(mesh_import(p, &r, &nrm, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_vert, 3);
     assert_true(nrm);
     assert_float_equal(r.normal[3], 1.0f, 0);
     const char *x3 = "0 0 1\n1.5e-3 -2 0\n";
     test_spit(p, x3, strlen(x3));
-    assert_int_equal(xyz_read(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(xyz_read(p, &r, &nrm, err, sizeof(err)), IMPORT_OK);
     assert_false(nrm);
     assert_float_equal(r.pos[3], 1.5e-3f, 0);
     /* PLY variants: big-endian doubles with an extra element and a quad face; OBJ forms. */
@@ -147,7 +147,7 @@ static void test_round_trips(void **state)
     memcpy(file, ph, strlen(ph));
     memcpy(file + strlen(ph), body, o);
     test_spit(p, file, strlen(ph) + o);
-    assert_int_equal(ply_load(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_load(p, &r, &nrm, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_vert, 4);
     assert_int_equal(r.n_tri, 2);
     assert_false(nrm);
@@ -156,31 +156,31 @@ static void test_round_trips(void **state)
     const char *ob = "mtllib x.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\n"
                      "vn 0 0 1\ng g\ns off\nusemtl m\nf 1/1/1 2/1/1 3/1/1 4/1/1\nf -4 -2 -1 # tri\n";
     test_spit(p, ob, strlen(ob));
-    assert_int_equal(obj_read(p, &r, &nrm, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(obj_read(p, &r, &nrm, err, sizeof(err)), IMPORT_OK);
     assert_int_equal(r.n_tri, 3);
     assert_true(nrm); /* every vertex got vn 1 through the quad */
     mesh_free(&m);
     mesh_free(&r);
 }
 
-typedef argil_err_t (*reader_fn)(const char *, mesh_t *, bool *, char *, size_t);
+typedef import_err_t (*reader_fn)(const char *, mesh_t *, bool *, char *, size_t);
 
-static argil_err_t rd_stl(const char *p, mesh_t *m, bool *n, char *e, size_t l)
+static import_err_t rd_stl(const char *p, mesh_t *m, bool *n, char *e, size_t l)
 {
     (void)n;
     return stl_read(p, m, e, l);
 }
 
-/* Writes data, reads it with fn, expects PARSE (or want) and needles in the one-line message. */
+/* Writes data, reads it with fn, expects the rule want and needles in the one-line message. */
 static void expect_err(reader_fn fn, const char *name, const void *data, size_t len,
-                       argil_err_t want, const char *where, const char *rule)
+                       import_err_t want, const char *where, const char *rule)
 {
     char p[128], err[512] = "";
     test_path(p, sizeof(p), name);
     test_spit(p, data, len);
     mesh_t m;
     mesh_init(&m);
-    const argil_err_t got = fn(p, &m, NULL, err, sizeof(err));
+    const import_err_t got = fn(p, &m, NULL, err, sizeof(err));
     if (got != want || strstr(err, p) == NULL || strstr(err, where) == NULL ||
         strstr(err, rule) == NULL || strchr(err, '\n') != NULL)
         fail_msg("%s: got %d '%s', want %d with '%s' and '%s'", name, got, err, want, where, rule);
@@ -189,8 +189,8 @@ static void expect_err(reader_fn fn, const char *name, const void *data, size_t 
     mesh_free(&m);
 }
 
-#define EXPECT_TXT(fn, name, text, where, rule) \
-    expect_err(fn, name, text, strlen(text), ARGIL_ERR_PARSE, where, rule)
+#define EXPECT_TXT(fn, name, text, want, where, rule) \
+    expect_err(fn, name, text, strlen(text), want, where, rule)
 
 #define PH "ply\nformat ascii 1.0\n"
 
@@ -198,81 +198,100 @@ static void test_ply_errors(void **state)
 {
     (void)state;
     char buf[8192];
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex 0\n", "line 3",
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex 0\n",
+               IMPORT_ERR_PLY_HEADER_END, "line 3",
                "no end_header");
     size_t o = (size_t)sprintf(buf, "%s", PH);
     for (int i = 0; i < 600; i++)
         o += (size_t)sprintf(buf + o, "comment x\n");
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 513", "within 512 lines");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_PLY_HEADER_END, "line 513", "within 512 lines");
     memset(buf, 'a', 2000);
     memcpy(buf, "ply\ncomment ", 12);
     buf[2000] = '\n';
-    expect_err(ply_load, "e.ply", buf, 2001, ARGIL_ERR_PARSE, "line 2", "longer than 1023");
-    expect_err(ply_load, "e.ply", "ply\nfor\0mat\n", 12, ARGIL_ERR_PARSE, "line 2", "NUL byte");
-    EXPECT_TXT(ply_load, "e.ply", "PLY\n", "line 1", "not a PLY file");
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat binary 1.0\n", "line 2", "expected 'format");
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex\n", "line 3",
+    expect_err(ply_load, "e.ply", buf, 2001, IMPORT_ERR_LINE_LONG, "line 2", "longer than 1023");
+    expect_err(ply_load, "e.ply", "ply\nfor\0mat\n", 12, IMPORT_ERR_LINE_NUL, "line 2", "NUL byte");
+    EXPECT_TXT(ply_load, "e.ply", "PLY\n", IMPORT_ERR_PLY_MAGIC, "line 1", "not a PLY file");
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat binary 1.0\n", IMPORT_ERR_PLY_FORMAT,
+               "line 2", "expected 'format");
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex\n", IMPORT_ERR_PLY_ELEMENT,
+               "line 3",
                "expected 'element");
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex -3\n", "line 3",
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex -3\n",
+               IMPORT_ERR_PLY_ELEMENT, "line 3",
                "not a whole number");
     o = (size_t)sprintf(buf, "%s", PH);
     for (int i = 0; i < 17; i++)
         o += (size_t)sprintf(buf + o, "element e%d 0\n", i);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 19", "more than 16 elements");
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nproperty float x\n", "line 3",
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_PLY_LIMIT, "line 19", "more than 16 elements");
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nproperty float x\n",
+               IMPORT_ERR_PLY_PROPERTY, "line 3",
                "property before any element");
     o = (size_t)sprintf(buf, "%selement vertex 0\n", PH);
     for (int i = 0; i < 33; i++)
         o += (size_t)sprintf(buf + o, "property float p%d\n", i);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 36", "more than 32 properties");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_PLY_LIMIT, "line 36", "more than 32 properties");
     EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float\n",
+               IMPORT_ERR_PLY_PROPERTY,
                "line 4", "expected 'property");
     EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\n",
+               IMPORT_ERR_PLY_PROPERTY,
                "line 4", "unknown or unusable property type");
     EXPECT_TXT(ply_load, "e.ply",
-               "ply\nformat ascii 1.0\nelement f 1\nproperty list float int v\n", "line 4",
+               "ply\nformat ascii 1.0\nelement f 1\nproperty list float int v\n",
+               IMPORT_ERR_PLY_PROPERTY, "line 4",
                "unknown or unusable property type");
-    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nbogus\n", "line 3",
+    EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nbogus\n", IMPORT_ERR_PLY_KEYWORD,
+               "line 3",
                "unknown header keyword 'bogus'");
 #define VH "ply\nformat binary_little_endian 1.0\nelement vertex %s\nproperty float x\n" \
            "property float y\nproperty float z\n%send_header\n"
     sprintf(buf, VH, "1099511627776", "");
-    EXPECT_TXT(ply_load, "e.ply", buf, "byte 127", "declares 1099511627776 records but only 0");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_PLY_COUNTS,
+               "byte 127", "declares 1099511627776 records but only 0");
     sprintf(buf, VH, "1", "element face 1\nproperty list uchar int vertex_indices\n");
     o = strlen(buf);
     memset(buf + o, 0, 12);
-    expect_err(ply_load, "e.ply", buf, o + 12, ARGIL_ERR_PARSE, "byte", "elements declare more");
+    expect_err(ply_load, "e.ply", buf, o + 12, IMPORT_ERR_PLY_COUNTS,
+               "byte", "elements declare more");
     EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-               "end_header\n1\n", "header", "no 'vertex' element with scalar x, y and z");
+               "end_header\n1\n", IMPORT_ERR_PLY_NO_VERTEX,
+               "header", "no 'vertex' element with scalar x, y and z");
     const char *ah = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
                      "property float z\nproperty uchar red\nproperty uchar green\n"
                      "property uchar blue\nelement face 1\nproperty list uchar int vertex_indices\n"
                      "end_header\n";
     sprintf(buf, "%s0 0 0 1 2 3\n1 1 1 4 5 6\n3 0 1\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 15", "file ends inside face 0");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_TRUNCATED, "line 15", "file ends inside face 0");
     sprintf(buf, "%s0 0 0 1 2 3\n1 1 11111111111111111111111111111111111111111111111111111111111111111111 4 5 6\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 14", "vertex 1: value is not a number");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_NUMBER,
+               "line 14", "vertex 1: value is not a number");
     sprintf(buf, "%s0 0 0 1 2 3\n1 nan 1 4 5 6\n3 0 1 1\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 14", "'nan' is not a finite number");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_NUMBER,
+               "line 14", "'nan' is not a finite number");
     sprintf(buf, "%s0 0 0 1 2.5 3\n1 1 1 4 5 6\n3 0 1 1\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 13", "'2.5' must be a whole number");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_PLY_WHOLE,
+               "line 13", "'2.5' must be a whole number");
     sprintf(buf, "%s0 0 0 1 2 3\n1 1 1 4 5 6\n2 0 1\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 15", "face 0 has 2 vertices (at least 3)");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_FACE_SIZE,
+               "line 15", "face 0 has 2 vertices (at least 3)");
     sprintf(buf, "%s0 0 0 1 2 3\n1 1 1 4 5 6\n3 0 1 2\n", ah);
-    EXPECT_TXT(ply_load, "e.ply", buf, "line 15", "face 0 names vertex 2 of 2");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_INDEX, "line 15", "face 0 names vertex 2 of 2");
     sprintf(buf, "%s1e300 0 0 1 2 3\n1 1 1 4 5 6\n3 0 1 1\n", PH "element vertex 2\nproperty double x\n"
             "property float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
             "property uchar blue\nelement face 1\nproperty list uchar int vertex_indices\n"
             "end_header\n");
-    EXPECT_TXT(ply_load, "e.ply", buf, "vertex 0", "coordinates overflow a float");
+    EXPECT_TXT(ply_load, "e.ply", buf, IMPORT_ERR_NUMBER,
+               "vertex 0", "coordinates overflow a float");
     EXPECT_TXT(ply_load, "e.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int "
                "vertex_indices\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
-               "z\nend_header\n3 0 1 2\n0 0 0\n1 0 0\n0 1 0\n", "line 10", "faces come before vertices");
+               "z\nend_header\n3 0 1 2\n0 0 0\n1 0 0\n0 1 0\n", IMPORT_ERR_PLY_FACE_ORDER,
+               "line 10", "faces come before vertices");
     /* binary: truncated, NaN, bad list length, trailing bytes */
     sprintf(buf, VH, "2", "");
     o = strlen(buf);
     memset(buf + o, 0, 20);
-    expect_err(ply_load, "e.ply", buf, o + 20, ARGIL_ERR_PARSE, "byte", "declares 2 records but only 20");
+    expect_err(ply_load, "e.ply", buf, o + 20, IMPORT_ERR_PLY_COUNTS,
+               "byte", "declares 2 records but only 20");
     sprintf(buf, VH, "1", "");
     o = strlen(buf);
     memset(buf + o, 0, 12);
@@ -280,27 +299,30 @@ static void test_ply_errors(void **state)
     buf[o + 6] = (char)0xc0; /* y = NaN */
     char where[32];
     sprintf(where, "byte %zu", o + 4);
-    expect_err(ply_load, "e.ply", buf, o + 12, ARGIL_ERR_PARSE, where, "not finite (NaN or Inf)");
+    expect_err(ply_load, "e.ply", buf, o + 12, IMPORT_ERR_NUMBER, where, "not finite (NaN or Inf)");
     memset(buf + o, 0, 16);
     sprintf(where, "byte %zu", o + 12);
-    expect_err(ply_load, "e.ply", buf, o + 16, ARGIL_ERR_PARSE, where, "4 bytes after the last");
+    expect_err(ply_load, "e.ply", buf, o + 16, IMPORT_ERR_PLY_TRAILING,
+               where, "4 bytes after the last");
     sprintf(buf, VH, "1", "element face 1\nproperty list int int vertex_indices\n");
     o = strlen(buf);
     memset(buf + o, 0, 12);
     memset(buf + o + 12, 0xff, 4); /* count -1 */
-    expect_err(ply_load, "e.ply", buf, o + 16, ARGIL_ERR_PARSE, "byte", "list length -1 out of");
+    expect_err(ply_load, "e.ply", buf, o + 16, IMPORT_ERR_PLY_LIST_LENGTH,
+               "byte", "list length -1 out of");
     memset(buf + o + 12, 0, 4);
     buf[o + 12] = 3;
-    expect_err(ply_load, "e.ply", buf, o + 16, ARGIL_ERR_PARSE, "byte", "file ends inside face 0");
+    expect_err(ply_load, "e.ply", buf, o + 16, IMPORT_ERR_TRUNCATED,
+               "byte", "file ends inside face 0");
     char p[128], err[256];
     test_path(p, sizeof(p), "missing.ply");
     mesh_t m;
     mesh_init(&m);
-    assert_int_equal(ply_load(p, &m, NULL, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(ply_load(p, &m, NULL, err, sizeof(err)), IMPORT_ERR_IO);
     assert_non_null(strstr(err, "cannot open"));
-    assert_int_equal(ply_load(g_test_dir, &m, NULL, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(ply_load(g_test_dir, &m, NULL, err, sizeof(err)), IMPORT_ERR_IO);
     assert_non_null(strstr(err, "not a regular file"));
-    assert_int_equal(mesh_import("x.foo", &m, NULL, err, sizeof(err)), ARGIL_ERR_ARG);
+    assert_int_equal(mesh_import("x.foo", &m, NULL, err, sizeof(err)), IMPORT_ERR_ARG);
     assert_non_null(strstr(err, "unknown extension"));
     mesh_free(&m);
 }
@@ -309,30 +331,40 @@ static void test_stl_errors(void **state)
 {
     (void)state;
     uint8_t b[200] = {0};
-    expect_err(rd_stl, "e.stl", b, 50, ARGIL_ERR_PARSE, "byte 50", "too short for binary STL");
+    expect_err(rd_stl, "e.stl", b, 50, IMPORT_ERR_STL_SIZE, "byte 50", "too short for binary STL");
     b[80] = 3;
-    expect_err(rd_stl, "e.stl", b, 134, ARGIL_ERR_PARSE, "byte 80", "declares 3 facets");
+    expect_err(rd_stl, "e.stl", b, 134, IMPORT_ERR_STL_SIZE, "byte 80", "declares 3 facets");
     b[80] = 1;
     b[96 + 3] = 0x7f;
     b[96 + 2] = 0x80; /* +Inf */
-    expect_err(rd_stl, "e.stl", b, 134, ARGIL_ERR_PARSE, "byte 96", "facet 0 has a non-finite");
+    expect_err(rd_stl, "e.stl", b, 134, IMPORT_ERR_NUMBER, "byte 96", "facet 0 has a non-finite");
     char big[1500];
     memset(big, 'x', sizeof(big));
     memcpy(big, "solid a\n", 8);
-    expect_err(rd_stl, "e.stl", big, sizeof(big), ARGIL_ERR_PARSE, "line 2", "longer than 1023");
-    expect_err(rd_stl, "e.stl", "solid a\nfa\0cet\n", 15, ARGIL_ERR_PARSE, "line 2", "NUL byte");
-    EXPECT_TXT(rd_stl, "e.stl", "solidx\n", "line 1", "expects 'solid <name>'");
-    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 x\n", "line 2", "expects 'facet normal");
-    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\nouter loo\n", "line 3",
+    expect_err(rd_stl, "e.stl", big, sizeof(big), IMPORT_ERR_LINE_LONG,
+               "line 2", "longer than 1023");
+    expect_err(rd_stl, "e.stl", "solid a\nfa\0cet\n", 15, IMPORT_ERR_LINE_NUL,
+               "line 2", "NUL byte");
+    EXPECT_TXT(rd_stl, "e.stl", "solidx\n", IMPORT_ERR_STL_SYNTAX,
+               "line 1", "expects 'solid <name>'");
+    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 x\n", IMPORT_ERR_STL_SYNTAX,
+               "line 2", "expects 'facet normal");
+    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\nouter loo\n", IMPORT_ERR_STL_SYNTAX,
+               "line 3",
                "expects 'outer loop'");
     EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\n",
+               IMPORT_ERR_STL_SYNTAX,
                "line 4", "expects 'vertex x y z'");
     EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
-               "vertex 0 0 0\nvertex 0 0 0\nvertex 0 0 0\n", "line 7", "expects 'endloop'");
+               "vertex 0 0 0\nvertex 0 0 0\nvertex 0 0 0\n", IMPORT_ERR_STL_SYNTAX,
+               "line 7", "expects 'endloop'");
     EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
-               "vertex 0 0 0\nvertex 0 0 0\nendloop\nendloop\n", "line 8", "expects 'endfacet'");
-    EXPECT_TXT(rd_stl, "e.stl", "solid a\nendsolid a\nsolid b\n", "line 3", "nothing after endsolid");
-    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\n", "line 2", "before 'endsolid'");
+               "vertex 0 0 0\nvertex 0 0 0\nendloop\nendloop\n", IMPORT_ERR_STL_SYNTAX,
+               "line 8", "expects 'endfacet'");
+    EXPECT_TXT(rd_stl, "e.stl", "solid a\nendsolid a\nsolid b\n", IMPORT_ERR_STL_SYNTAX,
+               "line 3", "nothing after endsolid");
+    EXPECT_TXT(rd_stl, "e.stl", "solid a\nfacet normal 0 0 1\n", IMPORT_ERR_TRUNCATED,
+               "line 2", "before 'endsolid'");
 }
 
 static void test_obj_xyz_errors(void **state)
@@ -342,28 +374,39 @@ static void test_obj_xyz_errors(void **state)
     memset(big, '1', sizeof(big));
     big[0] = 'v';
     big[1] = ' ';
-    expect_err(obj_read, "e.obj", big, sizeof(big), ARGIL_ERR_PARSE, "line 1", "longer than 1023");
-    expect_err(obj_read, "e.obj", "v 0 0\0 0\n", 9, ARGIL_ERR_PARSE, "line 1", "NUL byte");
-    EXPECT_TXT(obj_read, "e.obj", "# c\nv 0 0\n", "line 2", "'v' needs 3 (x y z)");
-    EXPECT_TXT(obj_read, "e.obj", "v 0 0 inf\n", "line 1", "'v' needs 3");
-    EXPECT_TXT(obj_read, "e.obj", "vn 0 0\n", "line 1", "'vn' needs 3 finite numbers");
-    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", "line 3", "'f' needs 3 to 64");
-    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n", "line 3",
+    expect_err(obj_read, "e.obj", big, sizeof(big), IMPORT_ERR_LINE_LONG,
+               "line 1", "longer than 1023");
+    expect_err(obj_read, "e.obj", "v 0 0\0 0\n", 9, IMPORT_ERR_LINE_NUL, "line 1", "NUL byte");
+    EXPECT_TXT(obj_read, "e.obj", "# c\nv 0 0\n", IMPORT_ERR_OBJ_VERTEX,
+               "line 2", "'v' needs 3 (x y z)");
+    EXPECT_TXT(obj_read, "e.obj", "v 0 0 inf\n", IMPORT_ERR_OBJ_VERTEX, "line 1", "'v' needs 3");
+    EXPECT_TXT(obj_read, "e.obj", "vn 0 0\n", IMPORT_ERR_OBJ_VERTEX,
+               "line 1", "'vn' needs 3 finite numbers");
+    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", IMPORT_ERR_FACE_SIZE,
+               "line 3", "'f' needs 3 to 64");
+    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n", IMPORT_ERR_INDEX, "line 3",
                "face corner 3 names a vertex or normal that does not exist");
-    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nv 1 1 1\nf 1 2 -4\n", "line 4",
+    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nv 1 1 1\nf 1 2 -4\n", IMPORT_ERR_INDEX,
+               "line 4",
                "face corner 3 names");
     EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nv 1 0 0\nv 1 1 1\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+               IMPORT_ERR_INDEX,
                "line 5", "face corner 2 names");
-    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nbevel on\n", "line 2", "unknown OBJ statement 'bevel'");
+    EXPECT_TXT(obj_read, "e.obj", "v 0 0 0\nbevel on\n", IMPORT_ERR_OBJ_STATEMENT,
+               "line 2", "unknown OBJ statement 'bevel'");
 
     memset(big, '1', sizeof(big));
-    expect_err(xyz_read, "e.xyz", big, sizeof(big), ARGIL_ERR_PARSE, "line 1", "longer than 1023");
-    expect_err(xyz_read, "e.xyz", "0 0\0 0\n", 7, ARGIL_ERR_PARSE, "line 1", "NUL byte");
-    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 3 4\n", "line 2", "4 values; each point needs 3");
-    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 3 0 0 1\n", "line 2",
+    expect_err(xyz_read, "e.xyz", big, sizeof(big), IMPORT_ERR_LINE_LONG,
+               "line 1", "longer than 1023");
+    expect_err(xyz_read, "e.xyz", "0 0\0 0\n", 7, IMPORT_ERR_LINE_NUL, "line 1", "NUL byte");
+    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 3 4\n", IMPORT_ERR_XYZ_COLUMNS,
+               "line 2", "4 values; each point needs 3");
+    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 3 0 0 1\n", IMPORT_ERR_XYZ_COLUMNS, "line 2",
                "6 values but line 1 had 3 (every line must have the same count)");
-    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 1e999\n", "line 2", "value 3 '1e999' is not a finite");
-    EXPECT_TXT(xyz_read, "e.xyz", "# only a comment\n\n", "line 2", "no points");
+    EXPECT_TXT(xyz_read, "e.xyz", "0 0 0\n1 2 1e999\n", IMPORT_ERR_NUMBER,
+               "line 2", "value 3 '1e999' is not a finite");
+    EXPECT_TXT(xyz_read, "e.xyz", "# only a comment\n\n", IMPORT_ERR_XYZ_EMPTY,
+               "line 2", "no points");
 }
 
 /* How a volume case is read: raw with dims, type and byte order, or NRRD. */
@@ -583,11 +626,44 @@ static void test_volume_failures(void **state)
         assert_int_equal(volume_err_argil((volume_err_t)e), ARGIL_ERR_PARSE);
 }
 
+/* The import readers' failures outside the file, and the argil_err_t a command reports for each. */
+static void test_import_failures(void **state)
+{
+    (void)state;
+    char p[128], err[256] = "";
+    mesh_t m;
+    mesh_init(&m);
+    assert_int_equal(ply_load(NULL, &m, NULL, err, sizeof(err)), IMPORT_ERR_ARG);
+    assert_string_equal(err, "ply_load: no path or no mesh");
+    assert_int_equal(stl_read("a.stl", NULL, err, sizeof(err)), IMPORT_ERR_ARG);
+    assert_string_equal(err, "stl_read: no path or no mesh");
+    assert_int_equal(obj_read(NULL, &m, NULL, err, sizeof(err)), IMPORT_ERR_ARG);
+    assert_string_equal(err, "obj_read: no path or no mesh");
+    assert_int_equal(xyz_read(NULL, &m, NULL, err, sizeof(err)), IMPORT_ERR_ARG);
+    assert_string_equal(err, "xyz_read: no path or no mesh");
+    /* a sparse file one byte over the limit: refused before any byte is read */
+    test_path(p, sizeof(p), "huge.xyz");
+    test_spit(p, "", 0);
+    assert_int_equal(truncate(p, (off_t)IO_FILE_MAX_BYTES + 1), 0);
+    assert_int_equal(mesh_import(p, &m, NULL, err, sizeof(err)), IMPORT_ERR_FILE_SIZE);
+    assert_non_null(strstr(err, "more than the 4294967296 this reader takes"));
+    assert_int_equal(unlink(p), 0);
+    mesh_free(&m);
+
+    const argil_err_t got[] = {import_err_argil(IMPORT_OK), import_err_argil(IMPORT_ERR_ARG),
+                               import_err_argil(IMPORT_ERR_IO), import_err_argil(IMPORT_ERR_NOMEM)};
+    const argil_err_t want[] = {ARGIL_OK, ARGIL_ERR_ARG, ARGIL_ERR_IO, ARGIL_ERR_NOMEM};
+    assert_memory_equal(got, want, sizeof(want));
+    for (int e = IMPORT_ERR_FILE_SIZE; e >= IMPORT_ERR_XYZ_EMPTY; e--) /* every rule of a file */
+        assert_int_equal(import_err_argil((import_err_t)e), ARGIL_ERR_PARSE);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trips),   cmocka_unit_test(test_ply_errors),
         cmocka_unit_test(test_stl_errors),    cmocka_unit_test(test_obj_xyz_errors),
+        cmocka_unit_test(test_import_failures),
         cmocka_unit_test(test_volumes),       cmocka_unit_test(test_volume_type_names),
         cmocka_unit_test(test_volume_rules),  cmocka_unit_test(test_volume_failures),
     };

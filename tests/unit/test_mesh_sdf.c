@@ -174,12 +174,28 @@ static void test_refused(void **state)
     mesh_free(&m);
 }
 
+/* Grids of 1 to 2^30 samples are counted; a side below 1 or a larger count is refused. */
+static void test_grid_samples(void **state)
+{
+    (void)state;
+    uint64_t n = 0;
+    assert_true(mesh_sdf_grid_samples((const int32_t[3]){2, 3, 4}, &n));
+    assert_int_equal(n, 24);
+    assert_true(mesh_sdf_grid_samples((const int32_t[3]){1024, 1024, 1024}, &n));
+    assert_int_equal(n, (uint64_t)1 << 30);
+    assert_false(mesh_sdf_grid_samples((const int32_t[3]){1024, 1024, 1025}, &n));
+    assert_false(mesh_sdf_grid_samples((const int32_t[3]){4, 0, 4}, &n));
+    assert_false(mesh_sdf_grid_samples((const int32_t[3]){4, 4, -1}, &n));
+    assert_false(mesh_sdf_grid_samples((const int32_t[3]){INT32_MAX, INT32_MAX, 2}, &n));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_cube_on_rows),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_grid_samples),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

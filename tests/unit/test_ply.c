@@ -102,8 +102,8 @@ static void spit(const char *path, const void *data, size_t len)
     assert_int_equal(fclose(fp), 0);
 }
 
-/* Writes data as a file, reads it, expects err_code and every needle in the message. */
-static void expect_read_error(fixture_t *f, const void *data, size_t len, argil_err_t err_code,
+/* Writes data as a file, reads it, expects the rule err_code and every needle in the message. */
+static void expect_read_error(fixture_t *f, const void *data, size_t len, ply_err_t err_code,
                               const char *needle1, const char *needle2)
 {
     spit(f->path, data, len);
@@ -135,7 +135,7 @@ static void test_round_trip(void **state)
     assert_int_equal(ply_write(f->path, &f->mesh, err, sizeof(err)), ARGIL_OK);
     mesh_t back;
     mesh_init(&back);
-    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), PLY_OK);
     assert_int_equal(back.n_vert, f->mesh.n_vert);
     assert_int_equal(back.n_tri, f->mesh.n_tri);
     assert_memory_equal(back.pos, f->mesh.pos, 3 * sizeof(float) * back.n_vert);
@@ -151,7 +151,7 @@ static void test_round_trip(void **state)
     mesh_t empty;
     mesh_init(&empty);
     assert_int_equal(ply_write(f->path, &empty, err, sizeof(err)), ARGIL_OK);
-    assert_int_equal(ply_read_mesh(f->path, &empty, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &empty, err, sizeof(err)), PLY_OK);
     assert_int_equal(empty.n_vert + empty.n_tri, 0);
     mesh_free(&empty);
 }
@@ -176,7 +176,7 @@ static void test_round_trip_large(void **state)
     assert_true(24 * m.n_vert > 4 * 65536 && 13 * m.n_tri > 4 * 65536);
     char err[256] = "";
     assert_int_equal(ply_write(f->path, &m, err, sizeof(err)), ARGIL_OK);
-    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), PLY_OK);
     assert_int_equal(back.n_vert, m.n_vert);
     assert_int_equal(back.n_tri, m.n_tri);
     assert_memory_equal(back.pos, m.pos, 3 * sizeof(float) * m.n_vert);
@@ -226,15 +226,15 @@ static void test_truncated_and_trailing(void **state)
     fixture_t *f = *state;
     size_t len, hl;
     unsigned char *buf = valid_file(f, &len, &hl);
-    expect_read_error(f, buf, len - 5, ARGIL_ERR_PARSE, "file too short", "byte");
-    expect_read_error(f, buf, hl + 10, ARGIL_ERR_PARSE, "file too short", NULL);
-    expect_read_error(f, buf, hl - 4, ARGIL_ERR_PARSE, "no end of line", "header line 13");
-    expect_read_error(f, buf, 0, ARGIL_ERR_PARSE, "header line 1", NULL);
+    expect_read_error(f, buf, len - 5, PLY_ERR_SIZE, "file too short", "byte");
+    expect_read_error(f, buf, hl + 10, PLY_ERR_SIZE, "file too short", NULL);
+    expect_read_error(f, buf, hl - 4, PLY_ERR_LINE_END, "no end of line", "header line 13");
+    expect_read_error(f, buf, 0, PLY_ERR_LINE_END, "header line 1", NULL);
     unsigned char *longer = malloc(len + 3);
     assert_non_null(longer);
     memcpy(longer, buf, len);
     memset(longer + len, 0, 3);
-    expect_read_error(f, longer, len + 3, ARGIL_ERR_PARSE, "trailing bytes", NULL);
+    expect_read_error(f, longer, len + 3, PLY_ERR_SIZE, "trailing bytes", NULL);
     free(longer);
     free(buf);
 }
@@ -246,46 +246,46 @@ static void test_bad_header_lines(void **state)
     char text[1200];
 
     snprintf(text, sizeof(text), "plx\n%s", h + 4);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 1", "'ply'");
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 1", "'ply'");
 
     snprintf(text, sizeof(text), "ply\nformat ascii 1.0\n%s", strstr(h, "comment"));
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 2",
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 2",
                       "binary_little_endian");
     snprintf(text, sizeof(text), "ply\nformat binary_big_endian 1.0\n%s", strstr(h, "comment"));
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 2", NULL);
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 2", NULL);
 
     snprintf(text, sizeof(text), "ply\nformat binary_little_endian 1.0\nelement vertex abc\n");
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 3", "'abc'");
+    expect_read_error(f, text, strlen(text), PLY_ERR_COUNT, "header line 3", "'abc'");
     snprintf(text, sizeof(text), "ply\nformat binary_little_endian 1.0\nelement vertex -1\n");
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 3", "'-1'");
+    expect_read_error(f, text, strlen(text), PLY_ERR_COUNT, "header line 3", "'-1'");
 
     /* A property out of order, a missing face list, an unknown element. */
     char *p = strstr(h, "property float y");
     memcpy(p, "property float q", 16);
-    expect_read_error(f, h, strlen(h), ARGIL_ERR_PARSE, "header line 6", "property float y");
+    expect_read_error(f, h, strlen(h), PLY_ERR_HEADER, "header line 6", "property float y");
     free(h);
     snprintf(text, sizeof(text), "%s", "ply\nformat binary_little_endian 1.0\nelement vertex 0\n"
              "property float x\nproperty float y\nproperty float z\nproperty float nx\n"
              "property float ny\nproperty float nz\nelement face 0\n"
              "property list uchar uint vertex_indices\nend_header\n");
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 11", "list uchar int");
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 11", "list uchar int");
     snprintf(text, sizeof(text), "ply\nformat binary_little_endian 1.0\nelement edge 3\n");
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 3", NULL);
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 3", NULL);
 
     /* Over-long line, NUL byte, no header end within the limit. */
     memset(text, 'a', sizeof(text));
     memcpy(text, "ply\ncomment ", 12);
     text[600] = '\n';
-    expect_read_error(f, text, 601, ARGIL_ERR_PARSE, "header line 2", "longer than");
+    expect_read_error(f, text, 601, PLY_ERR_LINE_LONG, "header line 2", "longer than");
     const char nul[] = "ply\nform\0at binary_little_endian 1.0\n";
-    expect_read_error(f, nul, sizeof(nul) - 1, ARGIL_ERR_PARSE, "header line 2", "NUL");
+    expect_read_error(f, nul, sizeof(nul) - 1, PLY_ERR_LINE_NUL, "header line 2", "NUL");
     char *big = malloc(PLY_HEADER_MAX_BYTES + 200);
     assert_non_null(big);
     size_t n = 0;
     n += (size_t)sprintf(big, "ply\nformat binary_little_endian 1.0\n");
     while (n < PLY_HEADER_MAX_BYTES + 100)
         n += (size_t)sprintf(big + n, "comment padding padding\n");
-    expect_read_error(f, big, n, ARGIL_ERR_PARSE, "no end of line", NULL);
+    expect_read_error(f, big, n, PLY_ERR_LINE_END, "no end of line", NULL);
     free(big);
 }
 
@@ -297,14 +297,14 @@ static void test_huge_declared_counts(void **state)
     memset(text, 'x', 100);
     const char *h4 = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n";
     memcpy(text, h4, strlen(h4));
-    expect_read_error(f, text, 100, ARGIL_ERR_PARSE, "header line 3", "4000000000");
+    expect_read_error(f, text, 100, PLY_ERR_COUNT, "header line 3", "4000000000");
     /* Within the format, but far beyond what the file holds: refused before any allocation. */
     snprintf(text, sizeof(text), header_fmt, (size_t)2000000000u, (size_t)0);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "file too short", "2000000000");
+    expect_read_error(f, text, strlen(text), PLY_ERR_SIZE, "file too short", "2000000000");
     snprintf(text, sizeof(text), header_fmt, (size_t)0, (size_t)18446744073709551615u);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 11", NULL);
+    expect_read_error(f, text, strlen(text), PLY_ERR_COUNT, "header line 11", NULL);
     snprintf(text, sizeof(text), header_fmt, (size_t)0, (size_t)999999999999u);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "file too short", NULL);
+    expect_read_error(f, text, strlen(text), PLY_ERR_SIZE, "file too short", NULL);
 }
 
 static void test_bad_records(void **state)
@@ -320,7 +320,7 @@ static void test_bad_records(void **state)
     memcpy(c, buf, len);
     c[face0 + 13] = 4; /* face 1 claims four vertices */
     snprintf(where, sizeof(where), "byte %zu", face0 + 13);
-    expect_read_error(f, c, len, ARGIL_ERR_PARSE, where, "4 vertices");
+    expect_read_error(f, c, len, PLY_ERR_FACE_SIZE, where, "4 vertices");
 
     memcpy(c, buf, len);
     c[face0 + 1] = 0xFF; /* index 255 + ... out of range */
@@ -328,18 +328,18 @@ static void test_bad_records(void **state)
     c[face0 + 3] = 0x00;
     c[face0 + 4] = 0x00;
     snprintf(where, sizeof(where), "byte %zu", face0 + 1);
-    expect_read_error(f, c, len, ARGIL_ERR_PARSE, where, "names vertex 65535");
+    expect_read_error(f, c, len, PLY_ERR_INDEX, where, "names vertex 65535");
 
     memcpy(c, buf, len);
     c[face0 + 8] = 0xFF; /* second index negative */
     snprintf(where, sizeof(where), "byte %zu", face0 + 5);
-    expect_read_error(f, c, len, ARGIL_ERR_PARSE, where, "names vertex -");
+    expect_read_error(f, c, len, PLY_ERR_INDEX, where, "names vertex -");
 
     memcpy(c, buf, len);
     const unsigned char nan_le[4] = {0x00, 0x00, 0xC0, 0x7F};
     memcpy(c + hl + 24 + 16, nan_le, 4); /* vertex 1, ny */
     snprintf(where, sizeof(where), "byte %zu", hl + 24 + 16);
-    expect_read_error(f, c, len, ARGIL_ERR_PARSE, where, "non-finite ny");
+    expect_read_error(f, c, len, PLY_ERR_NONFINITE, where, "non-finite ny");
     free(c);
     free(buf);
 }
@@ -363,7 +363,7 @@ static void test_header_variants_accepted(void **state)
     mesh_t m;
     mesh_init(&m);
     char err[256] = "";
-    if (ply_read_mesh(f->path, &m, err, sizeof(err)) != ARGIL_OK)
+    if (ply_read_mesh(f->path, &m, err, sizeof(err)) != PLY_OK)
         fail_msg("%s", err);
     assert_int_equal(m.n_vert, 3);
     assert_int_equal(m.n_tri, 1);
@@ -401,7 +401,7 @@ static void test_colour_round_trip(void **state)
     assert_non_null(strstr((const char *)buf, rgb_props));
     const size_t hl = (size_t)(strstr((const char *)buf, "end_header\n") - (char *)buf) + 11;
     assert_int_equal(len, hl + 27 * m.n_vert + 13 * m.n_tri);
-    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), PLY_OK);
     assert_true(back.has_rgb);
     assert_int_equal(back.n_vert, m.n_vert);
     assert_memory_equal(back.pos, m.pos, 3 * sizeof(float) * m.n_vert);
@@ -410,7 +410,7 @@ static void test_colour_round_trip(void **state)
     assert_memory_equal(back.tri, m.tri, 3 * sizeof(uint32_t) * m.n_tri);
     /* the same mesh without colours into the same out: no colour array stays */
     assert_int_equal(ply_write(f->path, &f->mesh, err, sizeof(err)), ARGIL_OK);
-    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->path, &back, err, sizeof(err)), PLY_OK);
     assert_false(back.has_rgb);
     assert_null(back.rgb);
     assert_int_equal(back.n_vert, f->mesh.n_vert);
@@ -420,13 +420,13 @@ static void test_colour_round_trip(void **state)
     char *h = header_for(0, 0), text[1200];
     char *nz = strstr(h, "property float nz\n") + strlen("property float nz\n");
     snprintf(text, sizeof(text), "%.*sproperty uchar red\n%s", (int)(nz - h), h, nz);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 12",
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 12",
                       "property uchar green");
     snprintf(text, sizeof(text), "%.*sproperty float red\n%s", (int)(nz - h), h, nz);
-    expect_read_error(f, text, strlen(text), ARGIL_ERR_PARSE, "header line 11",
+    expect_read_error(f, text, strlen(text), PLY_ERR_HEADER, "header line 11",
                       "'property uchar red' or 'element face <count>'");
     free(h);
-    expect_read_error(f, buf, hl + 27 * m.n_vert - 1, ARGIL_ERR_PARSE, "file too short", NULL);
+    expect_read_error(f, buf, hl + 27 * m.n_vert - 1, PLY_ERR_SIZE, "file too short", NULL);
     free(buf);
     mesh_free(&m);
 }
@@ -440,13 +440,13 @@ static void test_io_errors(void **state)
 
     char missing[160];
     snprintf(missing, sizeof(missing), "%s/nope/m.ply", f->dir);
-    assert_int_equal(ply_read_mesh(missing, &m, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(ply_read_mesh(missing, &m, err, sizeof(err)), PLY_ERR_IO);
     assert_non_null(strstr(err, missing));
     assert_non_null(strstr(err, "fopen"));
     assert_int_equal(ply_write(missing, &f->mesh, err, sizeof(err)), ARGIL_ERR_IO);
     assert_non_null(strstr(err, "nope/m.ply.tmp"));
     assert_non_null(strstr(err, "fopen"));
-    assert_int_equal(ply_read_mesh(f->dir, &m, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(ply_read_mesh(f->dir, &m, err, sizeof(err)), PLY_ERR_IO);
     assert_non_null(strstr(err, "not a regular file"));
 
     /* Renaming onto a directory fails: the error names rename, no .tmp stays behind. */
@@ -479,8 +479,20 @@ static void test_io_errors(void **state)
     free(after);
 
     assert_int_equal(ply_write(NULL, &f->mesh, err, sizeof(err)), ARGIL_ERR_ARG);
-    assert_int_equal(ply_read_mesh(f->path, NULL, NULL, 0), ARGIL_ERR_ARG);
+    assert_int_equal(ply_read_mesh(f->path, NULL, NULL, 0), PLY_ERR_ARG);
     mesh_free(&m);
+}
+
+/* The argil_err_t a command reports for each ply_err_t. */
+static void test_err_argil(void **state)
+{
+    (void)state;
+    static const ply_err_t outside[] = {PLY_OK, PLY_ERR_ARG, PLY_ERR_IO, PLY_ERR_NOMEM};
+    static const argil_err_t as[] = {ARGIL_OK, ARGIL_ERR_ARG, ARGIL_ERR_IO, ARGIL_ERR_NOMEM};
+    for (size_t i = 0; i < sizeof(outside) / sizeof(outside[0]); i++)
+        assert_int_equal(ply_err_argil(outside[i]), as[i]);
+    for (int rule = PLY_ERR_HEADER; rule >= PLY_ERR_INDEX; rule--)
+        assert_int_equal(ply_err_argil((ply_err_t)rule), ARGIL_ERR_PARSE);
 }
 
 int main(void)
@@ -496,6 +508,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_header_variants_accepted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_colour_round_trip, setup, teardown),
         cmocka_unit_test_setup_teardown(test_io_errors, setup, teardown),
+        cmocka_unit_test(test_err_argil),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

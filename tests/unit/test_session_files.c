@@ -72,7 +72,7 @@ static void test_writes_both_whole(void **state)
                      ARGIL_OK);
     mesh_t back;
     mesh_init(&back);
-    assert_int_equal(ply_read_mesh(f->ply, &back, err, sizeof(err)), ARGIL_OK);
+    assert_int_equal(ply_read_mesh(f->ply, &back, err, sizeof(err)), PLY_OK);
     assert_int_equal(back.n_tri, f->mesh.n_tri);
     mesh_free(&back);
     argil_doc_t doc;
