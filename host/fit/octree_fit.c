@@ -10,7 +10,7 @@
 
 #include "host/fit/knn.h"
 #include "host/fit/normals.h"
-#include "host/io/mesh_sdf.h"
+#include "host/mesh/mc.h"
 
 #define OF_FIT_SAMPLES_MAX 600u  /* data used per node's normal equations (spread evenly) */
 #define OF_SPLIT_MIN 32u         /* a node holding fewer data is not split */
@@ -841,7 +841,7 @@ argil_err_t octfit_volume(const float *v, const int32_t dims[3], float spacing_m
         !isfinite(iso_norm))
         return ARGIL_ERR_ARG;
     uint64_t total;
-    if (!mesh_sdf_grid_samples(dims, &total))
+    if (!mc_grid_samples(dims, &total))
         return ARGIL_ERR_ARG;
     /* at most about 2^20 data: every step-th sample along each axis */
     int32_t step = 1;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/mesh/mc.h"
 #include "host/mesh/mesh_check.h"
 
 typedef struct {
@@ -168,20 +169,6 @@ static bool sdf_cross_push(sdf_cross_t **cr, size_t *n, size_t *cap, uint32_t ro
     return true;
 }
 
-bool mesh_sdf_grid_samples(const int32_t dims[3], uint64_t *samples)
-{
-    uint64_t total = 1;
-    for (int a = 0; a < 3; a++) {
-        if (dims[a] < 1)
-            return false;
-        total *= (uint64_t)dims[a];
-        if (total > MESH_SDF_SAMPLES_MAX)
-            return false;
-    }
-    *samples = total;
-    return true;
-}
-
 argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, vec3_t origin_m,
                      float band_m, float *sd, mesh_sdf_report_t *rep)
 {
@@ -192,7 +179,7 @@ argil_err_t mesh_sdf(const mesh_t *m, const int32_t dims[3], float spacing_m, ve
         !(band_m > 0) || !isfinite(band_m) || !vec3_isfinite(origin_m) || m->n_tri > UINT32_MAX / 3)
         return ARGIL_ERR_ARG;
     uint64_t total;
-    if (!mesh_sdf_grid_samples(dims, &total))
+    if (!mc_grid_samples(dims, &total))
         return ARGIL_ERR_ARG;
     for (size_t i = 0; i < 3 * m->n_vert; i++)
         if (!isfinite(m->pos[i]))

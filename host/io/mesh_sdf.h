@@ -14,12 +14,6 @@
 #include "shared/argil_err.h"
 #include "shared/vec3.h"
 
-#define MESH_SDF_SAMPLES_MAX ((uint64_t)1 << 30) /* most samples a grid may hold */
-
-/* The sample count of a grid of dims into *samples; false when a side is below 1 or the count
- * is above MESH_SDF_SAMPLES_MAX. */
-bool mesh_sdf_grid_samples(const int32_t dims[3], uint64_t *samples);
-
 typedef struct {
     size_t boundary_edges;    /* edges used by one triangle */
     size_t nonmanifold_edges; /* edges used by more than two, or twice the same way */

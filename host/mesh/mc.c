@@ -264,3 +264,17 @@ argil_err_t mc_extract(const float *density, const int32_t dims[3], float spacin
         mesh_clear(out);
     return err;
 }
+
+bool mc_grid_samples(const int32_t dims[3], uint64_t *samples)
+{
+    uint64_t total = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1)
+            return false;
+        total *= (uint64_t)dims[a];
+        if (total > MC_GRID_SAMPLES_MAX)
+            return false;
+    }
+    *samples = total;
+    return true;
+}

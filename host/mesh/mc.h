@@ -3,6 +3,7 @@
 #ifndef ARGIL_MC_H
 #define ARGIL_MC_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "host/mesh/mesh.h"
@@ -20,6 +21,12 @@
  * so that the slab and block meshers agree bit for bit. */
 void mc_edge_point(vec3_t origin_m, float spacing_m, float iso, const int32_t p[3], int a,
                    float d0, float d1, vec3_t g0, vec3_t g1, vec3_t *pos_m, vec3_t *normal);
+
+#define MC_GRID_SAMPLES_MAX ((uint64_t)1 << 30) /* most samples a dense grid may hold */
+
+/* The sample count of a dense grid of dims into *samples; false when a side is below 1 or the
+ * count is above MC_GRID_SAMPLES_MAX. */
+bool mc_grid_samples(const int32_t dims[3], uint64_t *samples);
 
 /* Replaces out with the iso-surface of density (x fastest, dims samples, sample (0,0,0) at
  * origin_m): closed, edge-manifold, one vertex per crossed grid edge, triangles CCW seen from

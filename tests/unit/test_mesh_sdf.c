@@ -11,6 +11,7 @@
 #include <stdlib.h>
 
 #include "host/io/mesh_sdf.h"
+#include "host/mesh/mc.h"
 
 /* An icosahedron subdivided `level` times, projected onto the sphere of radius r (CCW outside). */
 static void icosphere(mesh_t *m, int level, float r)
@@ -179,14 +180,14 @@ static void test_grid_samples(void **state)
 {
     (void)state;
     uint64_t n = 0;
-    assert_true(mesh_sdf_grid_samples((const int32_t[3]){2, 3, 4}, &n));
+    assert_true(mc_grid_samples((const int32_t[3]){2, 3, 4}, &n));
     assert_int_equal(n, 24);
-    assert_true(mesh_sdf_grid_samples((const int32_t[3]){1024, 1024, 1024}, &n));
+    assert_true(mc_grid_samples((const int32_t[3]){1024, 1024, 1024}, &n));
     assert_int_equal(n, (uint64_t)1 << 30);
-    assert_false(mesh_sdf_grid_samples((const int32_t[3]){1024, 1024, 1025}, &n));
-    assert_false(mesh_sdf_grid_samples((const int32_t[3]){4, 0, 4}, &n));
-    assert_false(mesh_sdf_grid_samples((const int32_t[3]){4, 4, -1}, &n));
-    assert_false(mesh_sdf_grid_samples((const int32_t[3]){INT32_MAX, INT32_MAX, 2}, &n));
+    assert_false(mc_grid_samples((const int32_t[3]){1024, 1024, 1025}, &n));
+    assert_false(mc_grid_samples((const int32_t[3]){4, 0, 4}, &n));
+    assert_false(mc_grid_samples((const int32_t[3]){4, 4, -1}, &n));
+    assert_false(mc_grid_samples((const int32_t[3]){INT32_MAX, INT32_MAX, 2}, &n));
 }
 
 int main(void)
