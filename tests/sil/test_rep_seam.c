@@ -202,7 +202,7 @@ static void test_journal_recovers_a_second_representation(void **st)
     const journal_stats_t js = s.j.stats;
     const size_t unwritten = s.j.buf_len;
     const uint32_t strays = s.pj.stray_records;
-    float *now = rep_densities(&ds);
+    float *after = rep_densities(&ds);
     journal_close(&s.j);
     rig_free(s.r);
 
@@ -222,7 +222,7 @@ static void test_journal_recovers_a_second_representation(void **st)
         for (int32_t y = 0; y < ds.dims[1]; y++)
             for (int32_t x = 0; x < ds.dims[0]; x++, k++) {
                 const float d = grid_get(g, GRID_DENSITY, x, y, z);
-                max_diff = fmaxf(max_diff, fabsf(d - now[k]));
+                max_diff = fmaxf(max_diff, fabsf(d - after[k]));
                 const int32_t n[3] = {x, y, z};
                 const vec3_t p = ds_pos_m(&ds, n);
                 if (p.x * p.x + p.y * p.y < 25e-6f && p.z > 0.0f)
@@ -236,7 +236,7 @@ static void test_journal_recovers_a_second_representation(void **st)
            (double)max_diff, (double)dent, (double)far_diff);
     argil_doc_free(&doc);
     free(before);
-    free(now);
+    free(after);
     const argil_err_t de = journal_discard(dir, err, sizeof(err));
     const int rm = rmdir(dir);
     rep.ops->free(rep.st);
