@@ -313,7 +313,8 @@ static inline bool dent_sphere_init(dent_sphere_t *s, int32_t edge, float spacin
     s->offset_m = calloc(n, sizeof(float));
     s->force = calloc(n, sizeof(float));
     *rep = (rep_t){.ops = &dent_sphere_ops, .st = s};
-    if (!s->offset_m || !s->force || grid_init(&s->grid, s->dims, spacing_m, s->lat.origin_m))
+    if (!s->offset_m || !s->force ||
+        grid_init(&s->grid, s->dims, spacing_m, s->lat.origin_m) != ARGIL_OK)
         return false;
     s->grid.iso = s->lat.iso;
     s->grid.band_m = s->lat.band_m;
