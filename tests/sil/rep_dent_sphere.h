@@ -1,7 +1,8 @@
 /* A second representation behind the seam (host/model/rep.h), small enough to read at once: an
  * analytic sphere's signed distance plus a per-node offset that the board's impulses move (a
- * push lowers it: the sphere dents where it is pushed) and the host's carve lowers. No grid, no
- * B-spline: what the peer, the board and the mesher get from it they get through the seam. */
+ * push lowers it: the sphere dents where it is pushed) and the host's carve lowers. No B-spline:
+ * what the peer, the board and the mesher get from it they get through the seam. Its densities
+ * are mirrored in a sample grid (host/model/grid.h) that the journal and .argil writers save. */
 #ifndef ARGIL_REP_DENT_SPHERE_H
 #define ARGIL_REP_DENT_SPHERE_H
 
@@ -20,6 +21,8 @@ typedef struct {
     float *offset_m;                  /* added to the signed distance (positive inside) */
     float *force;                     /* per node, taken by the next step */
     rep_box_t force_box;              /* nodes holding force (hi[0] <= lo[0]: none) */
+    grid_t grid;                      /* every node's density (and rest = density), as
+                                       * ds_density gives it: what is saved */
 } dent_sphere_t;
 
 /* True when n is a lattice node; its array index then goes to i. */
@@ -53,6 +56,23 @@ static inline float ds_density(const dent_sphere_t *s, const int32_t n[3])
 {
     size_t i;
     return ds_node(s, n, &i) ? grid_profile(ds_sd_m(s, n), s->lat.band_m) : 0.0f;
+}
+
+/* Copies the density of every node in box into the sample grid (rest = density, as the files
+ * read it back); grid_set's error (ARGIL_ERR_NOMEM) when the grid cannot store it. */
+static argil_err_t ds_mirror(dent_sphere_t *s, const rep_box_t *box)
+{
+    int32_t n[3];
+    argil_err_t e = ARGIL_OK;
+    for (n[2] = box->lo[2]; n[2] < box->hi[2]; n[2]++)
+        for (n[1] = box->lo[1]; n[1] < box->hi[1]; n[1]++)
+            for (n[0] = box->lo[0]; n[0] < box->hi[0] && e == ARGIL_OK; n[0]++) {
+                const float d = ds_density(s, n);
+                e = grid_set(&s->grid, GRID_DENSITY, n[0], n[1], n[2], d);
+                if (e == ARGIL_OK)
+                    e = grid_set(&s->grid, GRID_REST, n[0], n[1], n[2], d);
+            }
+    return e;
 }
 
 /* The sphere's lattice and material. */
@@ -141,7 +161,7 @@ static argil_err_t ds_step(void *st, const rep_box_t *region, float dt_s, rep_ch
                 }
                 s->force[i] = 0.0f;
             }
-    return ARGIL_OK;
+    return ds_mirror(s, &changed->box);
 }
 
 /* Only the default carve. */
@@ -178,7 +198,7 @@ static argil_err_t ds_apply_tool(void *st, const host_tool_t *tool, float radius
                     changed->felt = true;
                 }
             }
-    return ARGIL_OK;
+    return ds_mirror(s, &changed->box);
 }
 
 /* Its material is uniform. */
@@ -238,20 +258,20 @@ static argil_err_t ds_surface(const void *st, mesh_t *out)
     return e;
 }
 
-/* No sample grid: it is not saved. */
+/* The grid that mirrors its densities. */
 static grid_t *ds_samples(void *st)
 {
-    (void)st;
-    return NULL;
+    return &((dent_sphere_t *)st)->grid;
 }
 
-/* Frees the offset and force arrays. */
+/* Frees the offset and force arrays and the sample grid. */
 static void ds_free(void *st)
 {
     dent_sphere_t *s = st;
     free(s->offset_m);
     free(s->force);
     s->offset_m = s->force = NULL;
+    grid_free(&s->grid);
 }
 
 static const rep_ops_t dent_sphere_ops = {
@@ -273,7 +293,8 @@ static const rep_ops_t dent_sphere_ops = {
 };
 
 /* A sphere of radius_m at the lattice's centre: edge³ nodes spacing_m apart, the grid's default
- * band (4 spacings) and material. False when out of memory. */
+ * band (4 spacings) and material, its densities in the sample grid. False when out of memory
+ * (ds_free releases what was made). */
 static inline bool dent_sphere_init(dent_sphere_t *s, int32_t edge, float spacing_m,
                                     float radius_m, rep_t *rep)
 {
@@ -292,7 +313,14 @@ static inline bool dent_sphere_init(dent_sphere_t *s, int32_t edge, float spacin
     s->offset_m = calloc(n, sizeof(float));
     s->force = calloc(n, sizeof(float));
     *rep = (rep_t){.ops = &dent_sphere_ops, .st = s};
-    return s->offset_m && s->force;
+    if (!s->offset_m || !s->force ||
+        grid_init(&s->grid, s->dims, spacing_m, s->lat.origin_m) != ARGIL_OK)
+        return false;
+    s->grid.iso = s->lat.iso;
+    s->grid.band_m = s->lat.band_m;
+    s->grid.material = s->lat.material;
+    const rep_box_t all = {{0, 0, 0}, {edge, edge, edge}};
+    return ds_mirror(s, &all) == ARGIL_OK;
 }
 
 #endif
