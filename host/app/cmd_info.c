@@ -122,7 +122,7 @@ int cmd_info(int argc, char **argv)
     char err[1024];
     if (has_ext(path, ".argil")) {
         argil_doc_t d;
-        if (argil_file_read(path, &d, err, sizeof(err)) != ARGIL_OK) {
+        if (argil_file_read(path, &d, err, sizeof(err)) != ARGIL_FILE_OK) {
             fprintf(stderr, "argil info: %s\n", err);
             return 1;
         }

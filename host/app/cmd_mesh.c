@@ -158,7 +158,7 @@ int cmd_mesh(int argc, char **argv)
         fmt = EXPORT_PLY_ASCII;
     argil_doc_t d;
     char err[1024];
-    if (argil_file_read(in, &d, err, sizeof(err)) != ARGIL_OK) {
+    if (argil_file_read(in, &d, err, sizeof(err)) != ARGIL_FILE_OK) {
         fprintf(stderr, "argil mesh: %s\n", err);
         return 1;
     }

@@ -151,7 +151,7 @@ static argil_err_t load_model(const char *path, float iso2, mesh_t *m, mesh_t *w
                               render_scene_t *s, char *err, size_t err_len)
 {
     argil_doc_t d;
-    argil_err_t rc = argil_file_read(path, &d, err, err_len);
+    argil_err_t rc = argil_file_err_argil(argil_file_read(path, &d, err, err_len));
     if (rc != ARGIL_OK)
         return rc;
     const grid_t *g = &d.grid;

@@ -64,7 +64,7 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         io_err(err, err_len, "out of memory");
         goto out;
     }
-    e = argil_file_read(base_path, &b, err, err_len);
+    e = argil_file_err_argil(argil_file_read(base_path, &b, err, err_len));
     if (e != ARGIL_OK)
         goto out;
     const grid_t *g = &b.grid;
