@@ -58,7 +58,7 @@ int recover_offer(const char *dir, bool discard, bool interactive)
         return -1;
     }
     journal_info_t info;
-    const argil_err_t e = journal_probe(dir, &info, err, sizeof(err));
+    const argil_err_t e = journal_err_argil(journal_probe(dir, &info, err, sizeof(err)));
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE) {
         fprintf(stderr, "argil sculpt: %s holds a journal that cannot be read (%s); run 'argil "
                         "recover %s' or --discard-journal\n",
@@ -150,7 +150,7 @@ int cmd_recover(int argc, char **argv)
     }
     argil_doc_t doc;
     journal_info_t info;
-    const argil_err_t e = journal_recover(dir, &doc, &info, err, sizeof(err));
+    const argil_err_t e = journal_err_argil(journal_recover(dir, &doc, &info, err, sizeof(err)));
     int status = 0;
     if (grid_count(&doc.grid) == 0) {
         fprintf(stderr, "argil recover: %s\n", err);
