@@ -139,7 +139,7 @@ int cmd_plot(int argc, char **argv)
     }
     char err[1024];
     telemetry_log_t log;
-    if (telemetry_log_read(csv, &log, err, sizeof(err)) != ARGIL_OK) {
+    if (telemetry_log_read(csv, &log, err, sizeof(err)) != TELEMETRY_OK) {
         fprintf(stderr, "argil plot: %s\n", err);
         return chatter_only ? 2 : 1;
     }

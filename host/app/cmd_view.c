@@ -376,7 +376,7 @@ static int take_telemetry(view_opts_t *o)
 {
     char err[1024] = "";
     telemetry_log_t log;
-    if (telemetry_log_read(o->csv, &log, err, sizeof(err)) != ARGIL_OK) {
+    if (telemetry_log_read(o->csv, &log, err, sizeof(err)) != TELEMETRY_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return 1;
     }
