@@ -151,7 +151,7 @@ void cmd_volume_range(const volume_t *v, float *lo, float *hi)
 static argil_err_t info_model(const char *path, char *err, size_t err_len)
 {
     argil_doc_t d;
-    const argil_err_t e = argil_file_read(path, &d, err, err_len);
+    const argil_err_t e = argil_file_err_argil(argil_file_read(path, &d, err, err_len));
     if (e != ARGIL_OK)
         return e;
     const grid_t *g = &d.grid;

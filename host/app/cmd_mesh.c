@@ -137,7 +137,7 @@ argil_err_t cmd_mesh(int argc, char **argv, int *exit_status)
         fmt = EXPORT_PLY_ASCII;
     argil_doc_t d;
     char err[1024];
-    argil_err_t e = argil_file_read(in, &d, err, sizeof(err));
+    argil_err_t e = argil_file_err_argil(argil_file_read(in, &d, err, sizeof(err)));
     if (e != ARGIL_OK) {
         fprintf(stderr, "argil mesh: %s\n", err);
         return cmd_end(exit_status, 1, e);

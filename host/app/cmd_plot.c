@@ -149,7 +149,7 @@ argil_err_t cmd_plot(int argc, char **argv, int *exit_status)
     }
     char err[1024];
     telemetry_log_t log;
-    const argil_err_t e = telemetry_log_read(po.csv, &log, err, sizeof(err));
+    const argil_err_t e = telemetry_err_argil(telemetry_log_read(po.csv, &log, err, sizeof(err)));
     if (e != ARGIL_OK) {
         fprintf(stderr, "argil plot: %s\n", err);
         return cmd_end(exit_status, po.chatter_only ? 2 : 1, e);

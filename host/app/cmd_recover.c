@@ -68,7 +68,7 @@ argil_err_t recover_offer(const char *dir, bool discard, bool interactive, bool 
         return ARGIL_OK;
     }
     journal_info_t info;
-    const argil_err_t e = journal_probe(dir, &info, err, sizeof(err));
+    const argil_err_t e = journal_err_argil(journal_probe(dir, &info, err, sizeof(err)));
     if (e != ARGIL_OK && e != ARGIL_ERR_PARSE) {
         fprintf(stderr, "argil sculpt: %s holds a journal that cannot be read (%s); run 'argil "
                         "recover %s' or --discard-journal\n",
@@ -166,7 +166,7 @@ argil_err_t cmd_recover(int argc, char **argv, int *exit_status)
     }
     argil_doc_t doc;
     journal_info_t info;
-    const argil_err_t e = journal_recover(dir, &doc, &info, err, sizeof(err));
+    const argil_err_t e = journal_err_argil(journal_recover(dir, &doc, &info, err, sizeof(err)));
     argil_err_t status = ARGIL_OK; /* the error the command ends with */
     if (grid_count(&doc.grid) == 0) {
         fprintf(stderr, "argil recover: %s\n", err);

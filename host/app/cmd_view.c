@@ -155,7 +155,7 @@ static argil_err_t load_model(const char *path, float iso2, mesh_t *m, mesh_t *w
                               render_scene_t *s, char *err, size_t err_len)
 {
     argil_doc_t d;
-    argil_err_t rc = argil_file_read(path, &d, err, err_len);
+    argil_err_t rc = argil_file_err_argil(argil_file_read(path, &d, err, err_len));
     if (rc != ARGIL_OK)
         return rc;
     const grid_t *g = &d.grid;
@@ -384,7 +384,7 @@ static argil_err_t take_telemetry(view_opts_t *o)
 {
     char err[1024] = "";
     telemetry_log_t log;
-    const argil_err_t e = telemetry_log_read(o->csv, &log, err, sizeof(err));
+    const argil_err_t e = telemetry_err_argil(telemetry_log_read(o->csv, &log, err, sizeof(err)));
     if (e != ARGIL_OK) {
         fprintf(stderr, "argil view: %s\n", err);
         return e;

@@ -92,16 +92,17 @@ static argil_err_t push_cmd(script_t *s, const script_cmd_t *c)
     return ARGIL_OK;
 }
 
-#define FAIL(...)                                                                              \
+/* Writes the message into err and returns the rule code from the parser. */
+#define FAIL(code, ...)                                                                        \
     do {                                                                                       \
         snprintf(err, err_len, __VA_ARGS__);                                                   \
-        return ARGIL_ERR_PARSE;                                                                \
+        return code;                                                                           \
     } while (0)
 
 /* The host tool's verbs (host/model/host_tool.h): action NAME [strength S], action_shape NAME,
  * mirror none|x|y|z|xy|... */
-static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c, char *err,
-                                   size_t err_len)
+static script_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c, char *err,
+                                    size_t err_len)
 {
     const char *op = w[0];
     char list[160] = "";
@@ -109,13 +110,15 @@ static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c,
     if (strcmp(op, "mirror") == 0) {
         const int bits = n == 2 ? host_mirror_from_name(w[1]) : -1;
         if (n != 2)
-            FAIL("line %d: 'mirror' takes one word: none, or the axes x, y, z (e.g. xz)", lineno);
+            FAIL(SCRIPT_ERR_ARGS,
+                 "line %d: 'mirror' takes one word: none, or the axes x, y, z (e.g. xz)", lineno);
         if (bits < 0)
-            FAIL("line %d: unknown mirror '%s' (none, x, y, z, or axes together such as xz)",
+            FAIL(SCRIPT_ERR_NAME,
+                 "line %d: unknown mirror '%s' (none, x, y, z, or axes together such as xz)",
                  lineno, w[1]);
         c->op = SCRIPT_MIRROR;
         c->arg_int = bits;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     const int count = act ? HOST_ACT_COUNT : HOST_SHAPE_COUNT;
     for (int k = 0; k < count; k++) {
@@ -126,20 +129,22 @@ static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c,
     }
     if (!act) {
         if (n != 2)
-            FAIL("line %d: 'action_shape' takes one name (%s)", lineno, list);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'action_shape' takes one name (%s)", lineno, list);
         const int k = host_shape_from_name(w[1]);
         if (k < 0)
-            FAIL("line %d: unknown action_shape '%s' (%s)", lineno, w[1], list);
+            FAIL(SCRIPT_ERR_NAME, "line %d: unknown action_shape '%s' (%s)", lineno, w[1], list);
         c->op = SCRIPT_ACTION_SHAPE;
         c->arg_int = k;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (n < 2)
-        FAIL("line %d: 'action' takes a name (%s) and optionally strength S (paint and "
-             "soft-paint: rgb R G B)", lineno, list);
+        FAIL(SCRIPT_ERR_ARGS,
+             "line %d: 'action' takes a name (%s) and optionally strength S (paint and "
+             "soft-paint: rgb R G B)",
+             lineno, list);
     const int k = host_action_from_name(w[1]);
     if (k < 0)
-        FAIL("line %d: unknown action '%s' (%s)", lineno, w[1], list);
+        FAIL(SCRIPT_ERR_NAME, "line %d: unknown action '%s' (%s)", lineno, w[1], list);
     const bool paints = host_action_paints((host_action_t)k);
     c->op = SCRIPT_ACTION;
     c->arg_int = k;
@@ -150,32 +155,35 @@ static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c,
     for (int i = 2; i < n;) {
         if (strcmp(w[i], "strength") == 0) {
             if (i + 1 >= n)
-                FAIL("line %d: 'action' takes a name (%s) and optionally strength S", lineno,
-                     list);
+                FAIL(SCRIPT_ERR_ARGS,
+                     "line %d: 'action' takes a name (%s) and optionally strength S", lineno, list);
             if (!host_action_has_strength((host_action_t)k))
-                FAIL("line %d: 'action %s' takes no strength (it acts in full at once)", lineno,
+                FAIL(SCRIPT_ERR_OPTION,
+                     "line %d: 'action %s' takes no strength (it acts in full at once)", lineno,
                      w[1]);
             if (have_strength)
-                FAIL("line %d: 'strength' given twice", lineno);
+                FAIL(SCRIPT_ERR_REPEATED, "line %d: 'strength' given twice", lineno);
             if (!parse_float(w[i + 1], &c->value))
-                FAIL("line %d: '%s' is not a number", lineno, w[i + 1]);
+                FAIL(SCRIPT_ERR_NUMBER, "line %d: '%s' is not a number", lineno, w[i + 1]);
             if (!(c->value >= 0.0f && c->value <= HOST_STRENGTH_MAX))
-                FAIL("line %d: strength must be within 0 … %g, got %s", lineno,
+                FAIL(SCRIPT_ERR_RANGE, "line %d: strength must be within 0 … %g, got %s", lineno,
                      (double)HOST_STRENGTH_MAX, w[i + 1]);
             have_strength = true;
             i += 2;
         } else if (strcmp(w[i], "rgb") == 0 && paints) {
             if (have_rgb)
-                FAIL("line %d: 'rgb' given twice", lineno);
+                FAIL(SCRIPT_ERR_REPEATED, "line %d: 'rgb' given twice", lineno);
             if (i + 3 >= n)
-                FAIL("line %d: 'rgb' takes three whole numbers 0 … 255 (R G B)", lineno);
+                FAIL(SCRIPT_ERR_ARGS, "line %d: 'rgb' takes three whole numbers 0 … 255 (R G B)",
+                     lineno);
             float v[3];
             for (int a = 0; a < 3; a++) {
                 char *end;
                 errno = 0;
                 const long x = strtol(w[i + 1 + a], &end, 10);
                 if (end == w[i + 1 + a] || *end != '\0' || errno == ERANGE || x < 0 || x > 255)
-                    FAIL("line %d: 'rgb' takes three whole numbers 0 … 255, got '%s'", lineno,
+                    FAIL(SCRIPT_ERR_NUMBER,
+                         "line %d: 'rgb' takes three whole numbers 0 … 255, got '%s'", lineno,
                          w[i + 1 + a]);
                 v[a] = (float)x;
             }
@@ -183,21 +191,24 @@ static argil_err_t parse_host_tool(char **w, int n, int lineno, script_cmd_t *c,
             have_rgb = true;
             i += 4;
         } else if (strcmp(w[i], "rgb") == 0) {
-            FAIL("line %d: 'action %s' takes no colour (rgb is for paint and soft-paint)", lineno,
+            FAIL(SCRIPT_ERR_OPTION,
+                 "line %d: 'action %s' takes no colour (rgb is for paint and soft-paint)", lineno,
                  w[1]);
         } else if (paints) {
-            FAIL("line %d: 'action %s' takes NAME [rgb R G B]%s, not '%s'", lineno, w[1],
-                 host_action_has_strength((host_action_t)k) ? " [strength S]" : "", w[i]);
+            FAIL(SCRIPT_ERR_OPTION, "line %d: 'action %s' takes NAME [rgb R G B]%s, not '%s'",
+                 lineno, w[1], host_action_has_strength((host_action_t)k) ? " [strength S]" : "",
+                 w[i]);
         } else {
-            FAIL("line %d: 'action' takes NAME [strength S], not '%s'", lineno, w[i]);
+            FAIL(SCRIPT_ERR_OPTION, "line %d: 'action' takes NAME [strength S], not '%s'", lineno,
+                 w[i]);
         }
     }
-    return ARGIL_OK;
+    return SCRIPT_OK;
 }
 
 /* Parses one line's words into a command; returns 0 for a blank line, 1 for a command. */
-static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char *err,
-                              size_t err_len)
+static script_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char *err,
+                               size_t err_len)
 {
     c->line = lineno;
     c->arg_int = 0;
@@ -216,113 +227,117 @@ static argil_err_t parse_line(char **w, int n, int lineno, script_cmd_t *c, char
                 strncat(list, ", ", sizeof(list) - strlen(list) - 1);
         }
         if (n != 2)
-            FAIL("line %d: '%s' takes one name (%s)", lineno, op, list);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: '%s' takes one name (%s)", lineno, op, list);
         const int k = find_name(w[1], names, count);
         if (k < 0)
-            FAIL("line %d: unknown %s '%s' (%s)", lineno, op, w[1], list);
+            FAIL(SCRIPT_ERR_NAME, "line %d: unknown %s '%s' (%s)", lineno, op, w[1], list);
         c->op = op[0] == 't' ? SCRIPT_TOOL : op[0] == 's' ? SCRIPT_SHAPE : SCRIPT_FILTER;
         c->arg_int = k;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "axis") == 0) {
         float x, y, z;
         if (n != 4 || !parse_float(w[1], &x) || !parse_float(w[2], &y) || !parse_float(w[3], &z))
-            FAIL("line %d: 'axis' takes three numbers X Y Z", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'axis' takes three numbers X Y Z", lineno);
         const float len = sqrtf(x * x + y * y + z * z);
         if (!(len > 1e-6f) || !isfinite(len))
-            FAIL("line %d: 'axis' must not be the zero vector", lineno);
+            FAIL(SCRIPT_ERR_AXIS_ZERO, "line %d: 'axis' must not be the zero vector", lineno);
         c->op = SCRIPT_AXIS;
         c->target_m = vec3(x / len, y / len, z / len);
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "set") == 0) {
         if (n != 3)
-            FAIL("line %d: 'set' takes a name and a value", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'set' takes a name and a value", lineno);
         for (int k = 0; k < PARAM_COUNT; k++) {
             if (strcmp(w[1], PARAMS[k].name) == 0) {
                 if (!parse_float(w[2], &c->value))
-                    FAIL("line %d: '%s' is not a number", lineno, w[2]);
+                    FAIL(SCRIPT_ERR_NUMBER, "line %d: '%s' is not a number", lineno, w[2]);
                 if (c->value < PARAMS[k].min || c->value > PARAMS[k].max)
-                    FAIL("line %d: %s must be within %g … %g, got %s", lineno, PARAMS[k].name,
-                         (double)PARAMS[k].min, (double)PARAMS[k].max, w[2]);
+                    FAIL(SCRIPT_ERR_RANGE, "line %d: %s must be within %g … %g, got %s", lineno,
+                         PARAMS[k].name, (double)PARAMS[k].min, (double)PARAMS[k].max, w[2]);
                 c->op = SCRIPT_SET;
                 c->arg_int = k;
-                return ARGIL_OK;
+                return SCRIPT_OK;
             }
         }
-        FAIL("line %d: unknown parameter '%s' (see docs/script.md)", lineno, w[1]);
+        FAIL(SCRIPT_ERR_NAME, "line %d: unknown parameter '%s' (see docs/script.md)", lineno, w[1]);
     }
     if (strcmp(op, "move") == 0) {
         float x, y, z, t;
         if (n != 5)
-            FAIL("line %d: 'move' takes X Y Z (mm, model space) and SECONDS", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'move' takes X Y Z (mm, model space) and SECONDS",
+                 lineno);
         if (!parse_float(w[1], &x) || !parse_float(w[2], &y) || !parse_float(w[3], &z) ||
             !parse_float(w[4], &t))
-            FAIL("line %d: 'move' arguments must be numbers", lineno);
+            FAIL(SCRIPT_ERR_NUMBER, "line %d: 'move' arguments must be numbers", lineno);
         if (fabsf(x) > 500.0f || fabsf(y) > 500.0f || fabsf(z) > 500.0f)
-            FAIL("line %d: move target beyond ±500 mm", lineno);
+            FAIL(SCRIPT_ERR_RANGE, "line %d: move target beyond ±500 mm", lineno);
         if (t <= 0.0f || t > SCRIPT_MAX_SECONDS)
-            FAIL("line %d: move duration must be within 0 … %g s", lineno,
+            FAIL(SCRIPT_ERR_RANGE, "line %d: move duration must be within 0 … %g s", lineno,
                  (double)SCRIPT_MAX_SECONDS);
         c->op = SCRIPT_MOVE;
         c->target_m = vec3(x * 1e-3f, y * 1e-3f, z * 1e-3f);
         c->value = t;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "press") == 0 || strcmp(op, "release") == 0) {
         if (n != 2 || (strcmp(w[1], "1") != 0 && strcmp(w[1], "2") != 0))
-            FAIL("line %d: '%s' takes a button number, 1 or 2", lineno, op);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: '%s' takes a button number, 1 or 2", lineno, op);
         c->op = op[0] == 'p' ? SCRIPT_PRESS : SCRIPT_RELEASE;
         c->arg_int = w[1][0] - '0';
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "wait") == 0) {
         if (n != 2 || !parse_float(w[1], &c->value))
-            FAIL("line %d: 'wait' takes SECONDS", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'wait' takes SECONDS", lineno);
         if (c->value < 0.0f || c->value > SCRIPT_MAX_SECONDS)
-            FAIL("line %d: wait must be within 0 … %g s", lineno, (double)SCRIPT_MAX_SECONDS);
+            FAIL(SCRIPT_ERR_RANGE, "line %d: wait must be within 0 … %g s", lineno,
+                 (double)SCRIPT_MAX_SECONDS);
         c->op = SCRIPT_WAIT;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "paint") == 0) {
         float scale, radius_mm;
         if (n != 5 || (strcmp(w[1], "stiffness") != 0 && strcmp(w[1], "mass") != 0) ||
             strcmp(w[3], "radius") != 0)
-            FAIL("line %d: 'paint' takes stiffness|mass SCALE radius MM", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'paint' takes stiffness|mass SCALE radius MM", lineno);
         if (!parse_float(w[2], &scale) || !parse_float(w[4], &radius_mm))
-            FAIL("line %d: 'paint' scale and radius must be numbers", lineno);
+            FAIL(SCRIPT_ERR_NUMBER, "line %d: 'paint' scale and radius must be numbers", lineno);
         if (!(scale >= SCRIPT_PAINT_SCALE_MIN && scale <= SCRIPT_PAINT_SCALE_MAX))
-            FAIL("line %d: paint scale must be within %g … %g, got %s", lineno,
+            FAIL(SCRIPT_ERR_RANGE, "line %d: paint scale must be within %g … %g, got %s", lineno,
                  (double)SCRIPT_PAINT_SCALE_MIN, (double)SCRIPT_PAINT_SCALE_MAX, w[2]);
         if (!(radius_mm >= SCRIPT_PAINT_RADIUS_MIN_MM && radius_mm <= SCRIPT_PAINT_RADIUS_MAX_MM))
-            FAIL("line %d: paint radius must be within %g … %g mm, got %s", lineno,
-                 (double)SCRIPT_PAINT_RADIUS_MIN_MM, (double)SCRIPT_PAINT_RADIUS_MAX_MM, w[4]);
+            FAIL(SCRIPT_ERR_RANGE, "line %d: paint radius must be within %g … %g mm, got %s",
+                 lineno, (double)SCRIPT_PAINT_RADIUS_MIN_MM, (double)SCRIPT_PAINT_RADIUS_MAX_MM,
+                 w[4]);
         c->op = SCRIPT_PAINT;
         c->arg_int = w[1][0] == 's' ? SCRIPT_PAINT_STIFFNESS : SCRIPT_PAINT_MASS;
         c->value = scale;
         c->radius_m = radius_mm * 1e-3f;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "refine") == 0) {
         if (n != 1)
-            FAIL("line %d: 'refine' takes no arguments", lineno);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: 'refine' takes no arguments", lineno);
         c->op = SCRIPT_REFINE;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "undo") == 0 || strcmp(op, "redo") == 0) {
         if (n != 1)
-            FAIL("line %d: '%s' takes no arguments", lineno, op);
+            FAIL(SCRIPT_ERR_ARGS, "line %d: '%s' takes no arguments", lineno, op);
         c->op = op[0] == 'u' ? SCRIPT_UNDO : SCRIPT_REDO;
-        return ARGIL_OK;
+        return SCRIPT_OK;
     }
     if (strcmp(op, "action") == 0 || strcmp(op, "action_shape") == 0 || strcmp(op, "mirror") == 0)
         return parse_host_tool(w, n, lineno, c, err, err_len);
-    FAIL("line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
+    FAIL(SCRIPT_ERR_COMMAND,
+         "line %d: unknown command '%s' (tool, shape, filter, axis, set, move, press, release, "
          "wait, paint, refine, action, action_shape, mirror, undo, redo)",
          lineno, op);
 }
 
-argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len)
+script_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len)
 {
     char line[512];
     int lineno = 0;
@@ -338,11 +353,12 @@ argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, s
         if (l > 0 && text[at + l - 1] == '\r')
             l--;
         if (l >= sizeof(line))
-            FAIL("line %d: longer than %zu characters", lineno, sizeof(line) - 1);
+            FAIL(SCRIPT_ERR_LINE_LONG, "line %d: longer than %zu characters", lineno,
+                 sizeof(line) - 1);
         memcpy(line, text + at, l);
         line[l] = '\0';
         if (memchr(line, '\0', l) != NULL)
-            FAIL("line %d: contains a NUL byte", lineno);
+            FAIL(SCRIPT_ERR_LINE_NUL, "line %d: contains a NUL byte", lineno);
         at = end + 1;
         char *w[9];
         /* words at any C-locale space; a word starting with '#' ends the line */
@@ -351,40 +367,51 @@ argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, s
             continue;
         /* At most 5 words, but `action soft-paint rgb R G B strength S` takes 8. */
         if (n > 8 || (n > 5 && strcmp(w[0], "action") != 0))
-            FAIL("line %d: too many words", lineno);
+            FAIL(SCRIPT_ERR_WORDS, "line %d: too many words", lineno);
         script_cmd_t c;
-        const argil_err_t e = parse_line(w, n, lineno, &c, err, err_len);
-        if (e != ARGIL_OK)
+        const script_err_t e = parse_line(w, n, lineno, &c, err, err_len);
+        if (e != SCRIPT_OK)
             return e;
         if (c.op == SCRIPT_MOVE || c.op == SCRIPT_WAIT) {
             total_s += c.value;
             if (total_s > SCRIPT_MAX_SECONDS)
-                FAIL("line %d: the script runs longer than %g s", lineno,
+                FAIL(SCRIPT_ERR_DURATION, "line %d: the script runs longer than %g s", lineno,
                      (double)SCRIPT_MAX_SECONDS);
         }
         if (s->count >= SCRIPT_MAX_COMMANDS)
-            FAIL("line %d: more than %u commands", lineno, SCRIPT_MAX_COMMANDS);
+            FAIL(SCRIPT_ERR_COMMANDS_MAX, "line %d: more than %u commands", lineno,
+                 SCRIPT_MAX_COMMANDS);
         if (push_cmd(s, &c) != ARGIL_OK) {
             snprintf(err, err_len, "line %d: out of memory", lineno);
-            return ARGIL_ERR_NOMEM;
+            return SCRIPT_ERR_NOMEM;
         }
     }
-    return ARGIL_OK;
+    return SCRIPT_OK;
 }
 
-argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len)
+argil_err_t script_err_argil(script_err_t e)
+{
+    switch (e) {
+    case SCRIPT_OK: return ARGIL_OK;
+    case SCRIPT_ERR_IO: return ARGIL_ERR_IO;
+    case SCRIPT_ERR_NOMEM: return ARGIL_ERR_NOMEM;
+    default: return ARGIL_ERR_PARSE;
+    }
+}
+
+script_err_t script_load(script_t *s, const char *path, char *err, size_t err_len)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
-        return ARGIL_ERR_IO;
+        return SCRIPT_ERR_IO;
     }
     const size_t max = 16u << 20;
     char *buf = malloc(max);
     if (!buf) {
         fclose(f);
         snprintf(err, err_len, "%s: out of memory", path);
-        return ARGIL_ERR_NOMEM;
+        return SCRIPT_ERR_NOMEM;
     }
     const size_t n = fread(buf, 1, max, f);
     const int too_big = n == max && fgetc(f) != EOF;
@@ -393,12 +420,12 @@ argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len
     if (rd_err || too_big) {
         free(buf);
         snprintf(err, err_len, "%s: %s", path, rd_err ? "read error" : "larger than 16 MiB");
-        return rd_err ? ARGIL_ERR_IO : ARGIL_ERR_PARSE;
+        return rd_err ? SCRIPT_ERR_IO : SCRIPT_ERR_FILE_SIZE;
     }
     char msg[256];
-    const argil_err_t e = script_parse(s, buf, n, msg, sizeof(msg));
+    const script_err_t e = script_parse(s, buf, n, msg, sizeof(msg));
     free(buf);
-    if (e != ARGIL_OK)
+    if (e != SCRIPT_OK)
         snprintf(err, err_len, "%s: %s", path, msg);
     return e;
 }
@@ -463,6 +490,29 @@ void script_player_init(script_player_t *p, const script_t *s, vec3_t start_m)
     p->params_changed = 1;
 }
 
+/* Applies a command that changes a tool setting (action, action_shape, mirror, tool, shape,
+ * filter, axis, set) to the player. */
+static void player_set(script_player_t *p, const script_cmd_t *c)
+{
+    switch (c->op) {
+    case SCRIPT_ACTION:
+        p->host_tool.action = (host_action_t)c->arg_int;
+        p->host_tool.strength = c->value;
+        p->host_tool.rgb[0] = (uint8_t)c->target_m.x;
+        p->host_tool.rgb[1] = (uint8_t)c->target_m.y;
+        p->host_tool.rgb[2] = (uint8_t)c->target_m.z;
+        break;
+    case SCRIPT_ACTION_SHAPE: p->host_tool.shape = (host_shape_t)c->arg_int; break;
+    case SCRIPT_MIRROR: p->host_tool.mirror = (uint32_t)c->arg_int; break;
+    case SCRIPT_TOOL: p->tool = c->arg_int; break;
+    case SCRIPT_SHAPE: p->shape = c->arg_int; break;
+    case SCRIPT_FILTER: p->filter = c->arg_int; break;
+    case SCRIPT_AXIS: p->axis = c->target_m; break;
+    case SCRIPT_SET: p->params[c->arg_int] = c->value; break;
+    default: break;
+    }
+}
+
 int script_player_step(script_player_t *p, float dt_s)
 {
     /* Start commands until one takes time (bounded by the script's length); a paint waits for
@@ -494,39 +544,14 @@ int script_player_step(script_player_t *p, float dt_s)
             p->history_line = c->line;
             break;
         case SCRIPT_ACTION:
-            p->host_tool.action = (host_action_t)c->arg_int;
-            p->host_tool.strength = c->value;
-            p->host_tool.rgb[0] = (uint8_t)c->target_m.x;
-            p->host_tool.rgb[1] = (uint8_t)c->target_m.y;
-            p->host_tool.rgb[2] = (uint8_t)c->target_m.z;
-            p->params_changed = 1;
-            break;
         case SCRIPT_ACTION_SHAPE:
-            p->host_tool.shape = (host_shape_t)c->arg_int;
-            p->params_changed = 1;
-            break;
         case SCRIPT_MIRROR:
-            p->host_tool.mirror = (uint32_t)c->arg_int;
-            p->params_changed = 1;
-            break;
         case SCRIPT_TOOL:
-            p->tool = c->arg_int;
-            p->params_changed = 1;
-            break;
         case SCRIPT_SHAPE:
-            p->shape = c->arg_int;
-            p->params_changed = 1;
-            break;
         case SCRIPT_FILTER:
-            p->filter = c->arg_int;
-            p->params_changed = 1;
-            break;
         case SCRIPT_AXIS:
-            p->axis = c->target_m;
-            p->params_changed = 1;
-            break;
         case SCRIPT_SET:
-            p->params[c->arg_int] = c->value;
+            player_set(p, c);
             p->params_changed = 1;
             break;
         case SCRIPT_PRESS:
@@ -536,18 +561,12 @@ int script_player_step(script_player_t *p, float dt_s)
             p->buttons &= ~(1 << (c->arg_int - 1));
             break;
         case SCRIPT_MOVE:
+        case SCRIPT_WAIT: /* a wait is a move to where the hand is */
             p->active = 1;
             p->elapsed_s = 0.0f;
             p->duration_s = c->value;
             p->from_m = p->pos_m;
-            p->to_m = c->target_m;
-            break;
-        case SCRIPT_WAIT:
-            p->active = 1;
-            p->elapsed_s = 0.0f;
-            p->duration_s = c->value;
-            p->from_m = p->pos_m;
-            p->to_m = p->pos_m;
+            p->to_m = c->op == SCRIPT_MOVE ? c->target_m : p->pos_m;
             break;
         }
     }

@@ -81,12 +81,40 @@ typedef struct {
 void script_init(script_t *s);
 void script_free(script_t *s);
 
-/* Parses script text. On error returns ARGIL_ERR_PARSE (or ARGIL_ERR_NOMEM) and writes
- * "LINE: what is wrong" into err. Text need not be NUL-terminated. */
-argil_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len);
+/* What the script readers return: SCRIPT_OK, a failure outside the text (system call, memory),
+ * or the rule a line broke. */
+typedef enum {
+    SCRIPT_OK = 0,
+    SCRIPT_ERR_IO = -1,           /* the file cannot be opened or read */
+    SCRIPT_ERR_NOMEM = -2,        /* an allocation failed */
+    SCRIPT_ERR_FILE_SIZE = -3,    /* a file larger than 16 MiB */
+    SCRIPT_ERR_LINE_LONG = -4,    /* a line longer than 511 characters */
+    SCRIPT_ERR_LINE_NUL = -5,     /* a line holds a NUL byte */
+    SCRIPT_ERR_WORDS = -6,        /* more words than any command takes */
+    SCRIPT_ERR_COMMAND = -7,      /* an unknown command */
+    SCRIPT_ERR_ARGS = -8,         /* a command given the wrong number or kind of words */
+    SCRIPT_ERR_NAME = -9,         /* an unknown tool, shape, filter, parameter, action,
+                                   * action_shape or mirror */
+    SCRIPT_ERR_NUMBER = -10,      /* a word that is not a number (rgb: a whole number 0..255) */
+    SCRIPT_ERR_RANGE = -11,       /* a number out of its range (parameter, move target or
+                                   * duration, wait, paint scale or radius, strength) */
+    SCRIPT_ERR_AXIS_ZERO = -12,   /* 'axis' the zero vector */
+    SCRIPT_ERR_OPTION = -13,      /* an option the action does not take */
+    SCRIPT_ERR_REPEATED = -14,    /* 'strength' or 'rgb' given twice */
+    SCRIPT_ERR_DURATION = -15,    /* moves and waits longer than SCRIPT_MAX_SECONDS in all */
+    SCRIPT_ERR_COMMANDS_MAX = -16 /* more than SCRIPT_MAX_COMMANDS commands */
+} script_err_t;
+
+/* The argil_err_t a command reports for e: IO and NOMEM as themselves, every rule (and a file too
+ * large) ARGIL_ERR_PARSE. */
+argil_err_t script_err_argil(script_err_t e);
+
+/* Parses script text: the rule a line broke, with "line N: what is wrong" in err; NOMEM. Text
+ * need not be NUL-terminated. */
+script_err_t script_parse(script_t *s, const char *text, size_t len, char *err, size_t err_len);
 
 /* Reads and parses a file; err names the file and line. */
-argil_err_t script_load(script_t *s, const char *path, char *err, size_t err_len);
+script_err_t script_load(script_t *s, const char *path, char *err, size_t err_len);
 
 /* The name a param is written with in scripts, and its default value. */
 const char *script_param_name(script_param_t p);

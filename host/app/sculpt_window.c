@@ -1341,7 +1341,7 @@ static argil_err_t window_inputs(view_t *v, const session_opts_t *so, const scul
 {
     ui_input_init(&v->script);
     if (wo->input_path != NULL &&
-        ui_input_load(&v->script, wo->input_path, err, err_len) != ARGIL_OK)
+        ui_input_load(&v->script, wo->input_path, err, err_len) != UI_INPUT_OK)
         return ARGIL_ERR_PARSE;
     if (wo->frames_dir != NULL && so->out_dir != NULL)
         (void)mkdir(so->out_dir, 0777); /* the session creates it too; errors show below */

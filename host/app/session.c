@@ -288,7 +288,8 @@ static argil_err_t load_script(session_t *s, const session_opts_t *opts, char *e
 {
     if (!opts->script_path)
         return ARGIL_OK;
-    const argil_err_t rc = script_load(&s->script, opts->script_path, err, err_len);
+    const argil_err_t rc =
+        script_err_argil(script_load(&s->script, opts->script_path, err, err_len));
     if (rc != ARGIL_OK)
         return rc;
     /* Script lines only the B-spline model can carry out, with why the springs cannot. */

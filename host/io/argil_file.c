@@ -342,15 +342,36 @@ argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, 
     return e;
 }
 
+/* Takes a dense copy of painted channel ch into c (its runs and painted samples counted);
+ * ARGIL_ERR_NOMEM, or ARGIL_ERR_NONFINITE for a value out of grid_mat_valid's range. */
+static argil_err_t af_take_mat(af_wctx_t *c, int ch, const char *path, char *err, size_t err_len)
+{
+    const grid_mat_t mc = (grid_mat_t)ch;
+    int32_t mlo[3], mn[3];
+    c->mat[ch] = grid_dense_copy_mat(&c->d->grid, mc, mlo, mn);
+    const float *m = c->mat[ch];
+    if (m == NULL) {
+        io_err(err, err_len, "argil_file_write: %s: out of memory", path);
+        return ARGIL_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < c->n; i++)
+        if (!grid_mat_valid(mc, m[i])) {
+            io_err(err, err_len, "argil_file_write: %s: painted material channel %d holds "
+                   "%g at sample %zu (out of range)", path, ch, (double)m[i], i);
+            return ARGIL_ERR_NONFINITE;
+        }
+    c->mat_runs[ch] = argil_file_mat_runs(m, c->n, grid_mat_default(mc), &c->mat_samples[ch]);
+    return ARGIL_OK;
+}
+
 static argil_err_t af_write_ctx(const char *path, af_wctx_t *cp, char *err, size_t err_len)
 {
-    af_wctx_t c = *cp;
-    const argil_doc_t *d = c.d;
+    const argil_doc_t *d = cp->d;
     const grid_t *g = &d->grid;
-    const size_t n = c.n;
+    const size_t n = cp->n;
     const float gf[6] = {g->spacing_m, g->origin_m.x, g->origin_m.y, g->origin_m.z, g->iso,
                          g->band_m};
-    if (!af_finite(gf, 6) || !af_finite(c.dens, n) ||
+    if (!af_finite(gf, 6) || !af_finite(cp->dens, n) ||
         (d->has_rbf && (!af_finite(d->rbf.centre_m, 3 * (size_t)d->rbf.n) ||
                         !af_finite(d->rbf.weight, d->rbf.n) || !af_finite(d->rbf.poly, 4)))) {
         io_err(err, err_len, "argil_file_write: %s: the model holds NaN or Inf", path);
@@ -380,25 +401,13 @@ static argil_err_t af_write_ctx(const char *path, af_wctx_t *cp, char *err, size
         return ARGIL_ERR_ARG;
     }
     for (int ch = 0; ch < GRID_MAT_N; ch++) {
-        if (!grid_mat_painted(g, (grid_mat_t)ch))
-            continue;
-        int32_t mlo[3], mn[3];
-        float *m = grid_dense_copy_mat(g, (grid_mat_t)ch, mlo, mn);
-        if (m == NULL) {
-            io_err(err, err_len, "argil_file_write: %s: out of memory", path);
-            return ARGIL_ERR_NOMEM;
-        }
-        c.mat[ch] = cp->mat[ch] = m;
-        for (size_t i = 0; i < n; i++)
-            if (!grid_mat_valid((grid_mat_t)ch, m[i])) {
-                io_err(err, err_len, "argil_file_write: %s: painted material channel %d holds "
-                       "%g at sample %zu (out of range)", path, ch, (double)m[i], i);
-                return ARGIL_ERR_NONFINITE;
-            }
-        c.mat_runs[ch] = argil_file_mat_runs(m, n, grid_mat_default((grid_mat_t)ch),
-                                             &c.mat_samples[ch]);
+        const argil_err_t e = grid_mat_painted(g, (grid_mat_t)ch)
+                                  ? af_take_mat(cp, ch, path, err, err_len)
+                                  : ARGIL_OK;
+        if (e != ARGIL_OK)
+            return e;
     }
-    return io_write_atomic(path, af_write_body, &c, "argil_file_write", err, err_len);
+    return io_write_atomic(path, af_write_body, cp, "argil_file_write", err, err_len);
 }
 
 /* ------------------------------------------------------------------ reader */
@@ -409,10 +418,36 @@ typedef struct {
     size_t err_len;
 } af_rctx_t;
 
-static argil_err_t af_fail(const af_rctx_t *c, size_t off, const char *rule)
+/* Writes "path: byte off: rule" into the context's err and returns code. */
+static argil_file_err_t af_fail(const af_rctx_t *c, size_t off, argil_file_err_t code,
+                                const char *rule)
 {
     io_err(c->err, c->err_len, "%s: byte %zu: %s", c->path, off, rule);
-    return ARGIL_ERR_PARSE;
+    return code;
+}
+
+argil_err_t argil_file_err_argil(argil_file_err_t e)
+{
+    switch (e) {
+    case ARGIL_FILE_OK: return ARGIL_OK;
+    case ARGIL_FILE_ERR_ARG: return ARGIL_ERR_ARG;
+    case ARGIL_FILE_ERR_IO: return ARGIL_ERR_IO;
+    case ARGIL_FILE_ERR_NOMEM: return ARGIL_ERR_NOMEM;
+    default: return ARGIL_ERR_PARSE;
+    }
+}
+
+/* The argil_file_err_t of a failure outside the file: io_slurp's (PARSE: the file is too
+ * large) or an allocation's. */
+static argil_file_err_t af_outside_err(argil_err_t e)
+{
+    switch (e) {
+    case ARGIL_OK: return ARGIL_FILE_OK;
+    case ARGIL_ERR_ARG: return ARGIL_FILE_ERR_ARG;
+    case ARGIL_ERR_NOMEM: return ARGIL_FILE_ERR_NOMEM;
+    case ARGIL_ERR_PARSE: return ARGIL_FILE_ERR_FILE_SIZE;
+    default: return ARGIL_FILE_ERR_IO;
+    }
 }
 
 static void af_get_f32s(const uint8_t *p, float *v, size_t n)
@@ -422,31 +457,36 @@ static void af_get_f32s(const uint8_t *p, float *v, size_t n)
 }
 
 /* Decodes the GRID section payload (len bytes at p, file offset off). */
-static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
-                           argil_doc_t *d)
+static argil_file_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
+                                argil_doc_t *d)
 {
     if (len < 36)
-        return af_fail(c, off, "GRID section shorter than its 36-byte head");
+        return af_fail(c, off, ARGIL_FILE_ERR_GRID_HEAD,
+                       "GRID section shorter than its 36-byte head");
     int32_t dims[3];
     uint64_t n = 1;
     for (int a = 0; a < 3; a++) {
         dims[a] = (int32_t)le_get_u32(p + 4 * a);
         if (dims[a] < 1)
-            return af_fail(c, off + 4 * (size_t)a, "GRID dimension below 1");
+            return af_fail(c, off + 4 * (size_t)a, ARGIL_FILE_ERR_GRID_DIM,
+                           "GRID dimension below 1");
         n *= (uint64_t)dims[a];
         if (n > (uint64_t)GRID_SAMPLES_MAX)
-            return af_fail(c, off + 4 * (size_t)a, "GRID holds more than 2^30 samples");
+            return af_fail(c, off + 4 * (size_t)a, ARGIL_FILE_ERR_GRID_SAMPLES_MAX,
+                           "GRID holds more than 2^30 samples");
     }
     if (len != af_grid_bytes((size_t)n))
-        return af_fail(c, off, "GRID section length does not match its dimensions");
+        return af_fail(c, off, ARGIL_FILE_ERR_GRID_LENGTH,
+                       "GRID section length does not match its dimensions");
     float gf[6];
     af_get_f32s(p + 12, gf, 6);
     if (!af_finite(gf, 6) || !(gf[0] > 0) || !(gf[5] > 0))
-        return af_fail(c, off + 12, "GRID spacing, origin, iso or band not finite (or not > 0)");
+        return af_fail(c, off + 12, ARGIL_FILE_ERR_GRID_GEOMETRY,
+                       "GRID spacing, origin, iso or band not finite (or not > 0)");
     if (grid_init(&d->grid, dims, gf[0], vec3(gf[1], gf[2], gf[3])) != ARGIL_OK) {
         io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
                (unsigned long long)n);
-        return ARGIL_ERR_NOMEM;
+        return ARGIL_FILE_ERR_NOMEM;
     }
     d->grid.iso = gf[4];
     d->grid.band_m = gf[5];
@@ -454,13 +494,14 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     if (v == NULL) {
         io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
                (unsigned long long)n);
-        return ARGIL_ERR_NOMEM;
+        return ARGIL_FILE_ERR_NOMEM;
     }
     for (size_t i = 0; i < (size_t)n; i++) {
         v[i] = le_get_f32(p + 36 + 4 * i);
         if (!isfinite(v[i]) || v[i] < 0.0f || v[i] > 1.0f) {
             free(v);
-            return af_fail(c, off + 36 + 4 * i, "GRID density not a finite number in [0, 1]");
+            return af_fail(c, off + 36 + 4 * i, ARGIL_FILE_ERR_GRID_DENSITY,
+                           "GRID density not a finite number in [0, 1]");
         }
     }
     const int32_t zero[3] = {0, 0, 0};
@@ -471,33 +512,35 @@ static argil_err_t af_grid(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
     if (e != ARGIL_OK) {
         io_err(c->err, c->err_len, "%s: out of memory for %llu samples", c->path,
                (unsigned long long)n);
-        return e;
+        return af_outside_err(e);
     }
-    return ARGIL_OK;
+    return ARGIL_FILE_OK;
 }
 
-/* Decodes the OCTB section (head at file offset pos, payload of len bytes at p / off). */
-static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t pos,
-                           size_t off, argil_doc_t *d)
+/* Decodes the OCTB section (len >= 40 bytes at p, file offset off). */
+static argil_file_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
+                                argil_doc_t *d)
 {
-    if (d->has_octree || len < 40)
-        return af_fail(c, pos, "OCTB section repeated or shorter than its 40-byte head");
     const uint32_t n = le_get_u32(p), per_axis = le_get_u32(p + 4), kind = le_get_u32(p + 8);
     if (n < 1 || n > OCTFIT_NODES_MAX || (uint64_t)len < 40u + 4u * (uint64_t)n)
-        return af_fail(c, off, "OCTB node count not in 1..65537 or past the section's end");
+        return af_fail(c, off, ARGIL_FILE_ERR_OCTB_NODES,
+                       "OCTB node count not in 1..65537 or past the section's end");
     if (per_axis != OCTFIT_N)
-        return af_fail(c, off + 4, "OCTB coefficients per axis not 6");
+        return af_fail(c, off + 4, ARGIL_FILE_ERR_OCTB_PER_AXIS,
+                       "OCTB coefficients per axis not 6");
     if (kind > 1)
-        return af_fail(c, off + 8, "OCTB kind not 0 (signed distance) or 1 (intensity)");
+        return af_fail(c, off + 8, ARGIL_FILE_ERR_OCTB_KIND,
+                       "OCTB kind not 0 (signed distance) or 1 (intensity)");
     float of[7];
     af_get_f32s(p + 12, of, 7);
     if (!af_finite(of, 7) || !(of[3] > 0) || of[6] != OCTFIT_OVERLAP)
-        return af_fail(c, off + 12, "OCTB origin, size, errors or overlap not finite (size > 0, "
-                                    "overlap 0.25)");
+        return af_fail(c, off + 12, ARGIL_FILE_ERR_OCTB_GEOMETRY,
+                       "OCTB origin, size, errors or overlap not finite (size > 0, "
+                       "overlap 0.25)");
     uint32_t *child = malloc((size_t)n * sizeof(uint32_t));
     if (child == NULL) {
         io_err(c->err, c->err_len, "%s: out of memory", c->path);
-        return ARGIL_ERR_NOMEM;
+        return ARGIL_FILE_ERR_NOMEM;
     }
     uint64_t leaves = 0;
     for (uint32_t i = 0; i < n; i++) {
@@ -508,21 +551,24 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
      * them: a declared count never drives an allocation the file cannot back. */
     if (len != 40u + 4u * (uint64_t)n + 4u * OCTFIT_NCOEF * leaves) {
         free(child);
-        return af_fail(c, off, "OCTB section length does not match its nodes and leaves");
+        return af_fail(c, off, ARGIL_FILE_ERR_OCTB_LENGTH,
+                       "OCTB section length does not match its nodes and leaves");
     }
     const argil_err_t e = octfit_alloc(&d->octree, n, child, of, of[3]);
     free(child);
     if (e == ARGIL_ERR_NOMEM) {
         io_err(c->err, c->err_len, "%s: out of memory", c->path);
-        return e;
+        return ARGIL_FILE_ERR_NOMEM;
     }
     if (e != ARGIL_OK)
-        return af_fail(c, off + 40, "OCTB child links do not form an octree (each node the child "
-                                    "of one earlier node, 8 consecutive children, depth <= 10)");
+        return af_fail(c, off + 40, ARGIL_FILE_ERR_OCTB_LINKS,
+                       "OCTB child links do not form an octree (each node the child "
+                       "of one earlier node, 8 consecutive children, depth <= 10)");
     d->has_octree = true;
     octfit_model_t *m = &d->octree;
     if (len != af_octb_bytes(m))
-        return af_fail(c, off, "OCTB section length does not match its nodes and leaves");
+        return af_fail(c, off, ARGIL_FILE_ERR_OCTB_LENGTH,
+                       "OCTB section length does not match its nodes and leaves");
     m->kind = kind;
     m->rms_err = of[4];
     m->max_err = of[5];
@@ -531,32 +577,36 @@ static argil_err_t af_octb(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         af_get_f32s(q + 4 * OCTFIT_NCOEF * (size_t)i, m->leaf[i].coef, OCTFIT_NCOEF);
         if (!af_finite(m->leaf[i].coef, OCTFIT_NCOEF))
             return af_fail(c, off + (size_t)(q - p) + 4 * OCTFIT_NCOEF * (size_t)i,
-                           "OCTB coefficient NaN or Inf");
+                           ARGIL_FILE_ERR_OCTB_COEF, "OCTB coefficient NaN or Inf");
     }
-    return ARGIL_OK;
+    return ARGIL_FILE_OK;
 }
 
 /* Decodes the MTLS section (len bytes at p, file offset off) into the grid's painted channels
  * (n samples). Every value is checked before the channel it belongs to is allocated. */
-static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
-                           size_t n, argil_doc_t *d)
+static argil_file_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, size_t off,
+                                size_t n, argil_doc_t *d)
 {
     if (len < 4)
-        return af_fail(c, off, "MTLS section shorter than its 4-byte channel count");
+        return af_fail(c, off, ARGIL_FILE_ERR_MTLS_COUNT,
+                       "MTLS section shorter than its 4-byte channel count");
     const uint32_t k = le_get_u32(p);
     if (k < 1 || k > GRID_MAT_N)
-        return af_fail(c, off, "MTLS channel count not in 1..4");
+        return af_fail(c, off, ARGIL_FILE_ERR_MTLS_COUNT, "MTLS channel count not in 1..4");
     uint64_t at = 4;
     int64_t prev_ch = -1;
     for (uint32_t i = 0; i < k; i++) {
         if (len - at < 8)
-            return af_fail(c, off + (size_t)at, "MTLS channel head runs past the section");
+            return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_CHANNEL,
+                           "MTLS channel head runs past the section");
         const uint32_t ch = le_get_u32(p + at), runs = le_get_u32(p + at + 4);
         if (ch >= GRID_MAT_N || (int64_t)ch <= prev_ch)
-            return af_fail(c, off + (size_t)at, "MTLS channel id not 0..3 (stiffness, mass, "
-                                                "damping, rest length) in increasing order");
+            return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_CHANNEL,
+                           "MTLS channel id not 0..3 (stiffness, mass, "
+                           "damping, rest length) in increasing order");
         if (runs < 1)
-            return af_fail(c, off + (size_t)at + 4, "MTLS channel with no runs");
+            return af_fail(c, off + (size_t)at + 4, ARGIL_FILE_ERR_MTLS_CHANNEL,
+                           "MTLS channel with no runs");
         prev_ch = (int64_t)ch;
         at += 8;
         const uint64_t first = at;
@@ -564,18 +614,22 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         /* Check the runs... */
         for (uint32_t r = 0; r < runs; r++) {
             if (len - at < 8)
-                return af_fail(c, off + (size_t)at, "MTLS run head runs past the section");
+                return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_RUN,
+                               "MTLS run head runs past the section");
             const uint64_t start = le_get_u32(p + at), count = le_get_u32(p + at + 4);
             if (count < 1 || start < next_start || start + count > (uint64_t)n)
-                return af_fail(c, off + (size_t)at, "MTLS run empty, overlapping or out of order, "
-                                                    "or beyond the grid's samples");
+                return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_RUN,
+                               "MTLS run empty, overlapping or out of order, "
+                               "or beyond the grid's samples");
             if ((len - at - 8) / 4 < count)
-                return af_fail(c, off + (size_t)at, "MTLS run values run past the section");
+                return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_RUN,
+                               "MTLS run values run past the section");
             for (uint64_t v = 0; v < count; v++) {
                 const size_t vo = (size_t)(at + 8 + 4 * v);
                 if (!grid_mat_valid((grid_mat_t)ch, le_get_f32(p + vo)))
-                    return af_fail(c, off + vo, "MTLS value out of range (finite; mass scale > 0, "
-                                                "stiffness and damping scales >= 0)");
+                    return af_fail(c, off + vo, ARGIL_FILE_ERR_MTLS_VALUE,
+                                   "MTLS value out of range (finite; mass scale > 0, "
+                                   "stiffness and damping scales >= 0)");
             }
             next_start = start + count;
             at += 8 + 4 * count;
@@ -585,7 +639,7 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         float *m = grid_dense_copy_mat(&d->grid, (grid_mat_t)ch, mlo, mn);
         if (m == NULL) {
             io_err(c->err, c->err_len, "%s: out of memory", c->path);
-            return ARGIL_ERR_NOMEM;
+            return ARGIL_FILE_ERR_NOMEM;
         }
         for (uint64_t q = first, r = 0; r < runs; r++) {
             const size_t start = le_get_u32(p + q), count = le_get_u32(p + q + 4);
@@ -596,16 +650,17 @@ static argil_err_t af_mtls(const af_rctx_t *c, const uint8_t *p, uint64_t len, s
         free(m);
         if (we != ARGIL_OK) {
             io_err(c->err, c->err_len, "%s: out of memory", c->path);
-            return we;
+            return af_outside_err(we);
         }
     }
     if (at != len)
-        return af_fail(c, off + (size_t)at, "bytes after the last MTLS channel");
-    return ARGIL_OK;
+        return af_fail(c, off + (size_t)at, ARGIL_FILE_ERR_MTLS_TRAILING,
+                       "bytes after the last MTLS channel");
+    return ARGIL_FILE_OK;
 }
 
 /* The 16-byte TOOL section at p (payload offset off in the file) into d->tool. */
-static argil_err_t af_tool(const af_rctx_t *c, const uint8_t *p, size_t off, argil_doc_t *d)
+static argil_file_err_t af_tool(const af_rctx_t *c, const uint8_t *p, size_t off, argil_doc_t *d)
 {
     d->tool.tool_kind = le_get_u32(p);
     d->tool.radius_m = le_get_f32(p + 4);
@@ -613,23 +668,23 @@ static argil_err_t af_tool(const af_rctx_t *c, const uint8_t *p, size_t off, arg
     memcpy(d->tool.paint_rgb, p + 12, 3);
     if (!isfinite(d->tool.radius_m) || d->tool.radius_m < 0 || !isfinite(d->tool.strength) ||
         d->tool.strength < 0 || d->tool.strength > 1)
-        return af_fail(c, off + 4, "TOOL radius or strength out of range");
-    return ARGIL_OK;
+        return af_fail(c, off + 4, ARGIL_FILE_ERR_TOOL_VALUE,
+                       "TOOL radius or strength out of range");
+    return ARGIL_FILE_OK;
 }
 
-/* The RBF3 section (sl bytes at p; its head at file offset pos, payload at off) into d->rbf. */
-static argil_err_t af_rbf3(const af_rctx_t *c, const uint8_t *p, uint64_t sl, size_t pos,
-                           size_t off, argil_doc_t *d)
+/* The RBF3 section (sl >= 28 bytes at p, file offset off) into d->rbf. */
+static argil_file_err_t af_rbf3(const af_rctx_t *c, const uint8_t *p, uint64_t sl, size_t off,
+                                argil_doc_t *d)
 {
-    if (d->has_rbf || sl < 28)
-        return af_fail(c, pos, "RBF3 section repeated or shorter than 28 bytes");
     const uint32_t n = le_get_u32(p);
     if (n > RBF_CENTRES_MAX || sl != 28u + 16u * (uint64_t)n)
-        return af_fail(c, off, "RBF3 centre count out of range or not matching the "
-                               "section length");
+        return af_fail(c, off, ARGIL_FILE_ERR_RBF3_COUNT,
+                       "RBF3 centre count out of range or not matching the "
+                       "section length");
     if (rbf_alloc(&d->rbf, n) != ARGIL_OK) {
         io_err(c->err, c->err_len, "%s: out of memory", c->path);
-        return ARGIL_ERR_NOMEM;
+        return ARGIL_FILE_ERR_NOMEM;
     }
     d->has_rbf = true;
     float rf[6];
@@ -645,34 +700,112 @@ static argil_err_t af_rbf3(const af_rctx_t *c, const uint8_t *p, uint64_t sl, si
     }
     if (!af_finite(rf, 6) || !af_finite(d->rbf.centre_m, 3 * (size_t)n) ||
         !af_finite(d->rbf.weight, n))
-        return af_fail(c, off, "RBF3 holds NaN or Inf");
-    return ARGIL_OK;
+        return af_fail(c, off, ARGIL_FILE_ERR_RBF3_VALUE, "RBF3 holds NaN or Inf");
+    return ARGIL_FILE_OK;
 }
 
-static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, argil_doc_t *d)
+/* The sections a file holds at most once, each of a fixed length or at least a head's. */
+enum { AF_MATL, AF_TOOL, AF_STAT, AF_PNTS, AF_RBF3, AF_OCTB, AF_ONCE_N };
+
+static const struct {
+    char tag[5];
+    uint64_t bytes; /* the length, or the head's when not exact */
+    bool exact;
+    argil_file_err_t size_err;
+    const char *size_rule;
+} AF_ONCE[AF_ONCE_N] = {
+    {"MATL", 20, true, ARGIL_FILE_ERR_MATL_SIZE, "MATL section repeated or not 20 bytes"},
+    {"TOOL", 16, true, ARGIL_FILE_ERR_TOOL_SIZE, "TOOL section repeated or not 16 bytes"},
+    {"STAT", 20, true, ARGIL_FILE_ERR_STAT_SIZE, "STAT section repeated or not 20 bytes"},
+    {"PNTS", 4, true, ARGIL_FILE_ERR_PNTS_SIZE, "PNTS section repeated or not 4 bytes"},
+    {"RBF3", 28, false, ARGIL_FILE_ERR_RBF3_HEAD,
+     "RBF3 section repeated or shorter than 28 bytes"},
+    {"OCTB", 40, false, ARGIL_FILE_ERR_OCTB_HEAD,
+     "OCTB section repeated or shorter than its 40-byte head"},
+};
+
+/* The AF_ONCE index of tag, or -1 when it is not one of them. */
+static int af_once_find(const char *tag)
+{
+    for (int i = 0; i < AF_ONCE_N; i++)
+        if (strcmp(tag, AF_ONCE[i].tag) == 0)
+            return i;
+    return -1;
+}
+
+/* True when section fx may be sl bytes long. */
+static bool af_once_length_ok(int fx, uint64_t sl)
+{
+    return AF_ONCE[fx].exact ? sl == AF_ONCE[fx].bytes : sl >= AF_ONCE[fx].bytes;
+}
+
+/* Decodes section fx (its length checked; sl bytes at p, file offset off) into d, or the
+ * material into *matl (applied once the grid exists: sections come in any order). */
+static argil_file_err_t af_once(const af_rctx_t *c, int fx, const uint8_t *p, uint64_t sl,
+                                size_t off, spring_material_t *matl, argil_doc_t *d)
+{
+    float v[5];
+    af_get_f32s(p, v, fx <= AF_PNTS ? (size_t)AF_ONCE[fx].bytes / 4 : 0);
+    switch (fx) {
+    case AF_MATL: {
+        const spring_material_t m = {v[0], v[1], v[2], v[3], v[4]};
+        if (!spring_material_valid(&m))
+            return af_fail(c, off, ARGIL_FILE_ERR_MATL_VALUE,
+                           "MATL values out of range (mass > 0, others >= 0, finite)");
+        *matl = m;
+        return ARGIL_FILE_OK;
+    }
+    case AF_TOOL: return af_tool(c, p, off, d);
+    case AF_STAT:
+        if (!af_finite(v, 4) || !(v[3] > 0))
+            return af_fail(c, off, ARGIL_FILE_ERR_STAT_VALUE,
+                           "STAT transform not finite (or scale not > 0)");
+        d->state.device_offset_m = vec3(v[0], v[1], v[2]);
+        d->state.device_scale = v[3];
+        d->state.edits = le_get_u32(p + 16);
+        return ARGIL_FILE_OK;
+    case AF_RBF3: return af_rbf3(c, p, sl, off, d);
+    case AF_OCTB: return af_octb(c, p, sl, off, d);
+    default:
+        if (!isfinite(v[0]) || v[0] < 0 || v[0] > ARGIL_FILE_PAINT_RATE_MAX)
+            return af_fail(c, off, ARGIL_FILE_ERR_PNTS_RATE,
+                           "PNTS soft-paint rate not in 0..100 per second");
+        d->tool.paint_chosen = true;
+        d->tool.soft_paint_per_s = v[0];
+        return ARGIL_FILE_OK;
+    }
+}
+
+static argil_file_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, argil_doc_t *d)
 {
     if (len < ARGIL_FILE_HEADER_BYTES + 4)
-        return af_fail(c, len, "file shorter than the 32-byte header and 4-byte checksum");
+        return af_fail(c, len, ARGIL_FILE_ERR_SHORT,
+                       "file shorter than the 32-byte header and 4-byte checksum");
     if (memcmp(b, AF_MAGIC, 8) != 0)
-        return af_fail(c, 0, "not an .argil file (magic \"ARGIL\\r\\n\\x1a\")");
+        return af_fail(c, 0, ARGIL_FILE_ERR_MAGIC,
+                       "not an .argil file (magic \"ARGIL\\r\\n\\x1a\")");
     if (le_get_u32(b + 28) != crc32c(0, b, 28))
-        return af_fail(c, 28, "header checksum mismatch (file corrupted)");
+        return af_fail(c, 28, ARGIL_FILE_ERR_HEADER_CRC,
+                       "header checksum mismatch (file corrupted)");
     const uint32_t version = le_get_u32(b + 8);
     if (version == 0 || version > ARGIL_FILE_VERSION) {
         io_err(c->err, c->err_len, "%s: byte 8: format version %u; this argil reads 1..%u", c->path,
                version, ARGIL_FILE_VERSION);
-        return ARGIL_ERR_PARSE;
+        return ARGIL_FILE_ERR_VERSION;
     }
     const uint32_t n_sec = le_get_u32(b + 12);
     if (n_sec < 1 || n_sec > ARGIL_FILE_SECTIONS_MAX)
-        return af_fail(c, 12, "section count not in 1..64");
+        return af_fail(c, 12, ARGIL_FILE_ERR_SECTION_COUNT, "section count not in 1..64");
     if (le_get_u64(b + 16) != (uint64_t)len)
-        return af_fail(c, 16, "declared file length differs from the real size (truncated or "
-                              "extended)");
+        return af_fail(c, 16, ARGIL_FILE_ERR_FILE_LENGTH,
+                       "declared file length differs from the real size (truncated or "
+                       "extended)");
     if (le_get_u32(b + len - 4) != crc32c(0, b, len - 4))
-        return af_fail(c, len - 4, "file checksum mismatch (file corrupted)");
+        return af_fail(c, len - 4, ARGIL_FILE_ERR_FILE_CRC,
+                       "file checksum mismatch (file corrupted)");
     size_t pos = ARGIL_FILE_HEADER_BYTES;
-    bool seen_grid = false, seen_matl = false, seen_tool = false, seen_stat = false;
+    bool seen_grid = false, seen[AF_ONCE_N] = {false};
+    int fx;
     spring_material_t matl;
     spring_material_default(&matl);
     const uint8_t *colr = NULL, *mtls = NULL;
@@ -681,122 +814,104 @@ static argil_err_t af_parse(const af_rctx_t *c, const uint8_t *b, size_t len, ar
     for (uint32_t s = 0; s < n_sec; s++) {
         const size_t end = len - 4;
         if (end - pos < AF_SEC_OVERHEAD)
-            return af_fail(c, pos, "section head runs past the end of the file");
+            return af_fail(c, pos, ARGIL_FILE_ERR_SECTION_HEAD,
+                           "section head runs past the end of the file");
         const uint64_t sl = le_get_u64(b + pos + 4);
         if (sl > (uint64_t)(end - pos - AF_SEC_OVERHEAD))
-            return af_fail(c, pos + 4, "section length runs past the end of the file");
+            return af_fail(c, pos + 4, ARGIL_FILE_ERR_SECTION_LENGTH,
+                           "section length runs past the end of the file");
         const uint8_t *p = b + pos + 12;
         const size_t crc_off = pos + 12 + (size_t)sl;
         if (le_get_u32(b + crc_off) != crc32c(0, b + pos, 12 + (size_t)sl))
-            return af_fail(c, crc_off, "section checksum mismatch (file corrupted)");
+            return af_fail(c, crc_off, ARGIL_FILE_ERR_SECTION_CRC,
+                           "section checksum mismatch (file corrupted)");
         const size_t off = pos + 12;
         char tag[5] = {0};
         memcpy(tag, b + pos, 4);
-        argil_err_t e = ARGIL_OK;
+        argil_file_err_t e = ARGIL_FILE_OK;
         if (strcmp(tag, "GRID") == 0) {
             if (seen_grid)
-                return af_fail(c, pos, "second GRID section");
+                return af_fail(c, pos, ARGIL_FILE_ERR_GRID_REPEATED, "second GRID section");
             seen_grid = true;
             e = af_grid(c, p, sl, off, d);
-        } else if (strcmp(tag, "MATL") == 0) {
-            if (seen_matl || sl != 20)
-                return af_fail(c, pos, "MATL section repeated or not 20 bytes");
-            seen_matl = true;
-            float mf[5];
-            af_get_f32s(p, mf, 5);
-            spring_material_t m = {mf[0], mf[1], mf[2], mf[3], mf[4]};
-            if (!spring_material_valid(&m))
-                return af_fail(c, off, "MATL values out of range (mass > 0, others >= 0, finite)");
-            matl = m; /* applied once the grid exists (sections may come in any order) */
-        } else if (strcmp(tag, "TOOL") == 0) {
-            if (seen_tool || sl != 16)
-                return af_fail(c, pos, "TOOL section repeated or not 16 bytes");
-            seen_tool = true;
-            e = af_tool(c, p, off, d);
-        } else if (strcmp(tag, "STAT") == 0) {
-            if (seen_stat || sl != 20)
-                return af_fail(c, pos, "STAT section repeated or not 20 bytes");
-            seen_stat = true;
-            float sf[4];
-            af_get_f32s(p, sf, 4);
-            if (!af_finite(sf, 4) || !(sf[3] > 0))
-                return af_fail(c, off, "STAT transform not finite (or scale not > 0)");
-            d->state.device_offset_m = vec3(sf[0], sf[1], sf[2]);
-            d->state.device_scale = sf[3];
-            d->state.edits = le_get_u32(p + 16);
-        } else if (strcmp(tag, "PNTS") == 0) {
-            if (d->tool.paint_chosen || sl != 4)
-                return af_fail(c, pos, "PNTS section repeated or not 4 bytes");
-            const float rate = le_get_f32(p);
-            if (!isfinite(rate) || rate < 0 || rate > ARGIL_FILE_PAINT_RATE_MAX)
-                return af_fail(c, off, "PNTS soft-paint rate not in 0..100 per second");
-            d->tool.paint_chosen = true;
-            d->tool.soft_paint_per_s = rate;
+        } else if ((fx = af_once_find(tag)) >= 0) {
+            if (seen[fx] || !af_once_length_ok(fx, sl))
+                return af_fail(c, pos, AF_ONCE[fx].size_err, AF_ONCE[fx].size_rule);
+            seen[fx] = true;
+            e = af_once(c, fx, p, sl, off, &matl, d);
         } else if (strcmp(tag, "COLR") == 0) {
             if (colr != NULL)
-                return af_fail(c, pos, "second COLR section");
+                return af_fail(c, pos, ARGIL_FILE_ERR_COLR_REPEATED, "second COLR section");
             colr = p;
             colr_len = sl;
             colr_off = off;
-        } else if (strcmp(tag, "RBF3") == 0) {
-            e = af_rbf3(c, p, sl, pos, off, d);
-        } else if (strcmp(tag, "OCTB") == 0) {
-            e = af_octb(c, p, sl, pos, off, d);
         } else if (strcmp(tag, "MTLS") == 0) {
             if (mtls != NULL)
-                return af_fail(c, pos, "second MTLS section");
+                return af_fail(c, pos, ARGIL_FILE_ERR_MTLS_REPEATED, "second MTLS section");
             if (version < ARGIL_FILE_VERSION_MTLS)
-                return af_fail(c, pos, "MTLS section (painted material) in a version-1 file");
+                return af_fail(c, pos, ARGIL_FILE_ERR_MTLS_VERSION,
+                               "MTLS section (painted material) in a version-1 file");
             mtls = p;
             mtls_len = sl;
             mtls_off = off;
         }
         /* other tags: a later minor revision's optional data, checked and skipped */
-        if (e != ARGIL_OK)
+        if (e != ARGIL_FILE_OK)
             return e;
         pos = crc_off + 4;
     }
     if (pos != len - 4)
-        return af_fail(c, pos, "bytes between the last section and the file checksum");
+        return af_fail(c, pos, ARGIL_FILE_ERR_TRAILING,
+                       "bytes between the last section and the file checksum");
     if (!seen_grid)
-        return af_fail(c, ARGIL_FILE_HEADER_BYTES, "no GRID section (the model)");
+        return af_fail(c, ARGIL_FILE_HEADER_BYTES, ARGIL_FILE_ERR_GRID_MISSING,
+                       "no GRID section (the model)");
     d->grid.material = matl;
     const size_t n = grid_count(&d->grid);
     if (colr != NULL) {
         if (colr_len != 3u * (uint64_t)n)
-            return af_fail(c, colr_off, "COLR section is not 3 bytes per GRID sample");
+            return af_fail(c, colr_off, ARGIL_FILE_ERR_COLR_LENGTH,
+                           "COLR section is not 3 bytes per GRID sample");
         d->rgb = malloc(3 * n);
         if (d->rgb == NULL) {
             io_err(c->err, c->err_len, "%s: out of memory", c->path);
-            return ARGIL_ERR_NOMEM;
+            return ARGIL_FILE_ERR_NOMEM;
         }
         memcpy(d->rgb, colr, 3 * n);
     }
     if (mtls != NULL) {
-        const argil_err_t e = af_mtls(c, mtls, mtls_len, mtls_off, n, d);
-        if (e != ARGIL_OK)
+        const argil_file_err_t e = af_mtls(c, mtls, mtls_len, mtls_off, n, d);
+        if (e != ARGIL_FILE_OK)
             return e;
     }
     d->file_version = version;
-    return ARGIL_OK;
+    return ARGIL_FILE_OK;
 }
 
-argil_err_t argil_file_read(const char *path, argil_doc_t *d, char *err, size_t err_len)
+/* Reads the file c names and parses it into d (initialised). */
+static argil_file_err_t af_read(const af_rctx_t *c, argil_doc_t *d)
 {
-    if (path == NULL || d == NULL) {
-        io_err(err, err_len, "argil_file_read: no path or no document");
-        return ARGIL_ERR_ARG;
-    }
-    argil_doc_init(d);
     uint8_t *b;
     size_t len;
-    argil_err_t e = io_slurp(path, IO_FILE_MAX_BYTES, &b, &len, err, err_len);
-    if (e != ARGIL_OK)
-        return e;
+    argil_file_err_t e = af_outside_err(io_slurp(c->path, IO_FILE_MAX_BYTES, &b, &len, c->err,
+                                                 c->err_len));
+    if (e == ARGIL_FILE_OK) {
+        e = af_parse(c, b, len, d);
+        free(b);
+    }
+    return e;
+}
+
+argil_file_err_t argil_file_read(const char *path, argil_doc_t *d, char *err, size_t err_len)
+{
     const af_rctx_t c = {path, err, err_len};
-    e = af_parse(&c, b, len, d);
-    free(b);
-    if (e != ARGIL_OK)
+    if (path == NULL || d == NULL) {
+        io_err(err, err_len, "argil_file_read: no path or no document");
+        return ARGIL_FILE_ERR_ARG;
+    }
+    argil_doc_init(d);
+    const argil_file_err_t e = af_read(&c, d);
+    if (e != ARGIL_FILE_OK)
         argil_doc_free(d);
     return e;
 }

@@ -71,9 +71,72 @@ argil_err_t argil_file_write(const char *path, const argil_doc_t *d, char *err, 
  * inside them; runs bridge up to ARGIL_FILE_RUN_GAP unpainted samples. 0 runs: nothing painted. */
 uint32_t argil_file_mat_runs(const float *m, size_t n, float def, uint64_t *samples);
 
-/* Reads path into d (initialised by the call; empty on error). ARGIL_ERR_PARSE with err naming
- * the path, the byte offset and the rule broken (magic, version, length, checksum, section,
- * value ranges); IO / NOMEM. */
-argil_err_t argil_file_read(const char *path, argil_doc_t *d, char *err, size_t err_len);
+/* What argil_file_read returns: ARGIL_FILE_OK, a failure outside the file (argument, system
+ * call, memory), or the rule the file broke. */
+typedef enum {
+    ARGIL_FILE_OK = 0,
+    ARGIL_FILE_ERR_ARG = -1, /* no path or no document */
+    ARGIL_FILE_ERR_IO = -2, /* the file cannot be opened or read, or is not regular */
+    ARGIL_FILE_ERR_NOMEM = -3, /* an allocation failed */
+    ARGIL_FILE_ERR_FILE_SIZE = -4, /* a file larger than IO_FILE_MAX_BYTES */
+    ARGIL_FILE_ERR_SHORT = -5, /* shorter than the 32-byte header and 4-byte checksum */
+    ARGIL_FILE_ERR_MAGIC = -6, /* the first 8 bytes are not "ARGIL\r\n\x1a" */
+    ARGIL_FILE_ERR_HEADER_CRC = -7, /* the header's CRC-32C does not match */
+    ARGIL_FILE_ERR_VERSION = -8, /* format version 0 or newer than ARGIL_FILE_VERSION */
+    ARGIL_FILE_ERR_SECTION_COUNT = -9, /* section count not in 1..ARGIL_FILE_SECTIONS_MAX */
+    ARGIL_FILE_ERR_FILE_LENGTH = -10, /* the declared file length differs from the real size */
+    ARGIL_FILE_ERR_FILE_CRC = -11, /* the whole file's CRC-32C does not match */
+    ARGIL_FILE_ERR_SECTION_HEAD = -12, /* a section head runs past the end of the file */
+    ARGIL_FILE_ERR_SECTION_LENGTH = -13, /* a section length runs past the end of the file */
+    ARGIL_FILE_ERR_SECTION_CRC = -14, /* a section's CRC-32C does not match */
+    ARGIL_FILE_ERR_TRAILING = -15, /* bytes between the last section and the file checksum */
+    ARGIL_FILE_ERR_GRID_MISSING = -16, /* no GRID section */
+    ARGIL_FILE_ERR_GRID_REPEATED = -17, /* a second GRID section */
+    ARGIL_FILE_ERR_GRID_HEAD = -18, /* GRID shorter than its 36-byte head */
+    ARGIL_FILE_ERR_GRID_DIM = -19, /* a GRID dimension below 1 */
+    ARGIL_FILE_ERR_GRID_SAMPLES_MAX = -20, /* GRID holds more than GRID_SAMPLES_MAX samples */
+    ARGIL_FILE_ERR_GRID_LENGTH = -21, /* GRID length does not match its dimensions */
+    ARGIL_FILE_ERR_GRID_GEOMETRY = -22, /* GRID spacing, origin, iso or band not finite (> 0) */
+    ARGIL_FILE_ERR_GRID_DENSITY = -23, /* a GRID density not a finite number in [0, 1] */
+    ARGIL_FILE_ERR_MATL_SIZE = -24, /* MATL repeated or not 20 bytes */
+    ARGIL_FILE_ERR_MATL_VALUE = -25, /* MATL values out of spring_material_valid's range */
+    ARGIL_FILE_ERR_TOOL_SIZE = -26, /* TOOL repeated or not 16 bytes */
+    ARGIL_FILE_ERR_TOOL_VALUE = -27, /* TOOL radius or strength out of range */
+    ARGIL_FILE_ERR_STAT_SIZE = -28, /* STAT repeated or not 20 bytes */
+    ARGIL_FILE_ERR_STAT_VALUE = -29, /* STAT transform not finite or scale not > 0 */
+    ARGIL_FILE_ERR_PNTS_SIZE = -30, /* PNTS repeated or not 4 bytes */
+    ARGIL_FILE_ERR_PNTS_RATE = -31, /* PNTS rate not in 0..ARGIL_FILE_PAINT_RATE_MAX */
+    ARGIL_FILE_ERR_COLR_REPEATED = -32, /* a second COLR section */
+    ARGIL_FILE_ERR_COLR_LENGTH = -33, /* COLR is not 3 bytes per GRID sample */
+    ARGIL_FILE_ERR_MTLS_REPEATED = -34, /* a second MTLS section */
+    ARGIL_FILE_ERR_MTLS_VERSION = -35, /* MTLS in a version-1 file */
+    ARGIL_FILE_ERR_MTLS_COUNT = -36, /* MTLS channel count absent or not in 1..GRID_MAT_N */
+    ARGIL_FILE_ERR_MTLS_CHANNEL = -37, /* an MTLS channel head past the section, its id not
+                                        * increasing in 0..3, or no runs */
+    ARGIL_FILE_ERR_MTLS_RUN = -38, /* an MTLS run empty, out of order, beyond the grid or
+                                    * past the section */
+    ARGIL_FILE_ERR_MTLS_VALUE = -39, /* an MTLS value out of grid_mat_valid's range */
+    ARGIL_FILE_ERR_MTLS_TRAILING = -40, /* bytes after the last MTLS channel */
+    ARGIL_FILE_ERR_RBF3_HEAD = -41, /* RBF3 repeated or shorter than 28 bytes */
+    ARGIL_FILE_ERR_RBF3_COUNT = -42, /* RBF3 centre count out of range or not its length's */
+    ARGIL_FILE_ERR_RBF3_VALUE = -43, /* RBF3 holds NaN or Inf */
+    ARGIL_FILE_ERR_OCTB_HEAD = -44, /* OCTB repeated or shorter than its 40-byte head */
+    ARGIL_FILE_ERR_OCTB_NODES = -45, /* OCTB node count not in 1..OCTFIT_NODES_MAX or past
+                                      * the section */
+    ARGIL_FILE_ERR_OCTB_PER_AXIS = -46, /* OCTB coefficients per axis not OCTFIT_N */
+    ARGIL_FILE_ERR_OCTB_KIND = -47, /* OCTB kind not 0 or 1 */
+    ARGIL_FILE_ERR_OCTB_GEOMETRY = -48, /* OCTB origin, size, errors or overlap out of range */
+    ARGIL_FILE_ERR_OCTB_LENGTH = -49, /* OCTB length does not match its nodes and leaves */
+    ARGIL_FILE_ERR_OCTB_LINKS = -50, /* OCTB child links do not form an octree */
+    ARGIL_FILE_ERR_OCTB_COEF = -51 /* an OCTB coefficient NaN or Inf */
+} argil_file_err_t;
+
+/* The argil_err_t a command reports for e: ARG, IO and NOMEM as themselves, every rule of the
+ * file (and a file too large) ARGIL_ERR_PARSE. */
+argil_err_t argil_file_err_argil(argil_file_err_t e);
+
+/* Reads path into d (initialised by the call; empty on error). Returns the rule the file broke
+ * with err naming the path, the byte offset and the rule; ARG / IO / FILE_SIZE / NOMEM. */
+argil_file_err_t argil_file_read(const char *path, argil_doc_t *d, char *err, size_t err_len);
 
 #endif

@@ -179,31 +179,83 @@ bool journal_exists(const char *dir);
 /* Removes a journal and every base snapshot in dir. */
 argil_err_t journal_discard(const char *dir, char *err, size_t err_len);
 
-/* Decodes and checks a journal's header. ARGIL_ERR_PARSE with err naming name and the byte. */
-argil_err_t journal_header_decode(const uint8_t *data, size_t len, const char *name,
+/* What the journal readers return: JOURNAL_OK, a failure outside the file (argument, system call,
+ * memory), or the rule the journal (or its base snapshot) broke. */
+typedef enum {
+    JOURNAL_OK = 0,
+    JOURNAL_ERR_ARG = -1,             /* the caller's grid differs from the journal's */
+    JOURNAL_ERR_IO = -2,              /* a file cannot be opened or read, or is not regular */
+    JOURNAL_ERR_NOMEM = -3,           /* an allocation failed */
+    JOURNAL_ERR_FILE_SIZE = -4,       /* a file larger than IO_FILE_MAX_BYTES */
+    JOURNAL_ERR_SHORT = -5,           /* shorter than the JOURNAL_HEADER_BYTES header */
+    JOURNAL_ERR_MAGIC = -6,           /* the first 8 bytes are not JOURNAL_MAGIC */
+    JOURNAL_ERR_HEADER_CRC = -7,      /* the header's CRC-32C does not match */
+    JOURNAL_ERR_VERSION = -8,         /* version 0 or newer than JOURNAL_VERSION */
+    JOURNAL_ERR_HEADER_SIZE = -9,     /* the header size field is not JOURNAL_HEADER_BYTES */
+    JOURNAL_ERR_DIMS = -10,           /* a grid dimension < 1, or over GRID_SAMPLES_MAX samples */
+    JOURNAL_ERR_GEOMETRY = -11,       /* grid spacing (> 0), origin, iso or band not finite */
+    JOURNAL_ERR_MATERIAL = -12,       /* the header's material out of range */
+    JOURNAL_ERR_FIRST_SEQ = -13,      /* first record number 0 */
+    JOURNAL_ERR_BASE_PADDING = -14,   /* the base name is not NUL-padded */
+    JOURNAL_ERR_BASE_NAME = -15,      /* the base name is empty or not a plain file name */
+    JOURNAL_ERR_BASE_ASCII = -16,     /* the base name is not printable ASCII */
+    JOURNAL_ERR_RECORD_CRC = -17,     /* a record's CRC-32C does not match (not the last) */
+    JOURNAL_ERR_RECORD_HEAD = -18,    /* a record shorter than JOURNAL_RECORD_HEAD_BYTES */
+    JOURNAL_ERR_RECORD_TYPE = -19,    /* a record type not 1, or 2 or 3 in a version-2 journal */
+    JOURNAL_ERR_RECORD_SEQ = -20,     /* a record number not one past the last */
+    JOURNAL_ERR_RECORD_MATERIAL = -21, /* a record's material out of range */
+    JOURNAL_ERR_RUN_HEAD = -22,       /* a density run head runs past the record */
+    JOURNAL_ERR_RUN_RANGE = -23,      /* a density run empty, beyond the grid or past the record */
+    JOURNAL_ERR_DENSITY = -24,        /* a density not a finite number in [0, 1] */
+    JOURNAL_ERR_MAT_COUNT_HEAD = -25, /* the material block count runs past the record */
+    JOURNAL_ERR_MAT_COUNT = -26,      /* the material block count out of range for the type */
+    JOURNAL_ERR_MAT_BLOCK_HEAD = -27, /* a material block head runs past the record */
+    JOURNAL_ERR_MAT_CHANNEL = -28,    /* a material channel not 0..3 increasing, or with no runs */
+    JOURNAL_ERR_MAT_RUN_HEAD = -29,   /* a material run head runs past the record */
+    JOURNAL_ERR_MAT_RUN_RANGE = -30,  /* a material run empty, beyond the grid or past the record */
+    JOURNAL_ERR_MAT_VALUE = -31,      /* a painted material value out of grid_mat_valid's range */
+    JOURNAL_ERR_RGB_COUNT_HEAD = -32, /* the colour run count runs past the record */
+    JOURNAL_ERR_RGB_COUNT = -33,      /* the colour run count 0 */
+    JOURNAL_ERR_RGB_RUN_HEAD = -34,   /* a colour run head runs past the record */
+    JOURNAL_ERR_RGB_RUN_RANGE = -35,  /* a colour run empty, out of order, beyond the grid or past
+                                       * the record */
+    JOURNAL_ERR_TRAILING = -36,       /* bytes after a record's last run */
+    JOURNAL_ERR_BASE_FILE = -37,      /* the base snapshot breaks a rule of .argil files */
+    JOURNAL_ERR_BASE_MISMATCH = -38,  /* the base's length, CRC, material or edits differ from
+                                       * the header's */
+    JOURNAL_ERR_BASE_GRID = -39       /* the base's grid differs from the header's */
+} journal_err_t;
+
+/* The argil_err_t a command reports for e: ARG, IO and NOMEM as themselves, every rule of the
+ * journal or its base (and a file too large) ARGIL_ERR_PARSE. */
+argil_err_t journal_err_argil(journal_err_t e);
+
+/* Decodes and checks a journal's header: the rule it broke, with err naming name and the byte. */
+journal_err_t journal_header_decode(const uint8_t *data, size_t len, const char *name,
                                   journal_info_t *info, char *err, size_t err_len);
 
-/* Walks the records after the header; with density (n samples, matching the header's dims)
- * applies each good record's densities to it (painted material is checked, not applied). An
- * incomplete last record (a write cut short by a crash) is ignored and counted in torn_bytes. A
- * bad record before the end stops the walk: density holds the model as of the record before it,
- * info describes the good part, and the result is ARGIL_ERR_PARSE with err naming the byte, the
- * record and the rule. */
-argil_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
+/* Walks the records after the header; with density (n samples, matching the header's dims:
+ * JOURNAL_ERR_ARG otherwise) applies each good record's densities to it (painted material is
+ * checked, not applied). An incomplete last record (a write cut short by a crash) is ignored and
+ * counted in torn_bytes. A bad record before the end stops the walk: density holds the model as
+ * of the record before it, info describes the good part, and the result is the rule the record
+ * broke with err naming the byte, the record and the rule. */
+journal_err_t journal_replay(const uint8_t *data, size_t len, const char *name, float *density,
                            size_t n, journal_info_t *info, char *err, size_t err_len);
 
 /* journal_replay onto a whole grid (dims matching the header's): densities, painted channels and
- * colour (allocated as records need them); ARGIL_ERR_NOMEM when a channel cannot be. */
-argil_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
+ * colour (allocated as records need them); JOURNAL_ERR_NOMEM when a channel cannot be. */
+journal_err_t journal_replay_grid(const uint8_t *data, size_t len, const char *name, grid_t *g,
                                 journal_info_t *info, char *err, size_t err_len);
 
 /* Reads dir's journal without its base: counts the good records (for the offer to recover). */
-argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len);
+journal_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len);
 
 /* Rebuilds the model in doc (initialised here) from dir's base snapshot and journal: refuses a
- * base whose length or CRC differ from the header's, or whose grid differs. Same results as
- * journal_replay (ARGIL_ERR_PARSE after a bad record, with doc as of the record before it). */
-argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
+ * base that is not a valid .argil file (BASE_FILE), whose length or CRC differ from the header's
+ * (BASE_MISMATCH), or whose grid differs (BASE_GRID). Same results as journal_replay (after a bad
+ * record, its rule with doc as of the record before it). */
+journal_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
                             size_t err_len);
 
 /* Fills doc (initialised here, owning copies of density and of the painted channels in mat,

@@ -114,8 +114,10 @@ bool journal_buf_reserve(journal_t *j, size_t more);
 /* ---- journal_reader.c ---- */
 
 /* journal_replay with optional painted channels mat and colour *rgb. */
-argil_err_t journal_replay_channels(const uint8_t *data, size_t len, const char *name,
-                                    float *density, size_t n, float **mat, uint8_t **rgb,
-                                    journal_info_t *info, char *err, size_t err_len);
+journal_err_t journal_replay_channels(const uint8_t *data, size_t len, const char *name,
+                                      float *density, size_t n, float **mat, uint8_t **rgb,
+                                      journal_info_t *info, char *err, size_t err_len);
+/* The journal_err_t of a failure outside the file (io_slurp's: PARSE is a file too large). */
+journal_err_t journal_outside_err(argil_err_t e);
 
 #endif

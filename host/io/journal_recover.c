@@ -8,30 +8,43 @@
 #include "host/io/journal_internal.h"
 
 /* dir's journal.log into *data, its path into *path (both malloc'ed). */
-static argil_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
-                                char *err, size_t err_len)
+static journal_err_t read_journal(const char *dir, uint8_t **data, size_t *len, char **path,
+                                  char *err, size_t err_len)
 {
     *data = NULL;
     *path = journal_path(dir, JOURNAL_FILE);
     if (*path == NULL) {
         io_err(err, err_len, "out of memory");
-        return ARGIL_ERR_NOMEM;
+        return JOURNAL_ERR_NOMEM;
     }
-    return io_slurp(*path, IO_FILE_MAX_BYTES, data, len, err, err_len);
+    return journal_outside_err(io_slurp(*path, IO_FILE_MAX_BYTES, data, len, err, err_len));
 }
 
 /* Scans dir's journal without applying it (journal.h). */
-argil_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len)
+journal_err_t journal_probe(const char *dir, journal_info_t *info, char *err, size_t err_len)
 {
     uint8_t *data;
     size_t len = 0;
     char *path;
-    argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
-    if (e == ARGIL_OK)
+    journal_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
+    if (e == JOURNAL_OK)
         e = journal_replay(data, len, path, NULL, 0, info, err, err_len);
     free(data);
     free(path);
     return e;
+}
+
+/* The journal_err_t of argil_file_read's result for the base snapshot. */
+static journal_err_t base_file_err(argil_file_err_t e)
+{
+    const argil_err_t a = argil_file_err_argil(e);
+    return a == ARGIL_ERR_PARSE ? JOURNAL_ERR_BASE_FILE : journal_outside_err(a);
+}
+
+/* True when e is a rule the journal or its base broke (not a failure outside the files). */
+static bool journal_rule(journal_err_t e)
+{
+    return journal_err_argil(e) == ARGIL_ERR_PARSE;
 }
 
 /* True when a and b are the same binary32, bit for bit. */
@@ -41,8 +54,8 @@ static bool same_f32(float a, float b)
 }
 
 /* Base snapshot checked against the header, then the records replayed onto it (journal.h). */
-argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
-                            size_t err_len)
+journal_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *info, char *err,
+                              size_t err_len)
 {
     argil_doc_init(doc);
     uint8_t *data = NULL;
@@ -52,20 +65,20 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     argil_doc_init(&b);
     float *dens = NULL, *mat[GRID_MAT_N] = {NULL};
     uint8_t *rgb = NULL;
-    argil_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
-    if (e != ARGIL_OK)
+    journal_err_t e = read_journal(dir, &data, &len, &path, err, err_len);
+    if (e != JOURNAL_OK)
         goto out;
     e = journal_header_decode(data, len, path, info, err, err_len);
-    if (e != ARGIL_OK)
+    if (e != JOURNAL_OK)
         goto out;
     base_path = journal_path(dir, info->base_name);
     if (base_path == NULL) {
-        e = ARGIL_ERR_NOMEM;
+        e = JOURNAL_ERR_NOMEM;
         io_err(err, err_len, "out of memory");
         goto out;
     }
-    e = argil_file_read(base_path, &b, err, err_len);
-    if (e != ARGIL_OK)
+    e = base_file_err(argil_file_read(base_path, &b, err, err_len));
+    if (e != JOURNAL_OK)
         goto out;
     const grid_t *g = &b.grid;
     int32_t glo[3], ghi[3], gdims[3];
@@ -75,8 +88,8 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
     const size_t bn = grid_count(g);
     struct stat st;
     const uint64_t blen = stat(base_path, &st) == 0 ? (uint64_t)st.st_size : 0;
-    e = journal_grid_dense(g, glo, gdims, &dens, mat, &rgb);
-    if (e != ARGIL_OK) {
+    e = journal_outside_err(journal_grid_dense(g, glo, gdims, &dens, mat, &rgb));
+    if (e != JOURNAL_OK) {
         io_err(err, err_len, "%s: out of memory for the model", base_path);
         goto out;
     }
@@ -94,7 +107,7 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
                "and edit count): refusing to replay onto it",
                path, base_path, (unsigned long long)blen, crc, (unsigned long long)info->base_len,
                info->base_crc);
-        e = ARGIL_ERR_PARSE;
+        e = JOURNAL_ERR_BASE_MISMATCH;
         goto out;
     }
     if (glo[0] != 0 || glo[1] != 0 || glo[2] != 0 || gdims[0] != info->dims[0] ||
@@ -104,24 +117,24 @@ argil_err_t journal_recover(const char *dir, argil_doc_t *doc, journal_info_t *i
         !same_f32(g->origin_m.z, info->origin_m.z) || !same_f32(g->iso, info->iso) ||
         !same_f32(g->band_m, info->band_m)) {
         io_err(err, err_len, "%s: the base snapshot's grid differs from the journal's", base_path);
-        e = ARGIL_ERR_PARSE;
+        e = JOURNAL_ERR_BASE_GRID;
         goto out;
     }
     e = journal_replay_channels(data, len, path, dens, bn, mat, &rgb, info, err, err_len);
-    if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
+    if (e != JOURNAL_OK && !journal_rule(e))
         goto out;
-    /* After a bad record (PARSE) the arrays hold the model as of the record before it. */
+    /* After a bad record the arrays hold the model as of the record before it. */
     argil_err_t me = journal_model_doc(info, dens, mat, doc);
     if (me == ARGIL_OK && !journal_doc_set_rgb(doc, rgb, bn))
         me = ARGIL_ERR_NOMEM;
     if (me != ARGIL_OK) {
         io_err(err, err_len, "%s: out of memory for the recovered model", path);
-        e = me;
+        e = journal_outside_err(me);
     }
 out:
-    if (e != ARGIL_OK && e != ARGIL_ERR_PARSE)
+    if (e != JOURNAL_OK && !journal_rule(e))
         argil_doc_free(doc);
-    else if (e == ARGIL_ERR_PARSE && grid_count(&doc->grid) == 0)
+    else if (journal_rule(e) && grid_count(&doc->grid) == 0)
         argil_doc_free(doc);
     journal_dense_free(&dens, mat, &rgb);
     argil_doc_free(&b);

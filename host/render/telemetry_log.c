@@ -18,6 +18,16 @@ static const char *const COL_NAMES[COL_COUNT] = {"time_s", "x_mm", "y_mm", "z_mm
                                                   "fy_n", "fz_n", "force_n", "state",
                                                   "contact"};
 
+argil_err_t telemetry_err_argil(telemetry_err_t e)
+{
+    switch (e) {
+    case TELEMETRY_OK: return ARGIL_OK;
+    case TELEMETRY_ERR_IO: return ARGIL_ERR_IO;
+    case TELEMETRY_ERR_NOMEM: return ARGIL_ERR_NOMEM;
+    default: return ARGIL_ERR_PARSE;
+    }
+}
+
 void telemetry_log_free(telemetry_log_t *log)
 {
     free(log->time_s);
@@ -69,8 +79,8 @@ static argil_err_t grow(telemetry_log_t *log, size_t *cap, bool with_contact)
     return ARGIL_OK;
 }
 
-static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[COL_COUNT],
-                             const char *path, unsigned line_no, char *err, size_t err_len)
+static telemetry_err_t parse_row(telemetry_log_t *log, char **fields, const int col[COL_COUNT],
+                                 const char *path, unsigned line_no, char *err, size_t err_len)
 {
     float v[COL_STATE];
     double t = 0.0;
@@ -83,7 +93,7 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
             (c != COL_T && fabs(d) > FLT_MAX)) {
             snprintf(err, err_len, "%s: line %u: %s is not a finite number: '%.32s'", path,
                      line_no, COL_NAMES[c], s);
-            return ARGIL_ERR_PARSE;
+            return TELEMETRY_ERR_NUMBER;
         }
         if (c == COL_T)
             t = d;
@@ -92,13 +102,13 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
     if (log->n > 0 && t < log->time_s[log->n - 1]) {
         snprintf(err, err_len, "%s: line %u: time_s goes backwards (%.6g after %.6g)", path,
                  line_no, t, log->time_s[log->n - 1]);
-        return ARGIL_ERR_PARSE;
+        return TELEMETRY_ERR_TIME_BACKWARDS;
     }
     const char *st = fields[col[COL_STATE]];
     if (st[0] == '\0' || strlen(st) >= sizeof(log->state_name[0])) {
         snprintf(err, err_len, "%s: line %u: state '%.32s' is empty or longer than %zu characters",
                  path, line_no, st, sizeof(log->state_name[0]) - 1);
-        return ARGIL_ERR_PARSE;
+        return TELEMETRY_ERR_STATE;
     }
     int si = 0;
     while (si < log->n_states && strcmp(log->state_name[si], st) != 0)
@@ -107,7 +117,7 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
         if (log->n_states == TELEMETRY_STATES_MAX) {
             snprintf(err, err_len, "%s: line %u: more than %d different states (new: '%s')",
                      path, line_no, TELEMETRY_STATES_MAX, st);
-            return ARGIL_ERR_PARSE;
+            return TELEMETRY_ERR_STATES_MAX;
         }
         snprintf(log->state_name[si], sizeof(log->state_name[si]), "%s", st);
         log->n_states++;
@@ -117,7 +127,7 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
         if ((k[0] != '0' && k[0] != '1') || k[1] != '\0') {
             snprintf(err, err_len, "%s: line %u: contact is not 0 or 1: '%.32s'", path, line_no,
                      k);
-            return ARGIL_ERR_PARSE;
+            return TELEMETRY_ERR_CONTACT;
         }
     }
     const size_t i = log->n++;
@@ -130,16 +140,17 @@ static argil_err_t parse_row(telemetry_log_t *log, char **fields, const int col[
     log->state[i] = (uint8_t)si;
     if (log->contact != NULL)
         log->contact[i] = (uint8_t)(fields[col[COL_CONTACT]][0] - '0');
-    return ARGIL_OK;
+    return TELEMETRY_OK;
 }
 
-argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err, size_t err_len)
+telemetry_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err,
+                                   size_t err_len)
 {
     memset(log, 0, sizeof(*log));
     FILE *f = fopen(path, "r");
     if (f == NULL) {
         snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
-        return ARGIL_ERR_IO;
+        return TELEMETRY_ERR_IO;
     }
     char line[LINE_MAX_CHARS + 2];
     char *fields[FIELDS_MAX];
@@ -147,19 +158,19 @@ argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err
     int n_header = 0;
     unsigned line_no = 0;
     size_t cap = 0;
-    argil_err_t rc = ARGIL_OK;
+    telemetry_err_t rc = TELEMETRY_OK;
     while (fgets(line, sizeof(line), f) != NULL) {
         line_no++;
         if (strchr(line, '\n') == NULL && !feof(f)) {
             snprintf(err, err_len, "%s: line %u: longer than %d characters", path, line_no,
                      LINE_MAX_CHARS);
-            rc = ARGIL_ERR_PARSE;
+            rc = TELEMETRY_ERR_LINE_LONG;
             break;
         }
         const int n = split(line, fields);
         if (line_no == 1) {
             n_header = n;
-            for (int c = 0; c < COL_COUNT && rc == ARGIL_OK; c++) {
+            for (int c = 0; c < COL_COUNT && rc == TELEMETRY_OK; c++) {
                 col[c] = -1;
                 for (int k = 0; k < n && col[c] < 0; k++)
                     if (strcmp(fields[k], COL_NAMES[c]) == 0)
@@ -167,10 +178,10 @@ argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err
                 if (col[c] < 0 && c < COL_REQUIRED) {
                     snprintf(err, err_len, "%s: line 1: the header has no '%s' column (is this "
                                            "a telemetry.csv?)", path, COL_NAMES[c]);
-                    rc = ARGIL_ERR_PARSE;
+                    rc = TELEMETRY_ERR_COLUMN;
                 }
             }
-            if (rc != ARGIL_OK)
+            if (rc != TELEMETRY_OK)
                 break;
             continue;
         }
@@ -179,30 +190,31 @@ argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err
         if (n != n_header) {
             snprintf(err, err_len, "%s: line %u: %d fields where the header has %d", path,
                      line_no, n < 0 ? FIELDS_MAX + 1 : n, n_header);
-            rc = ARGIL_ERR_PARSE;
+            rc = TELEMETRY_ERR_FIELDS;
             break;
         }
-        if (log->n == cap && (rc = grow(log, &cap, col[COL_CONTACT] >= 0)) != ARGIL_OK) {
+        if (log->n == cap && grow(log, &cap, col[COL_CONTACT] >= 0) != ARGIL_OK) {
             snprintf(err, err_len, "%s: out of memory at line %u", path, line_no);
+            rc = TELEMETRY_ERR_NOMEM;
             break;
         }
         rc = parse_row(log, fields, col, path, line_no, err, err_len);
-        if (rc != ARGIL_OK)
+        if (rc != TELEMETRY_OK)
             break;
     }
-    if (rc == ARGIL_OK && ferror(f)) {
+    if (rc == TELEMETRY_OK && ferror(f)) {
         snprintf(err, err_len, "%s: read error: %s", path, strerror(errno));
-        rc = ARGIL_ERR_IO;
+        rc = TELEMETRY_ERR_IO;
     }
     fclose(f);
-    if (rc == ARGIL_OK && line_no == 0) {
+    if (rc == TELEMETRY_OK && line_no == 0) {
         snprintf(err, err_len, "%s: empty file (no header)", path);
-        rc = ARGIL_ERR_PARSE;
-    } else if (rc == ARGIL_OK && log->n == 0) {
+        rc = TELEMETRY_ERR_EMPTY;
+    } else if (rc == TELEMETRY_OK && log->n == 0) {
         snprintf(err, err_len, "%s: line %u: no data rows after the header", path, line_no);
-        rc = ARGIL_ERR_PARSE;
+        rc = TELEMETRY_ERR_NO_ROWS;
     }
-    if (rc != ARGIL_OK)
+    if (rc != TELEMETRY_OK)
         telemetry_log_free(log);
     return rc;
 }

@@ -22,10 +22,33 @@ typedef struct {
     int n_states;
 } telemetry_log_t;
 
+/* What telemetry_log_read returns: TELEMETRY_OK, the file cannot be opened or read (IO) or
+ * memory ran out (NOMEM), or the rule a line broke. */
+typedef enum {
+    TELEMETRY_OK = 0,
+    TELEMETRY_ERR_IO = -1,
+    TELEMETRY_ERR_NOMEM = -2,
+    TELEMETRY_ERR_EMPTY = -3,          /* no header line */
+    TELEMETRY_ERR_COLUMN = -4,         /* the header lacks a required column */
+    TELEMETRY_ERR_NO_ROWS = -5,        /* no data row after the header */
+    TELEMETRY_ERR_LINE_LONG = -6,      /* a line longer than the reader takes */
+    TELEMETRY_ERR_FIELDS = -7,         /* a row's field count differs from the header's */
+    TELEMETRY_ERR_NUMBER = -8,         /* a numeric field not a finite float */
+    TELEMETRY_ERR_TIME_BACKWARDS = -9, /* time_s below the previous row's */
+    TELEMETRY_ERR_STATE = -10,         /* a state empty or longer than 15 characters */
+    TELEMETRY_ERR_STATES_MAX = -11,    /* more than TELEMETRY_STATES_MAX different states */
+    TELEMETRY_ERR_CONTACT = -12        /* contact neither 0 nor 1 */
+} telemetry_err_t;
+
 /* Reads path. Columns are found by the header's names (time_s x_mm y_mm z_mm fx_n fy_n fz_n
- * force_n state are required; contact is read when present, as 0 or 1; others are skipped). ARGIL_ERR_PARSE with "<path>: line N: why",
- * ARGIL_ERR_IO, ARGIL_ERR_NOMEM; log is empty on error. */
-argil_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err, size_t err_len);
+ * force_n state are required; contact is read when present, as 0 or 1; others are skipped).
+ * Returns the rule a line broke with "<path>: line N: why" in err, IO or NOMEM; log is empty on
+ * error. */
+telemetry_err_t telemetry_log_read(const char *path, telemetry_log_t *log, char *err,
+                                   size_t err_len);
+
+/* The argil_err_t a command reports for e: OK, IO, NOMEM, or PARSE for a broken rule. */
+argil_err_t telemetry_err_argil(telemetry_err_t e);
 
 void telemetry_log_free(telemetry_log_t *log);
 

@@ -60,17 +60,18 @@ static bool number(const char *s, double lo, double hi, double *out)
     return true;
 }
 
-static argil_err_t fail(ui_input_t *in, int line, const char *what, const char *word, char *err,
-                        size_t err_len)
+/* Empties in and returns code, with "line N: what 'word'" (no word: "line N: what") in err. */
+static ui_input_err_t fail(ui_input_t *in, int line, ui_input_err_t code, const char *what,
+                           const char *word, char *err, size_t err_len)
 {
     snprintf(err, err_len, "line %d: %s%s%s%s", line, what, word ? " '" : "", word ? word : "",
              word ? "'" : "");
     ui_input_free(in);
-    return ARGIL_ERR_PARSE;
+    return code;
 }
 
-argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *err,
-                           size_t err_len)
+ui_input_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *err,
+                              size_t err_len)
 {
     ui_input_free(in);
     char buf[256];
@@ -83,13 +84,15 @@ argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *e
         while (end < len && text[end] != '\n')
             end++;
         if (end - pos >= sizeof(buf))
-            return fail(in, line, "line longer than 255 characters", NULL, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_LINE_LONG, "line longer than 255 characters", NULL,
+                        err, err_len);
         const size_t line_len = end - pos;
         memcpy(buf, text + pos, line_len);
         buf[line_len] = '\0';
         pos = end + 1;
         if (strlen(buf) != line_len)
-            return fail(in, line, "NUL byte in the line", NULL, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_LINE_NUL, "NUL byte in the line", NULL, err,
+                        err_len);
         char *hash = strchr(buf, '#');
         if (hash)
             *hash = '\0';
@@ -98,29 +101,33 @@ argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *e
         if (n == 0)
             continue;
         if (n > 4)
-            return fail(in, line, "too many words", NULL, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_WORDS, "too many words", NULL, err, err_len);
         ui_event_t e;
         memset(&e, 0, sizeof(e));
         e.line = line;
         if (!number(w[0], 0.0, 1e6, &e.at_s))
-            return fail(in, line, "time is not a number of seconds 0..1e6:", w[0], err, err_len);
+            return fail(in, line, UI_INPUT_ERR_TIME,
+                        "time is not a number of seconds 0..1e6:", w[0], err, err_len);
         if (e.at_s < last_s)
-            return fail(in, line, "time goes backwards:", w[0], err, err_len);
+            return fail(in, line, UI_INPUT_ERR_TIME_BACKWARDS, "time goes backwards:", w[0], err,
+                        err_len);
         last_s = e.at_s;
         if (n < 2)
-            return fail(in, line, "an event is missing after the time", NULL, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_EVENT_MISSING, "an event is missing after the time",
+                        NULL, err, err_len);
         const char *ev = w[1];
         if (strcmp(ev, "key") == 0) {
             if (n != 3)
-                return fail(in, line, "key needs one NAME", NULL, err, err_len);
+                return fail(in, line, UI_INPUT_ERR_KEY_ARGS, "key needs one NAME", NULL, err,
+                            err_len);
             e.kind = UI_EV_KEY;
             e.code = ui_input_key_code(w[2]);
             if (e.code < 0)
-                return fail(in, line, "unknown key", w[2], err, err_len);
+                return fail(in, line, UI_INPUT_ERR_KEY, "unknown key", w[2], err, err_len);
         } else if (strcmp(ev, "shift") == 0 || strcmp(ev, "left") == 0 ||
                    strcmp(ev, "right") == 0 || strcmp(ev, "ctrl") == 0) {
             if (n != 3 || (strcmp(w[2], "down") != 0 && strcmp(w[2], "up") != 0))
-                return fail(in, line, "needs down or up:", ev, err, err_len);
+                return fail(in, line, UI_INPUT_ERR_UP_DOWN, "needs down or up:", ev, err, err_len);
             e.kind = ev[0] == 's'   ? UI_EV_SHIFT
                      : ev[0] == 'c' ? UI_EV_CTRL
                      : ev[0] == 'l' ? UI_EV_LEFT
@@ -128,41 +135,43 @@ argil_err_t ui_input_parse(ui_input_t *in, const char *text, size_t len, char *e
             e.down = strcmp(w[2], "down") == 0;
         } else if (strcmp(ev, "cursor") == 0) {
             if (n != 4 || !number(w[2], -1e5, 1e5, &e.x) || !number(w[3], -1e5, 1e5, &e.y))
-                return fail(in, line, "cursor needs X Y in pixels (within 1e5)", NULL, err,
-                            err_len);
+                return fail(in, line, UI_INPUT_ERR_CURSOR,
+                            "cursor needs X Y in pixels (within 1e5)", NULL, err, err_len);
             e.kind = UI_EV_CURSOR;
         } else if (strcmp(ev, "wheel") == 0) {
             if (n != 3 || !number(w[2], -100, 100, &e.x))
-                return fail(in, line, "wheel needs STEPS within -100..100", NULL, err, err_len);
+                return fail(in, line, UI_INPUT_ERR_WHEEL, "wheel needs STEPS within -100..100",
+                            NULL, err, err_len);
             e.kind = UI_EV_WHEEL;
         } else {
-            return fail(in, line, "unknown event", ev, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_EVENT, "unknown event", ev, err, err_len);
         }
         if (in->count == UI_INPUT_MAX_EVENTS)
-            return fail(in, line, "more than 100000 events", NULL, err, err_len);
+            return fail(in, line, UI_INPUT_ERR_EVENTS_MAX, "more than 100000 events", NULL, err,
+                        err_len);
         if (in->count == in->cap) {
             const size_t cap = in->cap ? 2 * in->cap : 64;
             ui_event_t *p = realloc(in->ev, cap * sizeof(*p));
             if (p == NULL) {
                 ui_input_free(in);
                 snprintf(err, err_len, "out of memory");
-                return ARGIL_ERR_NOMEM;
+                return UI_INPUT_ERR_NOMEM;
             }
             in->ev = p;
             in->cap = cap;
         }
         in->ev[in->count++] = e;
     }
-    return ARGIL_OK;
+    return UI_INPUT_OK;
 }
 
-argil_err_t ui_input_load(ui_input_t *in, const char *path, char *err, size_t err_len)
+ui_input_err_t ui_input_load(ui_input_t *in, const char *path, char *err, size_t err_len)
 {
     ui_input_init(in);
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
         snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
-        return ARGIL_ERR_IO;
+        return UI_INPUT_ERR_IO;
     }
     char *text = NULL;
     size_t len = 0, cap = 0;
@@ -173,14 +182,14 @@ argil_err_t ui_input_load(ui_input_t *in, const char *path, char *err, size_t er
                 free(text);
                 fclose(f);
                 snprintf(err, err_len, "%s: larger than 16 MiB", path);
-                return ARGIL_ERR_PARSE;
+                return UI_INPUT_ERR_FILE_SIZE;
             }
             char *p = realloc(text, cap);
             if (p == NULL) {
                 free(text);
                 fclose(f);
                 snprintf(err, err_len, "%s: out of memory", path);
-                return ARGIL_ERR_NOMEM;
+                return UI_INPUT_ERR_NOMEM;
             }
             text = p;
         }
@@ -194,12 +203,12 @@ argil_err_t ui_input_load(ui_input_t *in, const char *path, char *err, size_t er
     if (bad) {
         free(text);
         snprintf(err, err_len, "%s: read error", path);
-        return ARGIL_ERR_IO;
+        return UI_INPUT_ERR_IO;
     }
     char perr[256];
-    const argil_err_t rc = ui_input_parse(in, text, len, perr, sizeof(perr));
+    const ui_input_err_t rc = ui_input_parse(in, text, len, perr, sizeof(perr));
     free(text);
-    if (rc != ARGIL_OK)
+    if (rc != UI_INPUT_OK)
         snprintf(err, err_len, "%s: %s", path, perr);
     return rc;
 }

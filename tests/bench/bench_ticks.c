@@ -122,7 +122,7 @@ int main(int argc, char **argv)
     }
     char err[256];
     script_init(&b->script);
-    if (script_load(&b->script, script_path, err, sizeof(err)) != ARGIL_OK) {
+    if (script_load(&b->script, script_path, err, sizeof(err)) != SCRIPT_OK) {
         fprintf(stderr, "bench_ticks: %s\n", err);
         return 1;
     }

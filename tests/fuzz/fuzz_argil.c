@@ -29,7 +29,7 @@ static void check_rewrite(const argil_doc_t *d, const char *path)
     argil_doc_t r;
     if (argil_file_write(again, d, err, sizeof(err)) != ARGIL_OK)
         return; /* e.g. a NaN in an RBF the reader does not check as strictly */
-    if (argil_file_read(again, &r, err, sizeof(err)) != ARGIL_OK)
+    if (argil_file_read(again, &r, err, sizeof(err)) != ARGIL_FILE_OK)
         abort();
     for (int ch = 0; ch < GRID_MAT_N; ch++)
         if (!grid_mat_equal(&r.grid, &d->grid, (grid_mat_t)ch))
@@ -46,8 +46,8 @@ static void parse_one(const uint8_t *data, size_t size)
     char err[512];
     err[0] = '\0';
     argil_doc_t d;
-    const argil_err_t e = argil_file_read(path, &d, err, sizeof(err));
-    if (e == ARGIL_OK) {
+    const argil_file_err_t e = argil_file_read(path, &d, err, sizeof(err));
+    if (e == ARGIL_FILE_OK) {
         if (grid_count(&d.grid) == 0 || (d.has_octree && (d.octree.n_nodes == 0 ||
                                                         d.octree.n_leaves == 0)))
             abort();

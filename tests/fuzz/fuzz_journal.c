@@ -27,10 +27,10 @@ static void check_one(const uint8_t *data, size_t size)
     static const char name[] = "fuzz.journal";
     journal_info_t scan, play;
     char err[512] = "", err2[512] = "";
-    const argil_err_t e = journal_replay(data, size, name, NULL, 0, &scan, err, sizeof(err));
-    if (e != ARGIL_OK) {
-        if (e != ARGIL_ERR_PARSE || strncmp(err, "fuzz.journal: byte ", 19) != 0 ||
-            strchr(err, '\n') != NULL)
+    const journal_err_t e = journal_replay(data, size, name, NULL, 0, &scan, err, sizeof(err));
+    if (e != JOURNAL_OK) {
+        if (journal_err_argil(e) != ARGIL_ERR_PARSE ||
+            strncmp(err, "fuzz.journal: byte ", 19) != 0 || strchr(err, '\n') != NULL)
             abort();
     } else if (scan.good_bytes + scan.torn_bytes != size) {
         abort(); /* a clean walk accounts for every byte */
@@ -48,7 +48,8 @@ static void check_one(const uint8_t *data, size_t size)
         return;
     for (size_t i = 0; i < n; i++)
         density[i] = 0.5f;
-    const argil_err_t e2 = journal_replay(data, size, name, density, n, &play, err2, sizeof(err2));
+    const journal_err_t e2 =
+        journal_replay(data, size, name, density, n, &play, err2, sizeof(err2));
     if (e2 != e || play.records != scan.records || play.last_seq != scan.last_seq ||
         play.good_bytes != scan.good_bytes || strcmp(err, err2) != 0)
         abort();
@@ -64,8 +65,8 @@ static void check_one(const uint8_t *data, size_t size)
         gv_set(&g, GRID_DENSITY, i, 0.5f);
     journal_info_t grid_play;
     char err3[512] = "";
-    const argil_err_t e3 = journal_replay_grid(data, size, name, &g, &grid_play, err3,
-                                               sizeof(err3));
+    const journal_err_t e3 =
+        journal_replay_grid(data, size, name, &g, &grid_play, err3, sizeof(err3));
     if (e3 != e || grid_play.records != scan.records || grid_play.mat_samples != scan.mat_samples ||
         grid_play.rgb_samples != scan.rgb_samples || strcmp(err, err3) != 0)
         abort();

@@ -15,10 +15,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     script_t s;
     script_init(&s);
     char err[256] = "";
-    const argil_err_t e = script_parse(&s, (const char *)data, size, err, sizeof(err));
-    if (e == ARGIL_ERR_PARSE && strncmp(err, "line ", 5) != 0)
+    const script_err_t e = script_parse(&s, (const char *)data, size, err, sizeof(err));
+    if (script_err_argil(e) == ARGIL_ERR_PARSE && strncmp(err, "line ", 5) != 0)
         abort(); /* every refusal names its line */
-    if (e == ARGIL_OK) {
+    if (e == SCRIPT_OK) {
         const float total = script_duration_s(&s);
         if (!(total >= 0.0f) || total > SCRIPT_MAX_SECONDS)
             abort();

@@ -19,8 +19,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         telemetry_log_t log;
         char err[512];
         err[0] = '\0';
-        const argil_err_t e = telemetry_log_read(path, &log, err, sizeof(err));
-        if (e == ARGIL_OK) {
+        const telemetry_err_t e = telemetry_log_read(path, &log, err, sizeof(err));
+        if (e == TELEMETRY_OK) {
             for (size_t i = 0; i < log.n; i++) {
                 if (!isfinite(log.time_s[i]) || !isfinite(log.force_mag_n[i]))
                     abort();

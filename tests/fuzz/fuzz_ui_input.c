@@ -15,10 +15,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ui_input_t in;
     ui_input_init(&in);
     char err[256] = "";
-    const argil_err_t e = ui_input_parse(&in, (const char *)data, size, err, sizeof(err));
-    if (e == ARGIL_ERR_PARSE && strncmp(err, "line ", 5) != 0)
+    const ui_input_err_t e = ui_input_parse(&in, (const char *)data, size, err, sizeof(err));
+    if (e <= UI_INPUT_ERR_LINE_LONG && strncmp(err, "line ", 5) != 0)
         abort();
-    if (e != ARGIL_OK && in.count != 0)
+    if (e != UI_INPUT_OK && in.count != 0)
         abort(); /* nothing half-parsed is kept */
     double last = 0.0;
     for (size_t i = 0; i < in.count; i++) {

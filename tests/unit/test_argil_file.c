@@ -21,6 +21,8 @@
 #include "tests/unit/test_files.h"
 #include "tests/unit/grid_view.h"
 
+#define E(rule) ARGIL_FILE_ERR_##rule /* the code of a rule, in the tables of crafted files */
+
 static int setup_dir(void **state)
 {
     (void)state;
@@ -154,15 +156,17 @@ static void test_any_corruption_refused(void **state)
     for (size_t i = 0; i < len; i += 3) {
         b[i] ^= (uint8_t)(1u << (i % 8));
         test_spit(q, b, len);
-        const argil_err_t e = argil_file_read(q, &r, err, sizeof(err));
-        if (e != ARGIL_ERR_PARSE || strstr(err, q) == NULL || strstr(err, "byte ") == NULL)
+        const argil_file_err_t e = argil_file_read(q, &r, err, sizeof(err));
+        if (e >= ARGIL_FILE_ERR_FILE_SIZE || argil_file_err_argil(e) != ARGIL_ERR_PARSE ||
+            strstr(err, q) == NULL || strstr(err, "byte ") == NULL)
             fail_msg("flip at byte %zu: %d '%s'", i, e, err);
         assert_int_equal(grid_count(&r.grid), 0);
         b[i] ^= (uint8_t)(1u << (i % 8));
     }
     for (size_t cut = 0; cut < len; cut += 17) {
         test_spit(q, b, cut);
-        assert_int_equal(argil_file_read(q, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
+        assert_int_equal(argil_file_err_argil(argil_file_read(q, &r, err, sizeof(err))),
+                         ARGIL_ERR_PARSE);
     }
     free(b);
 }
@@ -221,14 +225,16 @@ static size_t grid_payload(uint8_t *p, int32_t nx, float spacing, float density)
     return 36 + 4 * (n < 64 ? n : 64);
 }
 
-static void expect_rule(const char *path, const char *where, const char *rule)
+/* Reading path is refused with code, err naming the path, where and rule, and no model left. */
+static void expect_rule(const char *path, argil_file_err_t code, const char *where,
+                        const char *rule)
 {
     argil_doc_t r;
     char err[512] = "";
-    const argil_err_t e = argil_file_read(path, &r, err, sizeof(err));
-    if (e != ARGIL_ERR_PARSE || strstr(err, path) == NULL || strstr(err, where) == NULL ||
-        strstr(err, rule) == NULL)
-        fail_msg("got %d '%s', want '%s' and '%s'", e, err, where, rule);
+    const argil_file_err_t e = argil_file_read(path, &r, err, sizeof(err));
+    if (e != code || argil_file_err_argil(e) != ARGIL_ERR_PARSE || strstr(err, path) == NULL ||
+        strstr(err, where) == NULL || strstr(err, rule) == NULL)
+        fail_msg("got %d '%s', want %d '%s' and '%s'", e, err, code, where, rule);
     assert_int_equal(grid_count(&r.grid), 0);
 }
 
@@ -242,7 +248,7 @@ static void test_each_rule(void **state)
     const size_t gl = grid_payload(g, 1, 0.001f, 0.5f);
 
     test_spit(p, "ARGIL", 5);
-    expect_rule(p, "byte 5", "shorter than the 32-byte header");
+    expect_rule(p, ARGIL_FILE_ERR_SHORT, "byte 5", "shorter than the 32-byte header");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     b_end(&f, p, 1);
@@ -253,65 +259,66 @@ static void test_each_rule(void **state)
     argil_doc_free(&ok);
     f.b[0] = 'X';
     test_spit(p, f.b, f.len + 4);
-    expect_rule(p, "byte 0", "not an .argil file");
+    expect_rule(p, ARGIL_FILE_ERR_MAGIC, "byte 0", "not an .argil file");
     b_end(&f, p, 1);
     f.b[20] = 1;
     test_spit(p, f.b, f.len + 4);
-    expect_rule(p, "byte 28", "header checksum mismatch");
+    expect_rule(p, ARGIL_FILE_ERR_HEADER_CRC, "byte 28", "header checksum mismatch");
     b_end(&f, p, 3);
-    expect_rule(p, "byte 8", "format version 3; this argil reads 1..2");
+    expect_rule(p, ARGIL_FILE_ERR_VERSION, "byte 8", "format version 3; this argil reads 1..2");
     f.n_sec = 0;
     b_end(&f, p, 1);
-    expect_rule(p, "byte 12", "section count not in 1..64");
+    expect_rule(p, ARGIL_FILE_ERR_SECTION_COUNT, "byte 12", "section count not in 1..64");
     f.n_sec = 1;
     b_end(&f, p, 1);
     f.b[f.len + 4] = 0; /* one byte more than declared */
     test_spit(p, f.b, f.len + 5);
-    expect_rule(p, "byte 16", "declared file length differs");
+    expect_rule(p, ARGIL_FILE_ERR_FILE_LENGTH, "byte 16", "declared file length differs");
     b_end(&f, p, 1);
     f.b[40] ^= 1; /* inside the GRID payload: the file checksum catches it first */
     test_spit(p, f.b, f.len + 4);
     char at[32];
     snprintf(at, sizeof(at), "byte %zu", f.len);
-    expect_rule(p, at, "file checksum mismatch");
+    expect_rule(p, ARGIL_FILE_ERR_FILE_CRC, at, "file checksum mismatch");
     /* deeper rules need consistent outer checksums: */
     f.b[40] ^= 1;
     f.n_sec = 2;
     b_end(&f, p, 1);
     snprintf(at, sizeof(at), "byte %zu", f.len);
-    expect_rule(p, at, "section head runs past the end");
+    expect_rule(p, ARGIL_FILE_ERR_SECTION_HEAD, at, "section head runs past the end");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     le_put_u32(f.b + 36, 100000); /* length beyond the file, crc not even reached */
     b_end(&f, p, 1);
-    expect_rule(p, "byte 36", "section length runs past the end");
+    expect_rule(p, ARGIL_FILE_ERR_SECTION_LENGTH, "byte 36", "section length runs past the end");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     f.b[32 + 12 + 20] ^= 4;
     b_end(&f, p, 1);
     snprintf(at, sizeof(at), "byte %zu", 32 + 12 + gl);
-    expect_rule(p, at, "section checksum mismatch");
+    expect_rule(p, ARGIL_FILE_ERR_SECTION_CRC, at, "section checksum mismatch");
     const struct {
         const char *tag;
         const void *payload;
         size_t n;
         const char *where, *rule;
+        argil_file_err_t code;
     } cases[] = {
-        {"GRID", g, 20, "byte 44", "shorter than its 36-byte head"},
-        {"MATL", x, 19, "byte 32", "MATL section repeated or not 20 bytes"},
-        {"MATL", x, 20, "byte 44", "MATL values out of range"},
-        {"TOOL", x, 15, "byte 32", "TOOL section repeated or not 16 bytes"},
-        {"STAT", x, 20, "byte 44", "STAT transform not finite (or scale not > 0)"},
-        {"STAT", x, 21, "byte 32", "STAT section repeated or not 20 bytes"},
-        {"RBF3", x, 27, "byte 32", "RBF3 section repeated or shorter than 28"},
-        {"RBF3", x, 44, "byte 44", "RBF3 centre count out of range"},
-        {"XTRA", x, 8, "byte 32", "no GRID section"},
+        {"GRID", g, 20, "byte 44", "shorter than its 36-byte head", E(GRID_HEAD)},
+        {"MATL", x, 19, "byte 32", "MATL section repeated or not 20 bytes", E(MATL_SIZE)},
+        {"MATL", x, 20, "byte 44", "MATL values out of range", E(MATL_VALUE)},
+        {"TOOL", x, 15, "byte 32", "TOOL section repeated or not 16 bytes", E(TOOL_SIZE)},
+        {"STAT", x, 20, "byte 44", "STAT transform not finite (or scale not > 0)", E(STAT_VALUE)},
+        {"STAT", x, 21, "byte 32", "STAT section repeated or not 20 bytes", E(STAT_SIZE)},
+        {"RBF3", x, 27, "byte 32", "RBF3 section repeated or shorter than 28", E(RBF3_HEAD)},
+        {"RBF3", x, 44, "byte 44", "RBF3 centre count out of range", E(RBF3_COUNT)},
+        {"XTRA", x, 8, "byte 32", "no GRID section", E(GRID_MISSING)},
     };
     for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
         b_begin(&f);
         b_sec(&f, cases[k].tag, cases[k].payload, cases[k].n);
         b_end(&f, p, 1);
-        expect_rule(p, cases[k].where, cases[k].rule);
+        expect_rule(p, cases[k].code, cases[k].where, cases[k].rule);
     }
     /* values inside sections */
     uint8_t t[64] = {0};
@@ -319,63 +326,67 @@ static void test_each_rule(void **state)
     b_begin(&f);
     b_sec(&f, "TOOL", t, 16);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 48", "TOOL radius or strength out of range");
+    expect_rule(p, ARGIL_FILE_ERR_TOOL_VALUE, "byte 48", "TOOL radius or strength out of range");
     memset(t, 0, sizeof(t));
     le_put_u32(t, 1);
     le_put_f32(t + 8, NAN);
     b_begin(&f);
     b_sec(&f, "RBF3", t, 44);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 44", "RBF3 holds NaN or Inf");
+    expect_rule(p, ARGIL_FILE_ERR_RBF3_VALUE, "byte 44", "RBF3 holds NaN or Inf");
     uint8_t g2[512];
     size_t g2l = grid_payload(g2, 0, 0.001f, 0.5f);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 44", "GRID dimension below 1");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_DIM, "byte 44", "GRID dimension below 1");
     g2l = grid_payload(g2, 1, 0.001f, 0.5f);
     le_put_u32(g2 + 4, 1u << 20);
     le_put_u32(g2 + 8, 1u << 20);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 52", "more than 2^30 samples");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_SAMPLES_MAX, "byte 52", "more than 2^30 samples");
     g2l = grid_payload(g2, 2, 0.001f, 0.5f);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l - 4);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 44", "GRID section length does not match its dimensions");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_LENGTH, "byte 44",
+                "GRID section length does not match its dimensions");
     g2l = grid_payload(g2, 1, -0.001f, 0.5f);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 56", "GRID spacing, origin, iso or band");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_GEOMETRY, "byte 56", "GRID spacing, origin, iso or band");
     g2l = grid_payload(g2, 1, 0.001f, 1.5f);
     b_begin(&f);
     b_sec(&f, "GRID", g2, g2l);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 80", "GRID density not a finite number in [0, 1]");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_DENSITY, "byte 80",
+                "GRID density not a finite number in [0, 1]");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     b_sec(&f, "GRID", g, gl);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 92", "second GRID section");
+    expect_rule(p, ARGIL_FILE_ERR_GRID_REPEATED, "byte 92", "second GRID section");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     b_sec(&f, "COLR", x, 5);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 104", "COLR section is not 3 bytes per GRID sample");
+    expect_rule(p, ARGIL_FILE_ERR_COLR_LENGTH, "byte 104",
+                "COLR section is not 3 bytes per GRID sample");
     b_begin(&f);
     b_sec(&f, "COLR", x, 6);
     b_sec(&f, "COLR", x, 6);
     b_sec(&f, "GRID", g, gl);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 54", "second COLR section");
+    expect_rule(p, ARGIL_FILE_ERR_COLR_REPEATED, "byte 54", "second COLR section");
     b_begin(&f);
     b_sec(&f, "GRID", g, gl);
     f.len += 4; /* 4 stray bytes before the file checksum */
     b_end(&f, p, 1);
-    expect_rule(p, "byte 92", "bytes between the last section and the file checksum");
+    expect_rule(p, ARGIL_FILE_ERR_TRAILING, "byte 92",
+                "bytes between the last section and the file checksum");
     /* an unknown section with a good checksum is skipped; order does not matter */
     uint8_t m[20];
     const float mf[5] = {2.0f, 1.0f, 1.0f, 1.0f, 0.0f};
@@ -390,7 +401,7 @@ static void test_each_rule(void **state)
     assert_float_equal(ok.grid.material.node_mass, 2.0f, 0);
     argil_doc_free(&ok);
     test_spit(p, "", 0);
-    expect_rule(p, "byte 0", "shorter than the 32-byte header");
+    expect_rule(p, ARGIL_FILE_ERR_SHORT, "byte 0", "shorter than the 32-byte header");
 }
 
 /* The OCTB section (octree B-spline fit): round trip to the same function, and each rule. */
@@ -454,15 +465,18 @@ static void test_octb(void **state)
         float size, coef;
         size_t cut;
         const char *where, *rule;
+        argil_file_err_t code;
     } bad[] = {
-        {1, 6, 0, 0.02f, 0.0f, 900, "byte 92", "OCTB section repeated or shorter"},
-        {0, 6, 0, 0.02f, 0.0f, 0, "byte 104", "OCTB node count not in 1..65537"},
-        {1, 5, 0, 0.02f, 0.0f, 0, "byte 108", "OCTB coefficients per axis not 6"},
-        {1, 6, 2, 0.02f, 0.0f, 0, "byte 112", "OCTB kind not 0"},
-        {1, 6, 0, 0.0f, 0.0f, 0, "byte 116", "OCTB origin, size, errors or overlap"},
-        {2, 6, 0, 0.02f, 0.0f, 0, "byte 144", "OCTB child links do not form an octree"},
-        {1, 6, 0, 0.02f, 0.0f, 4, "byte 104", "OCTB section length does not match"},
-        {1, 6, 0, 0.02f, NAN, 0, "byte 148", "OCTB coefficient NaN or Inf"},
+        {1, 6, 0, 0.02f, 0.0f, 900, "byte 92", "OCTB section repeated or shorter", E(OCTB_HEAD)},
+        {0, 6, 0, 0.02f, 0.0f, 0, "byte 104", "OCTB node count not in 1..65537", E(OCTB_NODES)},
+        {1, 5, 0, 0.02f, 0.0f, 0, "byte 108", "OCTB coefficients per axis not 6", E(OCTB_PER_AXIS)},
+        {1, 6, 2, 0.02f, 0.0f, 0, "byte 112", "OCTB kind not 0", E(OCTB_KIND)},
+        {1, 6, 0, 0.0f, 0.0f, 0, "byte 116", "OCTB origin, size, errors or overlap",
+         E(OCTB_GEOMETRY)},
+        {2, 6, 0, 0.02f, 0.0f, 0, "byte 144", "OCTB child links do not form an octree",
+         E(OCTB_LINKS)},
+        {1, 6, 0, 0.02f, 0.0f, 4, "byte 104", "OCTB section length does not match", E(OCTB_LENGTH)},
+        {1, 6, 0, 0.02f, NAN, 0, "byte 148", "OCTB coefficient NaN or Inf", E(OCTB_COEF)},
     };
     for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
         size_t ol = octb_payload(o, bad[k].n, bad[k].per_axis, bad[k].kind, bad[k].size, leaf,
@@ -475,7 +489,7 @@ static void test_octb(void **state)
         b_sec(&f, "GRID", g, gl);
         b_sec(&f, "OCTB", o, ol);
         b_end(&f, p, 1);
-        expect_rule(p, bad[k].where, bad[k].rule);
+        expect_rule(p, bad[k].code, bad[k].where, bad[k].rule);
     }
     const size_t ol = octb_payload(o, 1, 6, 0, 0.02f, leaf, 0.5f);
     b_begin(&f);
@@ -487,7 +501,7 @@ static void test_octb(void **state)
     argil_doc_free(&r);
     b_sec(&f, "OCTB", o, ol);
     b_end(&f, p, 1);
-    expect_rule(p, "byte 1016", "OCTB section repeated");
+    expect_rule(p, ARGIL_FILE_ERR_OCTB_HEAD, "byte 1016", "OCTB section repeated");
 }
 
 
@@ -557,7 +571,7 @@ static void test_painted_round_trip(void **state)
     bq = test_slurp(q, &lq);
     for (size_t cut = 0; cut < lq; cut += 7) {
         test_spit(p, bq, cut);
-        assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_ERR_PARSE);
+        assert_true(argil_file_read(p, &r, err, sizeof(err)) < ARGIL_FILE_ERR_FILE_SIZE);
         assert_non_null(strstr(err, p));
         assert_int_equal(grid_count(&r.grid), 0);
     }
@@ -667,40 +681,43 @@ static void test_mtls_rules(void **state)
     argil_doc_free(&r);
     le_put_u32(two + 24, GRID_MAT_DAMPING);
     mtls_case(p, 2, two, 44, 1);
-    expect_rule(p, "byte 128", "MTLS channel id not 0..3");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_CHANNEL, "byte 128", "MTLS channel id not 0..3");
 
     mtls_case(p, 1, m, ml, 1);
-    expect_rule(p, "byte 92", "MTLS section (painted material) in a version-1 file");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_VERSION, "byte 92",
+                "MTLS section (painted material) in a version-1 file");
     mtls_case(p, 2, m, ml, 2);
-    expect_rule(p, "byte 132", "second MTLS section");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_REPEATED, "byte 132", "second MTLS section");
     mtls_case(p, 2, m, 2, 1);
-    expect_rule(p, "byte 104", "shorter than its 4-byte channel count");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_COUNT, "byte 104", "shorter than its 4-byte channel count");
     mtls_case(p, 2, m, 4, 1);
-    expect_rule(p, "byte 108", "MTLS channel head runs past the section");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_CHANNEL, "byte 108",
+                "MTLS channel head runs past the section");
     ml = mtls_one(m, 0, 0, 1, 1, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 104", "MTLS channel count not in 1..4");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_COUNT, "byte 104", "MTLS channel count not in 1..4");
     ml = mtls_one(m, 5, 0, 1, 1, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 104", "MTLS channel count not in 1..4");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_COUNT, "byte 104", "MTLS channel count not in 1..4");
     ml = mtls_one(m, 1, 4, 1, 1, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 108", "MTLS channel id not 0..3");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_CHANNEL, "byte 108", "MTLS channel id not 0..3");
     ml = mtls_one(m, 1, 0, 0, 1, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 112", "MTLS channel with no runs");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_CHANNEL, "byte 112", "MTLS channel with no runs");
     ml = mtls_one(m, 1, 0, 1, 1, 0, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 116", "MTLS run empty, overlapping or out of order");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_RUN, "byte 116",
+                "MTLS run empty, overlapping or out of order");
     ml = mtls_one(m, 1, 0, 1, 2, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 116", "beyond the grid's samples");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_RUN, "byte 116", "beyond the grid's samples");
     ml = mtls_one(m, 1, 0, 1, 0, 2, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 116", "MTLS run values run past the section");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_RUN, "byte 116", "MTLS run values run past the section");
     ml = mtls_one(m, 1, 0, 2, 0, 1, 4.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 128", "MTLS run head runs past the section");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_RUN, "byte 128", "MTLS run head runs past the section");
     /* Two runs, the second starting inside the first. */
     ml = mtls_one(m, 1, 0, 2, 0, 2, 4.0f);
     le_put_f32(m + 24, 3.0f);
@@ -708,19 +725,19 @@ static void test_mtls_rules(void **state)
     le_put_u32(m + 32, 1);
     le_put_f32(m + 36, 2.0f);
     mtls_case(p, 2, m, 40, 1);
-    expect_rule(p, "byte 132", "overlapping or out of order");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_RUN, "byte 132", "overlapping or out of order");
     ml = mtls_one(m, 1, GRID_MAT_MASS, 1, 0, 1, 0.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 124", "MTLS value out of range");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_VALUE, "byte 124", "MTLS value out of range");
     ml = mtls_one(m, 1, GRID_MAT_STIFFNESS, 1, 0, 1, -1.0f);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 124", "MTLS value out of range");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_VALUE, "byte 124", "MTLS value out of range");
     ml = mtls_one(m, 1, GRID_MAT_RESTLEN, 1, 0, 1, NAN);
     mtls_case(p, 2, m, ml, 1);
-    expect_rule(p, "byte 124", "MTLS value out of range");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_VALUE, "byte 124", "MTLS value out of range");
     ml = mtls_one(m, 1, 0, 1, 0, 1, 4.0f);
     mtls_case(p, 2, m, ml + 3, 1);
-    expect_rule(p, "byte 128", "bytes after the last MTLS channel");
+    expect_rule(p, ARGIL_FILE_ERR_MTLS_TRAILING, "byte 128", "bytes after the last MTLS channel");
 }
 
 /* The paint settings a session chose (TOOL's paint rgb + section PNTS): they come back; a
@@ -772,7 +789,8 @@ static void test_paint_settings(void **state)
         b_sec(&f, "PNTS", v, 4);
         b_end(&f, p, 1);
         snprintf(where, sizeof(where), "byte %zu", 32 + 16 + gl + 12);
-        expect_rule(p, where, "PNTS soft-paint rate not in 0..100 per second");
+        expect_rule(p, ARGIL_FILE_ERR_PNTS_RATE, where,
+                    "PNTS soft-paint rate not in 0..100 per second");
     }
     for (int k = 0; k < 2; k++) {
         build_t f;
@@ -784,8 +802,37 @@ static void test_paint_settings(void **state)
             b_sec(&f, "PNTS", v, 4);
         b_end(&f, p, 1);
         snprintf(where, sizeof(where), "byte %zu", 32 + 16 + gl + (k == 0 ? 0 : 16 + 4));
-        expect_rule(p, where, "PNTS section repeated or not 4 bytes");
+        expect_rule(p, ARGIL_FILE_ERR_PNTS_SIZE, where, "PNTS section repeated or not 4 bytes");
     }
+}
+
+/* Failures outside the file have their own codes, and the boundary maps each code. */
+static void test_read_failures(void **state)
+{
+    (void)state;
+    char p[128], err[256];
+    argil_doc_t r;
+    assert_int_equal(argil_file_read(NULL, &r, err, sizeof(err)), ARGIL_FILE_ERR_ARG);
+    assert_string_equal(err, "argil_file_read: no path or no document");
+    snprintf(p, sizeof(p), "%s/absent.argil", g_test_dir);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_FILE_ERR_IO);
+    assert_non_null(strstr(err, "cannot open"));
+    assert_int_equal(argil_file_read(g_test_dir, &r, err, sizeof(err)), ARGIL_FILE_ERR_IO);
+    assert_non_null(strstr(err, "not a regular file"));
+    /* a sparse file one byte over the limit: refused before any byte is read */
+    snprintf(p, sizeof(p), "%s/huge.argil", g_test_dir);
+    test_spit(p, "", 0);
+    assert_int_equal(truncate(p, (off_t)IO_FILE_MAX_BYTES + 1), 0);
+    assert_int_equal(argil_file_read(p, &r, err, sizeof(err)), ARGIL_FILE_ERR_FILE_SIZE);
+    assert_non_null(strstr(err, "more than the 4294967296 this reader takes"));
+    assert_int_equal(grid_count(&r.grid), 0);
+    assert_int_equal(unlink(p), 0);
+
+    /* at the boundary: the failures outside the file as themselves, every rule PARSE */
+    const argil_err_t outside[] = {ARGIL_OK, ARGIL_ERR_ARG, ARGIL_ERR_IO, ARGIL_ERR_NOMEM};
+    for (int e = ARGIL_FILE_OK; e >= ARGIL_FILE_ERR_OCTB_COEF; e--)
+        assert_int_equal(argil_file_err_argil((argil_file_err_t)e),
+                         e > ARGIL_FILE_ERR_FILE_SIZE ? outside[-e] : ARGIL_ERR_PARSE);
 }
 
 int main(void)
@@ -800,6 +847,7 @@ int main(void)
         cmocka_unit_test(test_old_version_loads),
         cmocka_unit_test(test_mtls_rules),
         cmocka_unit_test(test_paint_settings),
+        cmocka_unit_test(test_read_failures),
     };
     return cmocka_run_group_tests(tests, setup_dir, test_dir_teardown);
 }

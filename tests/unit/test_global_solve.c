@@ -323,7 +323,7 @@ static void test_painted_stiffness_springs_back(void **st)
     assert_true(stiff < 0.3f * plain);
 }
 
-static argil_err_t parse(script_t *s, const char *text, char *err)
+static script_err_t parse(script_t *s, const char *text, char *err)
 {
     return script_parse(s, text, strlen(text), err, 256);
 }
@@ -362,7 +362,7 @@ static void test_script_paint_verb(void **st)
     for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
         script_init(&s);
         err[0] = '\0';
-        assert_int_equal(parse(&s, bad[k], err), ARGIL_ERR_PARSE);
+        assert_int_equal(script_err_argil(parse(&s, bad[k], err)), ARGIL_ERR_PARSE);
         if (!strstr(err, "line 1") || !strstr(err, why[k]))
             fail_msg("'%s' gave '%s'", bad[k], err);
         script_free(&s);

@@ -343,7 +343,7 @@ static void test_script_refine_verb(void **st)
     script_init(&s);
     err[0] = '\0';
     assert_int_equal(script_parse(&s, "wait 1\nrefine 2\n", 16, err, sizeof(err)),
-                     ARGIL_ERR_PARSE);
+                     SCRIPT_ERR_ARGS);
     assert_non_null(strstr(err, "line 2: 'refine' takes no arguments"));
     script_free(&s);
 }

@@ -236,7 +236,7 @@ static void test_torn_tail_every_byte(void **state)
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), JOURNAL_ERR_SHORT);
     assert_non_null(strstr(err, "shorter than the journal header"));
     assert_int_equal(grid_count(&doc.grid), 0);
     free(full);
@@ -261,7 +261,8 @@ static void test_bad_crc_in_the_middle_stops_there(void **state)
     argil_doc_t doc;
     journal_info_t info;
     char err[512] = "";
-    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)),
+                     JOURNAL_ERR_RECORD_CRC);
     assert_non_null(strstr(err, "record 2: checksum mismatch"));
     char want[64];
     snprintf(want, sizeof(want), "byte %zu:", r2);
@@ -297,12 +298,19 @@ static void test_wrong_base_refused(void **state)
                      ARGIL_OK);
     argil_doc_t doc;
     journal_info_t info;
-    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)),
+                     JOURNAL_ERR_BASE_MISMATCH);
     assert_non_null(strstr(err, "is not the one this journal continues"));
+    assert_int_equal(grid_count(&doc.grid), 0);
+    /* A base that is not a valid .argil file. */
+    test_spit(bp, "ARGIL", 5);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)),
+                     JOURNAL_ERR_BASE_FILE);
+    assert_non_null(strstr(err, "shorter than the 32-byte header"));
     assert_int_equal(grid_count(&doc.grid), 0);
     /* No base at all. */
     assert_int_equal(unlink(bp), 0);
-    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), JOURNAL_ERR_IO);
     assert_non_null(strstr(err, "journal-base-0.argil"));
     assert_int_equal(grid_count(&doc.grid), 0);
     sess_free(s);
@@ -378,15 +386,17 @@ static void fix_record_crc(uint8_t *b, size_t len)
         le_put_u32(b + r + 4 + payload, crc32c(0, b + r, 4 + payload));
 }
 
-static void expect_refusal(const uint8_t *b, size_t len, const char *rule)
+/* Replaying b is refused with code, err naming the byte and rule, and no record counted. */
+static void expect_refusal(const uint8_t *b, size_t len, journal_err_t code, const char *rule)
 {
     journal_info_t info;
     char err[512] = "";
     static float density[N_SAMPLES];
-    const argil_err_t e = journal_replay(b, len, "j.log", density, N_SAMPLES, &info, err,
-                                         sizeof(err));
-    if (e != ARGIL_ERR_PARSE || strstr(err, rule) == NULL || strstr(err, "j.log: byte ") != err)
-        fail_msg("wanted '%s', got %d '%s'", rule, e, err);
+    const journal_err_t e =
+        journal_replay(b, len, "j.log", density, N_SAMPLES, &info, err, sizeof(err));
+    if (e != code || journal_err_argil(e) != ARGIL_ERR_PARSE || strstr(err, rule) == NULL ||
+        strstr(err, "j.log: byte ") != err)
+        fail_msg("wanted %d '%s', got %d '%s'", code, rule, e, err);
     assert_int_equal(info.records, 0);
 }
 
@@ -405,103 +415,103 @@ static void test_each_rule(void **state)
                                     sizeof(err)),
                      ARGIL_OK);
     assert_int_equal(info.records, 1);
-    assert_int_equal(journal_replay(good, len, "j.log", density, N_SAMPLES - 1, &info, err,
-                                    sizeof(err)),
-                     ARGIL_ERR_ARG);
+    assert_int_equal(
+        journal_replay(good, len, "j.log", density, N_SAMPLES - 1, &info, err, sizeof(err)),
+        JOURNAL_ERR_ARG);
 
 #define FRESH() memcpy(b, good, len)
     /* Header rules. */
     FRESH();
     b[0] = 'X';
-    expect_refusal(b, len, "not an argil journal");
+    expect_refusal(b, len, JOURNAL_ERR_MAGIC, "not an argil journal");
     FRESH();
     b[20] ^= 1;
-    expect_refusal(b, len, "header checksum mismatch");
+    expect_refusal(b, len, JOURNAL_ERR_HEADER_CRC, "header checksum mismatch");
 #define HDR_FIX() le_put_u32(b + h - 4, crc32c(0, b, h - 4))
     FRESH();
     le_put_u32(b + 8, 3);
     HDR_FIX();
-    expect_refusal(b, len, "journal version (this argil reads 1..2)");
+    expect_refusal(b, len, JOURNAL_ERR_VERSION, "journal version (this argil reads 1..2)");
     FRESH();
     le_put_u32(b + 12, 100);
     HDR_FIX();
-    expect_refusal(b, len, "header size");
+    expect_refusal(b, len, JOURNAL_ERR_HEADER_SIZE, "header size");
     FRESH();
     le_put_u32(b + 16, 0);
     HDR_FIX();
-    expect_refusal(b, len, "grid dimension");
+    expect_refusal(b, len, JOURNAL_ERR_DIMS, "grid dimension");
     FRESH();
     le_put_f32(b + 28, -1.0f);
     HDR_FIX();
-    expect_refusal(b, len, "spacing");
+    expect_refusal(b, len, JOURNAL_ERR_GEOMETRY, "spacing");
     FRESH();
     le_put_f32(b + 52, 0.0f); /* node mass */
     HDR_FIX();
-    expect_refusal(b, len, "material out of range");
+    expect_refusal(b, len, JOURNAL_ERR_MATERIAL, "material out of range");
     FRESH();
     le_put_u32(b + 76, 0);
     HDR_FIX();
-    expect_refusal(b, len, "first record number 0");
+    expect_refusal(b, len, JOURNAL_ERR_FIRST_SEQ, "first record number 0");
     FRESH();
     b[96] = '/';
     HDR_FIX();
-    expect_refusal(b, len, "plain file name");
+    expect_refusal(b, len, JOURNAL_ERR_BASE_NAME, "plain file name");
     FRESH();
     b[96 + 50] = 'x';
     HDR_FIX();
-    expect_refusal(b, len, "NUL-padded");
+    expect_refusal(b, len, JOURNAL_ERR_BASE_PADDING, "NUL-padded");
     FRESH();
     b[97] = 0x01;
     HDR_FIX();
-    expect_refusal(b, len, "printable");
+    expect_refusal(b, len, JOURNAL_ERR_BASE_ASCII, "printable");
 
     /* Record rules, each with a good CRC. */
     FRESH();
     le_put_u32(b + p, 7);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "unknown record type 7");
+    expect_refusal(b, len, JOURNAL_ERR_RECORD_TYPE, "unknown record type 7");
     FRESH();
     le_put_u32(b + 8, 1); /* a version-1 journal has no painted-material records */
     HDR_FIX();
     le_put_u32(b + p, 2);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "unknown record type 2");
+    expect_refusal(b, len, JOURNAL_ERR_RECORD_TYPE, "unknown record type 2");
     FRESH();
     le_put_u32(b + p, 2); /* type 2 without its material blocks */
     fix_record_crc(b, len);
-    expect_refusal(b, len, "material block count runs past the record");
+    expect_refusal(b, len, JOURNAL_ERR_MAT_COUNT_HEAD, "material block count runs past the record");
     FRESH();
     le_put_u32(b + p + 4, 5);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "record 1: number 5, expected 1");
+    expect_refusal(b, len, JOURNAL_ERR_RECORD_SEQ, "record 1: number 5, expected 1");
     FRESH();
     le_put_f32(b + p + 28, -1.0f);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "record 1: material out of range");
+    expect_refusal(b, len, JOURNAL_ERR_RECORD_MATERIAL, "record 1: material out of range");
     FRESH();
     le_put_u32(b + p + 52, N_SAMPLES); /* first run's start: past the last sample */
     fix_record_crc(b, len);
-    expect_refusal(b, len, "beyond the grid");
+    expect_refusal(b, len, JOURNAL_ERR_RUN_RANGE, "beyond the grid");
     FRESH();
     le_put_u32(b + p + 56, 0); /* first run's count */
     fix_record_crc(b, len);
-    expect_refusal(b, len, "empty");
+    expect_refusal(b, len, JOURNAL_ERR_RUN_RANGE, "empty");
     FRESH();
     le_put_f32(b + p + 60, 1.5f);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "density not a finite number in [0, 1]");
+    expect_refusal(b, len, JOURNAL_ERR_DENSITY, "density not a finite number in [0, 1]");
     FRESH();
     le_put_f32(b + p + 60, NAN);
     fix_record_crc(b, len);
-    expect_refusal(b, len, "density not a finite number in [0, 1]");
+    expect_refusal(b, len, JOURNAL_ERR_DENSITY, "density not a finite number in [0, 1]");
     FRESH();
     le_put_u32(b + p + 48, le_get_u32(b + p + 48) + 1u); /* one run more than there is */
     fix_record_crc(b, len);
-    expect_refusal(b, len, "head runs past the record");
+    expect_refusal(b, len, JOURNAL_ERR_RUN_HEAD, "head runs past the record");
     FRESH();
     le_put_u32(b + p + 48, le_get_u32(b + p + 48) - 1u); /* one run less */
     fix_record_crc(b, len);
-    expect_refusal(b, len, "bytes after the last run");
+    expect_refusal(b, len, JOURNAL_ERR_TRAILING, "bytes after the last run");
     /* A record shorter than its head: length 8, its CRC fixed, and a second copy after it so
      * it is not the last. */
     {
@@ -511,7 +521,7 @@ static void test_each_rule(void **state)
         memset(small + h + 4, 0, 8);
         le_put_u32(small + h + 12, crc32c(0, small + h, 12));
         memcpy(small + h + 16, small + h, 16);
-        expect_refusal(small, sizeof(small), "shorter than a record head");
+        expect_refusal(small, sizeof(small), JOURNAL_ERR_RECORD_HEAD, "shorter than a record head");
     }
     /* Scanning without a model gives the same verdicts. */
     FRESH();
@@ -678,7 +688,8 @@ static void test_painted_material(void **state)
     gv_mat_set(&base.grid, GRID_MAT_MASS, 130, 0.25f);
     assert_int_equal(argil_file_write(bp, &base, err, sizeof(err)), ARGIL_OK);
     argil_doc_free(&base);
-    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(g_test_dir, &doc, &info, err, sizeof(err)),
+                     JOURNAL_ERR_BASE_MISMATCH);
     assert_non_null(strstr(err, "is not the one this journal continues"));
     assert_int_equal(grid_count(&doc.grid), 0);
 
@@ -690,28 +701,31 @@ static void test_painted_material(void **state)
     assert_int_equal(le_get_u32(full + blocks), 2);                /* stiffness, rest length */
     journal_info_t ji;
     static float density[N_SAMPLES];
-#define MAT_CASE(off, val, rule)                                                            \
-    do {                                                                                    \
-        uint8_t *m = malloc(len);                                                           \
-        assert_non_null(m);                                                                 \
-        memcpy(m, full, len);                                                               \
-        le_put_u32(m + (off), (val));                                                     \
-        le_put_u32(m + r + 4 + payload, crc32c(0, m + r, 4 + payload));                  \
-        const argil_err_t e = journal_replay(m, len, "j.log", density, N_SAMPLES, &ji, err, \
-                                             sizeof(err));                                  \
-        if (e != ARGIL_ERR_PARSE || strstr(err, rule) == NULL)                              \
-            fail_msg("wanted '%s', got %d '%s'", rule, e, err);                             \
-        free(m);                                                                            \
+#define MAT_CASE(off, val, code, rule)                                                             \
+    do {                                                                                           \
+        uint8_t *m = malloc(len);                                                                  \
+        assert_non_null(m);                                                                        \
+        memcpy(m, full, len);                                                                      \
+        le_put_u32(m + (off), (val));                                                              \
+        le_put_u32(m + r + 4 + payload, crc32c(0, m + r, 4 + payload));                            \
+        const journal_err_t e =                                                                    \
+            journal_replay(m, len, "j.log", density, N_SAMPLES, &ji, err, sizeof(err));            \
+        if (e != (code) || strstr(err, rule) == NULL)                                              \
+            fail_msg("wanted %d '%s', got %d '%s'", (code), rule, e, err);                         \
+        free(m);                                                                                   \
     } while (0)
-    MAT_CASE(blocks, 0, "material block count 0 not in 1..4");
-    MAT_CASE(blocks, 5, "material block count 5 not in 1..4");
-    MAT_CASE(blocks + 4, 9, "channel 9 not 0..3");
-    MAT_CASE(blocks + 8, 0, "channel 0 not 0..3 in increasing order, or no runs");
-    MAT_CASE(blocks + 12, N_SAMPLES, "material run 0");
-    MAT_CASE(blocks + 16, 0, "empty, beyond the grid or past the record");
-    MAT_CASE(blocks + 20, 0xff800000u, "painted material value out of range");
-    MAT_CASE(blocks, 3, "material block 2 head runs past the record");
-    MAT_CASE(blocks, 1, "bytes after the last run");
+    MAT_CASE(blocks, 0, JOURNAL_ERR_MAT_COUNT, "material block count 0 not in 1..4");
+    MAT_CASE(blocks, 5, JOURNAL_ERR_MAT_COUNT, "material block count 5 not in 1..4");
+    MAT_CASE(blocks + 4, 9, JOURNAL_ERR_MAT_CHANNEL, "channel 9 not 0..3");
+    MAT_CASE(blocks + 8, 0, JOURNAL_ERR_MAT_CHANNEL,
+             "channel 0 not 0..3 in increasing order, or no runs");
+    MAT_CASE(blocks + 12, N_SAMPLES, JOURNAL_ERR_MAT_RUN_RANGE, "material run 0");
+    MAT_CASE(blocks + 16, 0, JOURNAL_ERR_MAT_RUN_RANGE,
+             "empty, beyond the grid or past the record");
+    MAT_CASE(blocks + 20, 0xff800000u, JOURNAL_ERR_MAT_VALUE,
+             "painted material value out of range");
+    MAT_CASE(blocks, 3, JOURNAL_ERR_MAT_BLOCK_HEAD, "material block 2 head runs past the record");
+    MAT_CASE(blocks, 1, JOURNAL_ERR_TRAILING, "bytes after the last run");
 #undef MAT_CASE
     free(full);
     sess_free(s);
@@ -783,7 +797,7 @@ static void test_discard_and_bad_config(void **state)
     assert_false(journal_exists(g_test_dir));
     assert_int_equal(file_size("journal-base-0.argil"), -1);
     journal_info_t info;
-    assert_int_equal(journal_probe(g_test_dir, &info, err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(journal_probe(g_test_dir, &info, err, sizeof(err)), JOURNAL_ERR_IO);
     sess_free(s);
 
     journal_t j;

@@ -82,7 +82,7 @@ static void sess_recover_equal(sess_t *s, const char *sub, uint32_t want_records
     assert_int_equal(journal_sync(&s->j, err, sizeof(err)), ARGIL_OK);
     argil_doc_t d;
     journal_info_t info;
-    if (journal_recover(dir, &d, &info, err, sizeof(err)) != ARGIL_OK)
+    if (journal_recover(dir, &d, &info, err, sizeof(err)) != JOURNAL_OK)
         fail_msg("recover: %s", err);
     assert_int_equal(info.records, want_records);
     assert_non_null(d.rgb);
@@ -133,7 +133,7 @@ static void test_colour_round_trip(void **state)
     char dir[128];
     test_path(dir, sizeof(dir), "a");
     journal_info_t info;
-    assert_int_equal(journal_recover(dir, &b, &info, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(journal_recover(dir, &b, &info, err, sizeof(err)), JOURNAL_ERR_BASE_MISMATCH);
     assert_non_null(strstr(err, "is not the one this journal continues"));
     argil_doc_free(&b);
     journal_close(&s.j);
@@ -241,19 +241,23 @@ static void test_crafted_colour_records(void **state)
     static const struct {
         int kind;
         size_t byte;            /* offset in the tail the error names */
+        journal_err_t code; /* the rule broken */
         const char *why;
     } cases[] = {
-        {0, 0, "record 1: material block count 5 not in 0..4"},
-        {1, 4, "record 1: colour run count runs past the record"},
-        {2, 4, "record 1: colour run count 0"},
-        {3, 8, "record 1: colour run 0 head runs past the record"},
-        {4, 8, "record 1: colour run 0 (0 samples from 3) empty"},
-        {5, 8, "record 1: colour run 0 (2 samples from 999) empty, out of order, beyond the grid"},
-        {6, 8, "record 1: colour run 0 (4 samples from 3) empty, out of order, beyond the grid or "
-               "past the record"},
-        {7, 22, "record 1: colour run 1 (1 samples from 3) empty, out of order"},
-        {8, 19, "record 1: 2 bytes after the last run"},
-        {9, 0, "record 1: unknown record type 4"},
+        {0, 0, JOURNAL_ERR_MAT_COUNT, "record 1: material block count 5 not in 0..4"},
+        {1, 4, JOURNAL_ERR_RGB_COUNT_HEAD, "record 1: colour run count runs past the record"},
+        {2, 4, JOURNAL_ERR_RGB_COUNT, "record 1: colour run count 0"},
+        {3, 8, JOURNAL_ERR_RGB_RUN_HEAD, "record 1: colour run 0 head runs past the record"},
+        {4, 8, JOURNAL_ERR_RGB_RUN_RANGE, "record 1: colour run 0 (0 samples from 3) empty"},
+        {5, 8, JOURNAL_ERR_RGB_RUN_RANGE,
+         "record 1: colour run 0 (2 samples from 999) empty, out of order, beyond the grid"},
+        {6, 8, JOURNAL_ERR_RGB_RUN_RANGE,
+         "record 1: colour run 0 (4 samples from 3) empty, out of order, beyond the grid or "
+         "past the record"},
+        {7, 22, JOURNAL_ERR_RGB_RUN_RANGE,
+         "record 1: colour run 1 (1 samples from 3) empty, out of order"},
+        {8, 19, JOURNAL_ERR_TRAILING, "record 1: 2 bytes after the last run"},
+        {9, 0, JOURNAL_ERR_RECORD_TYPE, "record 1: unknown record type 4"},
     };
     for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
         buf_t t = {{0}, 0};
@@ -280,7 +284,7 @@ static void test_crafted_colour_records(void **state)
         const size_t byte = cases[k].kind == 9 ? JOURNAL_HEADER_BYTES + 4 : tail_at + cases[k].byte;
         snprintf(want, sizeof(want), "j.log: byte %zu: %s", byte, cases[k].why);
         assert_int_equal(journal_replay(file, len, "j.log", NULL, 0, &info, err, sizeof(err)),
-                         ARGIL_ERR_PARSE);
+                         cases[k].code);
         if (strncmp(err, want, strlen(want)) != 0)
             fail_msg("case %zu: got \"%s\", want \"%s\"", k, err, want);
         assert_null(strchr(err, '\n'));
@@ -307,7 +311,7 @@ static void test_crafted_colour_records(void **state)
     assert_int_equal(grid_init(&g, dims, 0.002f, vec3(0, 0, 0)), ARGIL_OK);
     journal_info_t info;
     char err[512] = "";
-    if (journal_replay_grid(file, len, "j.log", &g, &info, err, sizeof(err)) != ARGIL_OK)
+    if (journal_replay_grid(file, len, "j.log", &g, &info, err, sizeof(err)) != JOURNAL_OK)
         fail_msg("good record: %s", err);
     assert_int_equal(info.records, 1);
     assert_int_equal(info.rgb_samples, 3);

@@ -238,7 +238,8 @@ static void write_file(const char *path, const char *text)
 
 #define HEADER "time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,force_n,state,tool,buttons,contact,sculpting\n"
 
-static void expect_csv_error(const char *text, const char *needle)
+/* Reading text as a telemetry.csv is refused with code, err holding needle, and no rows kept. */
+static void expect_csv_error(telemetry_err_t code, const char *text, const char *needle)
 {
     char path[] = "/tmp/argil-test-render-XXXXXX";
     const int fd = mkstemp(path);
@@ -247,7 +248,7 @@ static void expect_csv_error(const char *text, const char *needle)
     write_file(path, text);
     telemetry_log_t log;
     char err[512] = "";
-    assert_int_equal(telemetry_log_read(path, &log, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(telemetry_log_read(path, &log, err, sizeof(err)), code);
     if (strstr(err, needle) == NULL)
         fail_msg("error '%s' lacks '%s'", err, needle);
     assert_int_equal(log.n, 0);
@@ -257,23 +258,34 @@ static void expect_csv_error(const char *text, const char *needle)
 static void test_telemetry_errors_name_the_line(void **state)
 {
     (void)state;
-    expect_csv_error("", "empty file");
-    expect_csv_error("time_s,x_mm\n1,2\n", "line 1: the header has no 'y_mm'");
-    expect_csv_error(HEADER, "no data rows");
-    expect_csv_error(HEADER "0.001,0,0,60,0,0,0,0,IDLE,0,0,0,0\n0.002,0,0,60,0,0\n",
+    expect_csv_error(TELEMETRY_ERR_EMPTY, "", "empty file");
+    expect_csv_error(TELEMETRY_ERR_COLUMN, "time_s,x_mm\n1,2\n",
+                     "line 1: the header has no 'y_mm'");
+    expect_csv_error(TELEMETRY_ERR_NO_ROWS, HEADER, "no data rows");
+    expect_csv_error(TELEMETRY_ERR_FIELDS,
+                     HEADER "0.001,0,0,60,0,0,0,0,IDLE,0,0,0,0\n0.002,0,0,60,0,0\n",
                      "line 3: 6 fields where the header has 13");
-    expect_csv_error(HEADER "0.001,0,0,6x,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm is not a finite");
-    expect_csv_error(HEADER "0.001,0,0,nan,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm");
+    expect_csv_error(TELEMETRY_ERR_NUMBER, HEADER "0.001,0,0,6x,0,0,0,0,IDLE,0,0,0,0\n",
+                     "line 2: z_mm is not a finite");
+    expect_csv_error(TELEMETRY_ERR_NUMBER, HEADER "0.001,0,0,nan,0,0,0,0,IDLE,0,0,0,0\n",
+                     "line 2: z_mm");
     /* Finite as a double but beyond a float (found by fuzz_telemetry). */
-    expect_csv_error(HEADER "0.001,0,0,8e100,0,0,0,0,IDLE,0,0,0,0\n", "line 2: z_mm is not a finite");
-    expect_csv_error(HEADER "0.002,0,0,1,0,0,0,0,IDLE,0,0,0,0\n0.001,0,0,1,0,0,0,0,IDLE,0,0,0,0\n",
+    expect_csv_error(TELEMETRY_ERR_NUMBER, HEADER "0.001,0,0,8e100,0,0,0,0,IDLE,0,0,0,0\n",
+                     "line 2: z_mm is not a finite");
+    expect_csv_error(TELEMETRY_ERR_TIME_BACKWARDS,
+                     HEADER "0.002,0,0,1,0,0,0,0,IDLE,0,0,0,0\n0.001,0,0,1,0,0,0,0,IDLE,0,0,0,0\n",
                      "line 3: time_s goes backwards");
-    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,,0,0,0,0\n", "line 2: state '' is empty");
-    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,1,0\n0.002,0,0,1,0,0,0,0,A,0,0,2,0\n",
+    expect_csv_error(TELEMETRY_ERR_STATE, HEADER "0.001,0,0,1,0,0,0,0,,0,0,0,0\n",
+                     "line 2: state '' is empty");
+    expect_csv_error(TELEMETRY_ERR_CONTACT,
+                     HEADER "0.001,0,0,1,0,0,0,0,A,0,0,1,0\n0.002,0,0,1,0,0,0,0,A,0,0,2,0\n",
                      "line 3: contact is not 0 or 1: '2'");
-    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,,0\n", "line 2: contact is not 0 or 1");
-    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,10,0\n", "line 2: contact is not 0 or 1");
-    expect_csv_error(HEADER "0.001,0,0,1,0,0,0,0,A,0,0,0,0\n0.002,0,0,1,0,0,0,0,B,0,0,0,0\n"
+    expect_csv_error(TELEMETRY_ERR_CONTACT, HEADER "0.001,0,0,1,0,0,0,0,A,0,0,,0\n",
+                     "line 2: contact is not 0 or 1");
+    expect_csv_error(TELEMETRY_ERR_CONTACT, HEADER "0.001,0,0,1,0,0,0,0,A,0,0,10,0\n",
+                     "line 2: contact is not 0 or 1");
+    expect_csv_error(TELEMETRY_ERR_STATES_MAX,
+                     HEADER "0.001,0,0,1,0,0,0,0,A,0,0,0,0\n0.002,0,0,1,0,0,0,0,B,0,0,0,0\n"
                             "0.003,0,0,1,0,0,0,0,C,0,0,0,0\n0.004,0,0,1,0,0,0,0,D,0,0,0,0\n"
                             "0.005,0,0,1,0,0,0,0,E,0,0,0,0\n0.006,0,0,1,0,0,0,0,F,0,0,0,0\n"
                             "0.007,0,0,1,0,0,0,0,G,0,0,0,0\n0.008,0,0,1,0,0,0,0,H,0,0,0,0\n"
@@ -282,7 +294,13 @@ static void test_telemetry_errors_name_the_line(void **state)
     telemetry_log_t log;
     char err[256];
     assert_int_equal(telemetry_log_read("/nonexistent/telemetry.csv", &log, err, sizeof(err)),
-                     ARGIL_ERR_IO);
+                     TELEMETRY_ERR_IO);
+    /* A command reports IO and NOMEM as they are and every broken rule as PARSE. */
+    assert_int_equal(telemetry_err_argil(TELEMETRY_OK), ARGIL_OK);
+    assert_int_equal(telemetry_err_argil(TELEMETRY_ERR_IO), ARGIL_ERR_IO);
+    assert_int_equal(telemetry_err_argil(TELEMETRY_ERR_NOMEM), ARGIL_ERR_NOMEM);
+    assert_int_equal(telemetry_err_argil(TELEMETRY_ERR_EMPTY), ARGIL_ERR_PARSE);
+    assert_int_equal(telemetry_err_argil(TELEMETRY_ERR_CONTACT), ARGIL_ERR_PARSE);
 }
 
 /* The contact column is kept when the header has it (chatter's first-contact rule), and a log

@@ -11,7 +11,7 @@
 #include "host/app/script.h"
 #include "shared/proto.h"
 
-static argil_err_t parse(script_t *s, const char *text, char *err)
+static script_err_t parse(script_t *s, const char *text, char *err)
 {
     return script_parse(s, text, strlen(text), err, 256);
 }
@@ -40,33 +40,37 @@ static void test_parses_every_command(void **st)
 static void test_errors_name_the_line_and_rule(void **st)
 {
     (void)st;
-    const struct { const char *text; const char *expect; } cases[] = {
-        {"wait 1\nmvoe 1 2 3 4\n", "line 2: unknown command 'mvoe'"},
-        {"tool pinch\n", "line 1: unknown tool 'pinch'"},
-        {"tool\n", "line 1: 'tool' takes one name"},
-        {"set radius_mm\n", "line 1: 'set' takes a name and a value"},
-        {"set colour 3\n", "line 1: unknown parameter 'colour'"},
-        {"set alpha abc\n", "line 1: 'abc' is not a number"},
-        {"set radius_mm 100\n", "line 1: radius_mm must be within"},
-        {"set radius_mm nan\n", "line 1: 'nan' is not a number"},
-        {"move 1 2 3\n", "line 1: 'move' takes X Y Z"},
-        {"move 1 2 x 1\n", "line 1: 'move' arguments must be numbers"},
-        {"move 1 2 9000 1\n", "line 1: move target beyond"},
-        {"move 1 2 3 0\n", "line 1: move duration must be within"},
-        {"press 3\n", "line 1: 'press' takes a button number"},
-        {"release\n", "line 1: 'release' takes a button number"},
-        {"wait\n", "line 1: 'wait' takes SECONDS"},
-        {"wait -1\n", "line 1: wait must be within"},
-        {"move 1 2 3 4 5 6\n", "line 1: too many words"},
-        {"wait 3000\nwait 3000\n", "line 2: the script runs longer than"},
+    const struct {
+        const char *text, *expect;
+        script_err_t code;
+    } cases[] = {
+        {"wait 1\nmvoe 1 2 3 4\n", "line 2: unknown command 'mvoe'", SCRIPT_ERR_COMMAND},
+        {"tool pinch\n", "line 1: unknown tool 'pinch'", SCRIPT_ERR_NAME},
+        {"tool\n", "line 1: 'tool' takes one name", SCRIPT_ERR_ARGS},
+        {"set radius_mm\n", "line 1: 'set' takes a name and a value", SCRIPT_ERR_ARGS},
+        {"set colour 3\n", "line 1: unknown parameter 'colour'", SCRIPT_ERR_NAME},
+        {"set alpha abc\n", "line 1: 'abc' is not a number", SCRIPT_ERR_NUMBER},
+        {"set radius_mm 100\n", "line 1: radius_mm must be within", SCRIPT_ERR_RANGE},
+        {"set radius_mm nan\n", "line 1: 'nan' is not a number", SCRIPT_ERR_NUMBER},
+        {"move 1 2 3\n", "line 1: 'move' takes X Y Z", SCRIPT_ERR_ARGS},
+        {"move 1 2 x 1\n", "line 1: 'move' arguments must be numbers", SCRIPT_ERR_NUMBER},
+        {"move 1 2 9000 1\n", "line 1: move target beyond", SCRIPT_ERR_RANGE},
+        {"move 1 2 3 0\n", "line 1: move duration must be within", SCRIPT_ERR_RANGE},
+        {"press 3\n", "line 1: 'press' takes a button number", SCRIPT_ERR_ARGS},
+        {"release\n", "line 1: 'release' takes a button number", SCRIPT_ERR_ARGS},
+        {"wait\n", "line 1: 'wait' takes SECONDS", SCRIPT_ERR_ARGS},
+        {"wait -1\n", "line 1: wait must be within", SCRIPT_ERR_RANGE},
+        {"move 1 2 3 4 5 6\n", "line 1: too many words", SCRIPT_ERR_WORDS},
+        {"wait 3000\nwait 3000\n", "line 2: the script runs longer than", SCRIPT_ERR_DURATION},
     };
     for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         script_t s;
         script_init(&s);
         char err[256] = "";
-        assert_int_equal(parse(&s, cases[i].text, err), ARGIL_ERR_PARSE);
-        if (strncmp(err, cases[i].expect, strlen(cases[i].expect)) != 0)
-            fail_msg("case %u: got '%s', want '%s…'", i, err, cases[i].expect);
+        const script_err_t e = parse(&s, cases[i].text, err);
+        if (e != cases[i].code || strncmp(err, cases[i].expect, strlen(cases[i].expect)) != 0)
+            fail_msg("case %u: got %d '%s', want %d '%s…'", i, e, err, cases[i].code,
+                     cases[i].expect);
         script_free(&s);
     }
     /* A line too long and an embedded NUL. */
@@ -75,10 +79,10 @@ static void test_errors_name_the_line_and_rule(void **st)
     script_t s;
     script_init(&s);
     char err[256];
-    assert_int_equal(script_parse(&s, big, sizeof(big), err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(script_parse(&s, big, sizeof(big), err, sizeof(err)), SCRIPT_ERR_LINE_LONG);
     assert_non_null(strstr(err, "longer than"));
     const char nul[] = "wait 1\nwa\0it 1\n";
-    assert_int_equal(script_parse(&s, nul, sizeof(nul) - 1, err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(script_parse(&s, nul, sizeof(nul) - 1, err, sizeof(err)), SCRIPT_ERR_LINE_NUL);
     assert_non_null(strstr(err, "line 2"));
     script_free(&s);
 }
@@ -89,7 +93,7 @@ static void test_missing_file_names_the_path(void **st)
     script_t s;
     script_init(&s);
     char err[256];
-    assert_int_equal(script_load(&s, "/nonexistent/x.scn", err, sizeof(err)), ARGIL_ERR_IO);
+    assert_int_equal(script_load(&s, "/nonexistent/x.scn", err, sizeof(err)), SCRIPT_ERR_IO);
     assert_non_null(strstr(err, "/nonexistent/x.scn: cannot open"));
 }
 

@@ -12,7 +12,9 @@
 #include "host/app/script.h"
 #include "shared/proto.h"
 
-static argil_err_t parse(script_t *s, const char *text, char *err)
+#define E(rule) SCRIPT_ERR_##rule /* a rule's code, in the list of the bad lines' rules */
+
+static script_err_t parse(script_t *s, const char *text, char *err)
 {
     return script_parse(s, text, strlen(text), err, 256);
 }
@@ -107,13 +109,22 @@ static void test_bad_lines_name_the_line_and_rule(void **st)
                          "press, release, wait, paint, refine, action, action_shape, mirror, undo, "
                          "redo)"},
     };
+    /* the rule each case breaks, in the order of cases */
+    static const script_err_t codes[] = {
+        E(ARGS), E(NAME), E(ARGS), E(NUMBER), E(NUMBER), E(NUMBER), E(WORDS), E(REPEATED),
+        E(OPTION), E(OPTION), E(WORDS), E(REPEATED), E(OPTION), E(OPTION), E(ARGS), E(OPTION),
+        E(NUMBER), E(RANGE), E(RANGE), E(ARGS), E(NAME), E(NAME), E(ARGS), E(ARGS), E(NAME),
+        E(NAME), E(NAME), E(COMMAND)
+    };
+    assert_int_equal(sizeof(codes) / sizeof(codes[0]), sizeof(cases) / sizeof(cases[0]));
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         script_t s;
         script_init(&s);
         char err[256] = "";
-        assert_int_equal(parse(&s, cases[i].text, err), ARGIL_ERR_PARSE);
-        if (strncmp(err, cases[i].expect, strlen(cases[i].expect)) != 0)
-            fail_msg("case %zu: got \"%s\", want \"%s\"", i, err, cases[i].expect);
+        const script_err_t e = parse(&s, cases[i].text, err);
+        if (e != codes[i] || strncmp(err, cases[i].expect, strlen(cases[i].expect)) != 0)
+            fail_msg("case %zu: got %d \"%s\", want %d \"%s\"", i, e, err, codes[i],
+                     cases[i].expect);
         assert_null(strchr(err, '\n')); /* one line */
         script_free(&s);
     }

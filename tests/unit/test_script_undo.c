@@ -25,7 +25,7 @@ static void test_parse(void **st)
     assert_int_equal(s.cmds[2].op, SCRIPT_REDO);
     assert_int_equal(script_first_history_line(&s), 3);
     const char *bad = "wait 1\nundo 2\n";
-    assert_int_equal(script_parse(&s, bad, strlen(bad), err, sizeof(err)), ARGIL_ERR_PARSE);
+    assert_int_equal(script_parse(&s, bad, strlen(bad), err, sizeof(err)), SCRIPT_ERR_ARGS);
     assert_string_equal(err, "line 2: 'undo' takes no arguments");
     const char *none = "wait 1\n";
     assert_int_equal(script_parse(&s, none, strlen(none), err, sizeof(err)), ARGIL_OK);
