@@ -17,9 +17,12 @@ printf '%s\n' "set radius_mm 4" "tool touch" "move 45 0 45 0.5" "move 45 0 0 0.5
     "release 1" "move 80 0 0 0.3" >"$script"
 
 # 1. Run until the journal has rebased at least once (base 2) and holds records, then kill -9.
-# The poll sees journal-base-2 a moment before the new journal.log replaces the old one, and a
-# rebased journal holds no record at first (its base already has the step that grew the clay);
-# a kill in either moment is retried, since neither is the state this test is about.
+# The rebase writes journal-base-2 first and then the journal.log that replaces the old one; the
+# poll waits for that one (newer than the base: the old log is large, and a size test alone
+# fired between the two writes, which a loaded machine stretches: 5 kills of 5 there). A rebased
+# journal holds no record at first (its base already has the step that grew the clay); a kill
+# then, or one the poll could not tell apart, is retried, since it is not the state this test
+# is about.
 attempt=0
 while :; do
     attempt=$((attempt + 1))
@@ -30,7 +33,8 @@ while :; do
     polls=0
     while :; do
         size=$(stat -c %s "$tmp/s/journal.log" 2>/dev/null || echo 0)
-        [ -e "$tmp/s/journal-base-2.argil" ] && [ "$size" -gt 20000 ] && break
+        [ -e "$tmp/s/journal-base-2.argil" ] && [ "$tmp/s/journal.log" -nt "$tmp/s/journal-base-2.argil" ] &&
+            [ "$size" -gt 20000 ] && break
         kill -0 "$pid" 2>/dev/null || break
         polls=$((polls + 1))
         [ "$polls" -lt 6000 ] || fail "no rebased journal after 60 s"
