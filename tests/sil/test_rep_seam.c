@@ -214,9 +214,9 @@ static void test_journal_recovers_a_second_representation(void **st)
 
     argil_doc_t doc;
     journal_info_t info;
-    const argil_err_t re = journal_recover(dir, &doc, &info, err, sizeof(err));
+    const journal_err_t re = journal_recover(dir, &doc, &info, err, sizeof(err));
     const grid_t *g = &doc.grid;
-    bool same_lattice = re == ARGIL_OK && g->spacing_m == ds.lat.spacing_m &&
+    bool same_lattice = re == JOURNAL_OK && g->spacing_m == ds.lat.spacing_m &&
                         g->origin_m.x == ds.lat.origin_m.x && g->origin_m.y == ds.lat.origin_m.y &&
                         g->origin_m.z == ds.lat.origin_m.z;
     for (int a = 0; a < 3; a++)
@@ -252,7 +252,7 @@ static void test_journal_recovers_a_second_representation(void **st)
     assert_true(js.syncs > 0);
     assert_int_equal(unwritten, 0); /* nothing was left for a final write */
     assert_int_equal(strays, 0);    /* every change was inside the box the step reported */
-    assert_int_equal(re, ARGIL_OK);
+    assert_int_equal(re, JOURNAL_OK);
     assert_true(same_lattice);
     assert_int_equal(info.records, js.records);
     assert_true(max_diff == 0.0f);
