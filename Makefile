@@ -147,9 +147,12 @@ $(REL)/argil: $(REL)/host/app/main.o $(REL)/libargil.a
 $(SAN)/argil: $(SAN)/host/app/main.o $(SAN)/libargil.a
 	$(CC) $(TEST_CFLAGS) $^ -o $@ $(LDLIBS)
 
+# A test is rebuilt when a header it includes changes (tests/sil/rig.h, rep_dent_sphere.h …): -MMD
+# writes its .d into deps/ next to the binaries (not among them: the runner runs every test_* there),
+# included at the end.
 $(SAN)/tests/%: tests/unit/%.c $(SAN)/libargil.a
-	@mkdir -p $(dir $@)
-	$(CC) $(TEST_CFLAGS) $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
+	@mkdir -p $(dir $@)deps
+	$(CC) $(TEST_CFLAGS) -MMD -MP -MF $(dir $@)deps/$(notdir $@).d $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
 
 # A UDP host for tests/sys/test_board_daemon.sh (the host's protocol peer over a real socket).
 $(REL)/board_udp_client: tests/sys/board_udp_client.c $(REL)/libargil.a
@@ -176,12 +179,12 @@ tests-build: $(REL)/argil-sim $(REL)/argil-hil-check
 
 # Tests of the daemon and the Linux HAL link against the board library (no hal_sim.c).
 $(SAN)/tests/test_board_%: tests/unit/test_board_%.c $(SAN)/libboard.a
-	@mkdir -p $(dir $@)
-	$(CC) $(TEST_CFLAGS) $< $(SAN)/libboard.a -o $@ -lcmocka $(BOARD_LDLIBS)
+	@mkdir -p $(dir $@)deps
+	$(CC) $(TEST_CFLAGS) -MMD -MP -MF $(dir $@)deps/$(notdir $@).d $< $(SAN)/libboard.a -o $@ -lcmocka $(BOARD_LDLIBS)
 
 $(SAN)/sil/%: tests/sil/%.c $(SAN)/libargil.a
-	@mkdir -p $(dir $@)
-	$(CC) $(TEST_CFLAGS) $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
+	@mkdir -p $(dir $@)deps
+	$(CC) $(TEST_CFLAGS) -MMD -MP -MF $(dir $@)deps/$(notdir $@).d $< $(SAN)/libargil.a -o $@ -lcmocka $(LDLIBS)
 
 # The real-time parts must not reach the heap, stdio or blocking calls: link them into one
 # relocatable object and list what they still need from outside.
