@@ -8,19 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "host/model/f32_buf.h"
 #include "host/solve/gsolve_internal.h"
 
 /* gs->buf grown to at least n floats; NULL when out of memory. */
 float *gsolve_scratch(gsolve_t *gs, size_t n)
 {
-    if (n > gs->buf_n) {
-        float *b = realloc(gs->buf, n * sizeof(float));
-        if (!b)
-            return NULL;
-        gs->buf = b;
-        gs->buf_n = n;
-    }
-    return gs->buf;
+    return f32_buf_reserve(&gs->buf, &gs->buf_n, n) ? gs->buf : NULL;
 }
 
 /* gsolve_init_ratio at GSOLVE_RATIO_DEFAULT samples per knot span. */
